@@ -1,0 +1,3 @@
+from robotkit.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,138 @@
+"""doit task actions: module-level functions with picklable arguments.
+
+They run in worker processes under ``-j N`` (LIBRARIES.md section 6), so
+every input arrives as plain data and every output is written atomically.
+A user error becomes a failed task whose message is the problem lines; the
+build turns those into exit status 2.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import shutil
+
+from robotkit.errors import Problem, RobotkitError
+from robotkit.ioutil import write_if_changed
+
+FACTS_VERSION = 1
+
+
+def _user_errors_fail(fn):
+    @functools.wraps(fn)
+    def run(*args, **kwargs):
+        from doit.exceptions import TaskFailed
+
+        try:
+            fn(*args, **kwargs)
+        except RobotkitError as exc:
+            return TaskFailed("\n".join(exc.lines()))
+        return None
+
+    return run
+
+
+def dump_json(data) -> str:
+    return json.dumps(data, indent=1, sort_keys=True) + "\n"
+
+
+@_user_errors_fail
+def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
+    """Load a mesh, make it a closed volume, record its unit-density mass properties."""
+    import numpy as np
+
+    from robotkit.mesh.inertia import mesh_mass_properties
+    from robotkit.mesh.io import load_mesh, volume_mesh
+
+    loc = Problem("", **where)
+    mesh = load_mesh(source, scale, loc)
+    name = _display(source)
+    faces_in = len(mesh.faces)
+    bbox_min, bbox_max = mesh.bounds
+    vol_mesh, repairs, used, warnings = volume_mesh(mesh, policy, name, loc)
+    props = mesh_mass_properties(vol_mesh.vertices, vol_mesh.faces)
+    if not props.volume > 0:
+        raise RobotkitError(Problem(f"mesh '{name}' encloses no volume", **where))
+    facts = {
+        "version": FACTS_VERSION,
+        "source": name,
+        "scale": list(scale),
+        "faces": faces_in,
+        "vertices": int(len(mesh.vertices)),
+        "bbox_min": [float(v) for v in bbox_min],
+        "bbox_max": [float(v) for v in bbox_max],
+        "volume": props.volume,
+        "com": [float(v) for v in props.com],
+        "inertia": [[float(v) for v in row] for row in np.asarray(props.inertia)],
+        "used": used,
+        "repairs": repairs,
+        "warnings": [f"{_where_text(where)}{w}" for w in warnings],
+    }
+    write_if_changed(target, dump_json(facts))
+
+
+def _display(path: str) -> str:
+    from robotkit.errors import display_path
+
+    return display_path(path)
+
+
+def _where_text(where: dict) -> str:
+    p = Problem("", **where)
+    return str(p)
+
+
+def read_facts(paths: dict[str, str]) -> dict:
+    out = {}
+    for key, path in paths.items():
+        with open(path, encoding="utf-8") as f:
+            out[key] = json.load(f)
+    return out
+
+
+@_user_errors_fail
+def link_inertial(link, fact_paths: dict[str, str], target: str):
+    """Compute one link's inertial from the mesh facts of its source geometry."""
+    from robotkit.model.resolve import finalize_link_inertial, inertial_to_json
+
+    inertial = finalize_link_inertial(link, read_facts(fact_paths))
+    write_if_changed(target, dump_json(inertial_to_json(inertial)))
+
+
+def _finalized(robot, fact_paths: dict[str, str], inertial_paths: dict[str, str]):
+    from robotkit.model.resolve import finalize, inertial_from_json
+
+    inertials = {}
+    for link, path in inertial_paths.items():
+        with open(path, encoding="utf-8") as f:
+            inertials[link] = inertial_from_json(json.load(f))
+    return finalize(robot, read_facts(fact_paths), inertials)
+
+
+@_user_errors_fail
+def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[str, str], target: str,
+         options: dict):
+    """Render one output file of a finalized robot through a registered emitter."""
+    from robotkit.emit import EMITTERS
+
+    full = _finalized(robot, fact_paths, inertial_paths)
+    write_if_changed(target, EMITTERS[emitter](full, **options))
+
+
+@_user_errors_fail
+def copy_file(source: str, target: str):
+    """Copy a file verbatim (visual meshes keep their format, colours and textures)."""
+    import os
+
+    if os.path.exists(target) and _same_file(source, target):
+        return
+    tmp = target + ".tmp"
+    os.makedirs(os.path.dirname(target), exist_ok=True)
+    shutil.copyfile(source, tmp)
+    os.replace(tmp, target)
+
+
+def _same_file(a: str, b: str) -> bool:
+    import filecmp
+
+    return filecmp.cmp(a, b, shallow=False)

@@ -1,0 +1,173 @@
+"""The build: recipes -> resolved robots -> doit tasks -> files under the output folder.
+
+    load + validate each recipe   (robotkit.recipe.load)   all problems together, exit 2
+    resolve to a Robot            (robotkit.model.resolve) tree checks, SI units
+    task dicts                    (robotkit.tasks)         file_dep, targets, config_changed
+    run them with doit            (here)                   incremental, -j N worker processes
+
+doit's own record (which tasks ran, which were up to date) is returned in a
+:class:`BuildResult`; the CLI prints it, and the tests assert on it.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from robotkit.errors import Problem, RobotkitError
+
+
+@dataclass
+class BuildResult:
+    ran: list[str] = field(default_factory=list)
+    uptodate: list[str] = field(default_factory=list)
+    failed: list[tuple[str, str]] = field(default_factory=list)  # (task, message) user errors
+    errors: list[tuple[str, str]] = field(default_factory=list)  # (task, traceback) bugs
+    warnings: list[str] = field(default_factory=list)
+    robots: list[str] = field(default_factory=list)
+
+
+class _Recorder:
+    """A doit reporter that records instead of printing."""
+
+    def __init__(self, result: BuildResult, echo=None):
+        self.result = result
+        self.echo = echo
+        self.failures = []
+        self.runtime_errors: list[str] = []
+
+    def initialize(self, tasks, selected_tasks):
+        pass
+
+    def get_status(self, task):
+        pass
+
+    def execute_task(self, task):
+        if task.actions:
+            self.result.ran.append(task.name)
+            if self.echo:
+                self.echo(f"  {task.name}")
+
+    def add_failure(self, task, fail):
+        from doit.exceptions import TaskFailed, UnmetDependency
+
+        if isinstance(fail, UnmetDependency):
+            return
+        if isinstance(fail, TaskFailed):
+            self.result.failed.append((task.name, fail.message))
+        else:
+            self.result.errors.append((task.name, fail.get_msg()))
+
+    def add_success(self, task):
+        pass
+
+    def skip_uptodate(self, task):
+        self.result.uptodate.append(task.name)
+
+    def skip_ignore(self, task):
+        pass
+
+    def cleanup_error(self, exception):
+        self.result.errors.append(("cleanup", exception.get_msg()))
+
+    def runtime_error(self, msg):
+        self.runtime_errors.append(msg)
+
+    def teardown_task(self, task):
+        pass
+
+    def complete_run(self):
+        pass
+
+
+def state_db(out_dir: Path) -> str:
+    from robotkit.tasks import STATE
+
+    return str(out_dir / STATE / "doit.sqlite3")
+
+
+def doit_config(out_dir: Path, reporter=None) -> dict:
+    """The doit settings shared by ``robotkit build`` and dodo.py."""
+    cfg = {
+        "dep_file": state_db(out_dir),
+        "backend": "sqlite3",
+        "check_file_uptodate": "md5",
+        "verbosity": 0,
+        "continue": True,
+    }
+    if reporter is not None:
+        cfg["reporter"] = reporter
+        cfg["outfile"] = io.StringIO()
+    return cfg
+
+
+def to_doit(task: dict) -> dict:
+    """Our task dict -> doit's (names are flat strings; robot:kind:item)."""
+    return {"basename": task["name"], **{k: v for k, v in task.items() if k != "name"}}
+
+
+def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
+          echo=None) -> BuildResult:
+    """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem."""
+    from doit.cmd_base import TaskLoader2
+    from doit.doit_cmd import DoitMain
+    from doit.task import dict_to_task
+
+    from robotkit.tasks import load_robots, mesh_locations, robot_tasks
+
+    out = Path(out_dir).absolute()
+    robots = load_robots(recipes)  # raises before anything is written
+    result = BuildResult(robots=[r.name for _, r in robots])
+    tasks = []
+    for loaded, robot in robots:
+        tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot)))
+    (out / ".robotkit").mkdir(parents=True, exist_ok=True)
+    recorder = _Recorder(result, echo)
+
+    class Loader(TaskLoader2):
+        def setup(self, opt_values):
+            pass
+
+        def load_doit_config(self):
+            return doit_config(out, recorder)
+
+        def load_tasks(self, cmd, pos_args):
+            return [dict_to_task(dict(t)) for t in tasks]
+
+    args = ["run"]
+    if jobs > 1:
+        args += ["-n", str(jobs), "-P", "process"]
+    rc = DoitMain(Loader(), config_filenames=()).run(args)
+    if recorder.runtime_errors:
+        result.errors.append(("doit", "\n".join(recorder.runtime_errors)))
+    if result.failed:
+        lines = []
+        for _, msg in result.failed:
+            for line in msg.splitlines():
+                if line not in lines:
+                    lines.append(line)
+        raise RobotkitError([Problem(line) for line in lines])
+    if rc not in (0,) and not result.errors:
+        result.errors.append(("doit", f"doit exited with status {rc}"))
+    result.warnings = collect_warnings(out, result.robots)
+    return result
+
+
+def collect_warnings(out: Path, robots: list[str]) -> list[str]:
+    """Warnings recorded by mesh tasks (shown on every build, not only the one that ran them)."""
+    from robotkit.tasks import STATE
+
+    seen: list[str] = []
+    for name in robots:
+        for path in sorted((out / STATE / name / "mesh").glob("*.json")):
+            try:
+                data = json.loads(path.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                continue
+            for w in data.get("warnings", []):
+                if w not in seen:
+                    seen.append(w)
+    return seen

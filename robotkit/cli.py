@@ -1,0 +1,118 @@
+"""The robotkit command line.  Each command loads its input, calls one function,
+and maps a RobotkitError to one line per problem and exit status 2.
+
+Heavy libraries (trimesh, numpy, pydantic, doit, jinja2) are imported inside
+the commands, so ``robotkit --help`` and argument errors stay instant.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # usage errors: exit 2 with one line, like every bad input
+        self.print_usage(sys.stderr)
+        print(f"robotkit: error: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="robotkit", description="Declarative build system for robot description assets.")
+    p.add_argument("--version", action="store_true", help="print the version and exit")
+    sub = p.add_subparsers(dest="command", parser_class=_Parser)
+
+    b = sub.add_parser("build", help="build recipes into URDF, Gazebo model folders and meshes",
+                       description="Build each RECIPE into OUT/<robot>/ (incremental: only what changed reruns).")
+    b.add_argument("recipes", nargs="+", metavar="RECIPE", help="recipe YAML file(s)")
+    b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
+    b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="run N tasks in parallel processes")
+    b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
+
+    w = sub.add_parser("world", help="turn a ROS map_server occupancy map into a Gazebo world and MuJoCo scene",
+                       description="Write OUT/<name>/ with model.config, model.sdf, meshes/<name>.stl, "
+                                   "<name>.world and scene.xml.")
+    w.add_argument("map", metavar="MAP.yaml", help="map_server YAML file")
+    w.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
+    w.add_argument("--name", help="world name (default: the YAML file's stem)")
+    w.add_argument("--height", type=float, default=2.0, metavar="H", help="wall height in metres (default: 2.0)")
+    w.add_argument("--unknown-as-wall", action="store_true", help="treat unknown cells as walls")
+
+    s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
+    s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    if args.version:
+        from robotkit import __version__
+
+        print(f"robotkit {__version__}")
+        return 0
+    if args.command is None:
+        _parser().print_help()
+        return 2
+    from robotkit.errors import RobotkitError
+
+    try:
+        return {"build": _build, "world": _world, "schema": _schema}[args.command](args)
+    except RobotkitError as exc:
+        for line in exc.lines():
+            print(line, file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("robotkit: interrupted", file=sys.stderr)
+        return 130
+
+
+def _build(args) -> int:
+    from robotkit.build import build
+
+    if args.jobs < 1:
+        print("robotkit: error: -j must be at least 1", file=sys.stderr)
+        return 2
+    start = time.perf_counter()
+    echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
+    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo)
+    for w in result.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    if result.errors:
+        for name, msg in result.errors:
+            print(f"robotkit: internal error in task {name}:\n{msg}", file=sys.stderr)
+        return 1
+    elapsed = time.perf_counter() - start
+    out = os.path.relpath(os.path.abspath(args.out))
+    names = ", ".join(f"{out}/{r}" for r in result.robots)
+    if result.ran:
+        print(f"built {names}: {len(result.ran)} tasks run, {len(result.uptodate)} up to date ({elapsed:.2f} s)")
+    else:
+        print(f"{names}: up to date ({len(result.uptodate)} tasks, {elapsed:.2f} s)")
+    return 0
+
+
+def _world(args) -> int:
+    from robotkit.world import build_world
+
+    if not args.height > 0:
+        print("robotkit: error: --height must be > 0", file=sys.stderr)
+        return 2
+    paths = build_world(args.map, args.out, name=args.name, height=args.height,
+                        unknown_as_wall=args.unknown_as_wall)
+    for p in paths:
+        print(os.path.relpath(p))
+    return 0
+
+
+def _schema(args) -> int:
+    from robotkit.recipe.reference import json_schema, markdown
+
+    print(markdown() if args.markdown else json_schema(), end="")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

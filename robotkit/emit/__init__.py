@@ -1,0 +1,47 @@
+"""Emitters: a finalized Robot -> the text of one output file.
+
+Each emitter is registered by name; the doit tasks and the tests loop over
+this registry.  An emitter reads only the resolved model, never the recipe.
+"""
+
+from __future__ import annotations
+
+
+def _urdf(robot, **_):
+    from robotkit.emit.urdf import render_urdf
+
+    return render_urdf(robot)
+
+
+def _model_config(robot, sdf: str, **_):
+    from robotkit.emit.gazebo import render_model_config
+
+    return render_model_config(robot, sdf)
+
+
+def _package_xml(robot, **_):
+    from robotkit.emit.gazebo import render_package_xml
+
+    return render_package_xml(robot)
+
+
+def _cmakelists(robot, **_):
+    from robotkit.emit.gazebo import render_cmakelists
+
+    return render_cmakelists(robot)
+
+
+EMITTERS = {
+    "urdf": _urdf,
+    "model.config": _model_config,
+    "package.xml": _package_xml,
+    "CMakeLists.txt": _cmakelists,
+}
+
+# the templates each emitter renders (their edits must rebuild the output)
+TEMPLATES = {
+    "urdf": ["urdf/robot.urdf.j2"],
+    "model.config": ["gazebo/model.config.j2"],
+    "package.xml": ["ros/package.xml.j2"],
+    "CMakeLists.txt": ["ros/CMakeLists.txt.j2"],
+}

@@ -1,0 +1,63 @@
+"""The one Jinja environment every emitter renders through.
+
+Search path, in order: a recipe's own template folder (when given), the
+templates shipped inside the wheel (``robotkit/templates``), and the
+repository's top-level ``templates/`` (development checkout).
+StrictUndefined turns a missing context value into an error instead of an
+empty string; autoescaping keeps every attribute and text well-formed XML.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from pathlib import Path
+
+_PKG = Path(__file__).resolve().parent.parent
+
+
+def template_dirs(extra: tuple[str, ...] = ()) -> list[str]:
+    dirs = [str(Path(d)) for d in extra]
+    for d in (_PKG / "templates", _PKG.parent / "templates"):
+        if d.is_dir():
+            dirs.append(str(d))
+    return dirs
+
+
+def fmt(x: float) -> str:
+    """Shortest text that reads back as the same float64 (no -0, no exponent surprises)."""
+    x = float(x)
+    if not math.isfinite(x):
+        raise ValueError(f"cannot write non-finite number {x!r}")
+    if x == 0.0:
+        return "0"
+    text = repr(x)
+    if text.endswith(".0"):
+        text = text[:-2]
+    return text
+
+
+def vec(values) -> str:
+    return " ".join(fmt(v) for v in values)
+
+
+@functools.lru_cache(maxsize=8)
+def environment(extra: tuple[str, ...] = ()):
+    import jinja2
+
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(template_dirs(extra)),
+        undefined=jinja2.StrictUndefined,
+        autoescape=True,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+    )
+    env.filters["fmt"] = fmt
+    env.filters["vec"] = vec
+    return env
+
+
+def render(template: str, extra_dirs: tuple[str, ...] = (), **context) -> str:
+    """Render ``template`` (a path below a template folder) with ``context``."""
+    return environment(tuple(extra_dirs)).get_template(template).render(**context)

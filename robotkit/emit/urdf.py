@@ -1,0 +1,54 @@
+"""Robot -> URDF text (templates/urdf/robot.urdf.j2)."""
+
+from __future__ import annotations
+
+from robotkit.emit.env import render
+from robotkit.model.robot import Geom, Robot
+
+
+def mesh_uri(robot: Robot, geom: Geom) -> str:
+    return f"package://{robot.name}/meshes/visual/{geom.shape.mesh.file_name}"
+
+
+def geom_context(robot: Robot, geom: Geom) -> dict:
+    s = geom.shape
+    pose = geom.pose
+    ctx = {"xyz": pose.xyz, "rpy": pose.rpy, "kind": s.kind, "material": geom.material}
+    if s.kind == "mesh":
+        ctx["uri"] = mesh_uri(robot, geom)
+        ctx["scale"] = s.mesh.scale if any(v != 1.0 for v in s.mesh.scale) else None
+    elif s.kind == "box":
+        ctx["size"] = s.size
+    else:
+        ctx["radius"] = s.radius
+        ctx["length"] = s.length
+    return ctx
+
+
+def context(robot: Robot) -> dict:
+    materials = {m.name: m for m in robot.materials}
+    used = sorted({g.material for link in robot.links for g in link.visuals if g.material})
+    links = []
+    for link in robot.links:
+        gazebo_material = None
+        for g in link.visuals:
+            if g.material and materials[g.material].gazebo:
+                gazebo_material = materials[g.material].gazebo
+                break
+        links.append({
+            "name": link.name,
+            "visuals": [geom_context(robot, g) for g in link.visuals],
+            "collisions": [geom_context(robot, g) for g in link.collisions],
+            "inertial": link.inertial,
+            "gazebo_material": gazebo_material,
+        })
+    return {
+        "robot": robot,
+        "materials": [materials[name] for name in used],
+        "links": links,
+        "joints": robot.joints,
+    }
+
+
+def render_urdf(robot: Robot) -> str:
+    return render("urdf/robot.urdf.j2", **context(robot))

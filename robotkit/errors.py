@@ -1,0 +1,68 @@
+"""Errors a user can fix, reported as one line each.
+
+Every user-facing failure is a :class:`RobotkitError` holding one or more
+:class:`Problem` lines.  The CLI prints each line and exits 2; anything else
+that escapes is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+
+def display_path(path: str | os.PathLike | None) -> str:
+    """A path as the user would like to read it: relative to the cwd when below it."""
+    if path is None:
+        return "<input>"
+    path = os.fspath(path)
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:  # other drive (Windows)
+        return path
+    return path if rel.startswith("..") else rel
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One problem: ``file:line: key: message`` with the parts that are known."""
+
+    message: str
+    file: str | None = None
+    line: int | None = None
+    key: str | None = None
+
+    def __str__(self) -> str:
+        where = ""
+        if self.file is not None:
+            where = display_path(self.file)
+            if self.line is not None:
+                where += f":{self.line}"
+            where += ": "
+        key = f"{self.key}: " if self.key else ""
+        return f"{where}{key}{self.message}"
+
+
+class RobotkitError(Exception):
+    """A problem with the user's input; carries every problem found, in order."""
+
+    def __init__(self, problems: Problem | str | list[Problem]):
+        if isinstance(problems, (Problem, str)):
+            problems = [problems]
+        self.problems: list[Problem] = [Problem(p) if isinstance(p, str) else p for p in problems]
+        super().__init__("\n".join(str(p) for p in self.problems))
+
+    def lines(self) -> list[str]:
+        return [str(p) for p in self.problems]
+
+
+class RecipeError(RobotkitError):
+    """The recipe is invalid (schema, references, tree structure)."""
+
+
+class MeshError(RobotkitError):
+    """A mesh file cannot be read or used as asked."""
+
+
+class MapError(RobotkitError):
+    """An occupancy map (map_server YAML + image) is invalid."""

@@ -1,0 +1,108 @@
+"""Loading mesh files, and making them closed volumes for mass properties.
+
+trimesh returns wrong mass properties without a warning for meshes that are
+not closed, consistently wound volumes (LIBRARIES.md section 3), so every mesh
+used for an inertial goes through :func:`volume_mesh`: safe repairs first,
+then the recipe's policy (convex hull with a warning, or an error).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from robotkit.errors import MeshError, Problem
+
+SUPPORTED = (".stl", ".obj", ".dae")
+
+
+def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
+    """Load ``path`` as one triangle mesh in metres (coordinates times ``scale``).
+
+    ``where`` locates the recipe key that names the file, for error messages.
+    """
+    import trimesh
+
+    def fail(msg: str) -> MeshError:
+        base = where or Problem("")
+        return MeshError(Problem(msg, file=base.file, line=base.line, key=base.key))
+
+    name = os.path.basename(path)
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in SUPPORTED:
+        raise fail(f"mesh file '{name}' has an unsupported format (use STL, OBJ or DAE)")
+    if not os.path.isfile(path):
+        raise fail(f"mesh file '{name}' does not exist")
+    try:
+        loaded = trimesh.load(path, force="mesh", process=True)
+    except Exception as exc:  # trimesh raises many kinds on corrupt input
+        raise fail(f"cannot read mesh file '{name}': {type(exc).__name__}: {exc}".rstrip(": ")) from None
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        raise fail(f"mesh file '{name}' holds no triangles")
+    vertices = np.asarray(loaded.vertices, dtype=np.float64)
+    if not np.isfinite(vertices).all():
+        raise fail(f"mesh file '{name}' has vertices that are not finite numbers (NaN or inf)")
+    scale = np.asarray(scale, dtype=np.float64)
+    mesh = trimesh.Trimesh(vertices * scale, np.asarray(loaded.faces), process=True)
+    if np.prod(scale) < 0:  # a mirroring scale turns the winding inside out
+        mesh.invert()
+    return mesh
+
+
+def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):
+    """Return (mesh, repairs, used, warnings) where ``mesh`` is a closed volume.
+
+    ``used`` is ``"mesh"`` or ``"hull"``.  Safe repairs are those that do not
+    change the shape: merging vertices, removing duplicate and degenerate
+    faces, making the winding consistent and outward.
+    """
+    repairs: list[str] = []
+    warnings: list[str] = []
+    if not mesh.is_volume:
+        n = len(mesh.faces)
+        mesh.update_faces(mesh.unique_faces())
+        if len(mesh.faces) < n:
+            repairs.append(f"removed {n - len(mesh.faces)} duplicate faces")
+        n = len(mesh.faces)
+        mesh.update_faces(mesh.nondegenerate_faces())
+        if len(mesh.faces) < n:
+            repairs.append(f"removed {n - len(mesh.faces)} degenerate faces")
+        mesh.remove_unreferenced_vertices()
+        if mesh.is_watertight and not (mesh.is_winding_consistent and mesh.volume > 0):
+            import trimesh
+
+            trimesh.repair.fix_normals(mesh, multibody=True)
+            repairs.append("fixed face winding and orientation")
+    if mesh.is_volume:
+        return mesh, repairs, "mesh", warnings
+    reason = _why_not_volume(mesh)
+    if policy == "hull":
+        warnings.append(f"mesh '{name}' is not a closed volume ({reason}); "
+                        "its mass properties use its convex hull, which overestimates the volume")
+        return mesh.convex_hull, repairs, "hull", warnings
+    base = where or Problem("")
+    raise MeshError(Problem(
+        f"mesh '{name}' is not a closed volume ({reason}), so its mass properties would be wrong; "
+        "repair the mesh, give an explicit inertial, or set 'open_mesh: hull'",
+        file=base.file, line=base.line, key=base.key))
+
+
+def _why_not_volume(mesh) -> str:
+    import trimesh
+
+    edges = mesh.edges_sorted
+    groups = trimesh.grouping.group_rows(edges, require_count=1)
+    counts = np.unique(trimesh.grouping.hashable_rows(edges), return_counts=True)[1]
+    open_edges = len(groups)
+    nonmanifold = int((counts > 2).sum())
+    parts = []
+    if open_edges:
+        parts.append(f"{open_edges} open edges")
+    if nonmanifold:
+        parts.append(f"{nonmanifold} non-manifold edges")
+    if not parts and not mesh.is_winding_consistent:
+        parts.append("inconsistent winding")
+    if not parts:
+        parts.append(f"volume {mesh.volume:.3g} m^3")
+    return ", ".join(parts)

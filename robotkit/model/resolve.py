@@ -1,0 +1,411 @@
+"""Recipe -> resolved :class:`Robot`, collecting every problem with its location.
+
+Two steps:
+
+- :func:`resolve` turns a validated recipe into a structural robot (names,
+  frames, geometry, joints, how each inertial is obtained) and checks the
+  kinematic tree.  It reads no mesh, so it is cheap enough for every build.
+- :func:`finalize` fills in what needs mesh work: recentering offsets and
+  computed inertials, from the mesh facts the mesh tasks wrote.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+from dataclasses import replace
+
+import numpy as np
+
+from robotkit.errors import Problem, RecipeError
+from robotkit.model.robot import (
+    Author, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
+    Metadata, Mimic, Pose, Robot, Shape, rpy_matrix,
+)
+from robotkit.recipe.load import LoadedRecipe
+from robotkit.recipe.schema import UNITS
+
+
+def _h(text: str, n: int = 8) -> str:
+    return hashlib.sha1(text.encode()).hexdigest()[:n]
+
+
+def _t(v) -> tuple[float, ...]:
+    return tuple(float(x) for x in v)
+
+
+def resolve(loaded: LoadedRecipe) -> Robot:
+    r = loaded.recipe
+    marks = loaded.marks
+    base_dir = os.path.dirname(str(loaded.file))
+    problems: list[Problem] = []
+
+    materials = tuple(Material(name, _t(m.rgba), m.gazebo) for name, m in r.materials.items())
+    material_names = {m.name for m in materials}
+
+    # Output file names for meshes: the file's own name, made unique when two
+    # different sources share it.
+    sources: dict[str, str] = {}
+    for link_name, link in r.links.items():
+        for kind in ("visual", "collision"):
+            for geom in _geoms(getattr(link, kind)):
+                if geom.mesh:
+                    sources.setdefault(geom.mesh, "")
+    taken: dict[str, int] = {}
+    for src in sources:
+        taken[os.path.basename(src)] = taken.get(os.path.basename(src), 0) + 1
+    for src in sources:
+        name = os.path.basename(src)
+        if taken[name] > 1:
+            stem, ext = os.path.splitext(name)
+            name = f"{stem}-{_h(os.path.relpath(src, base_dir))}{ext}"
+        sources[src] = name
+
+    def make_geom(g, path, link_name, policy) -> Geom | None:
+        if g.material is not None and g.material not in material_names:
+            problems.append(marks.problem(path + ("material",), _unknown("material", g.material, material_names)))
+        origin = Pose(_t(g.origin.xyz), _t(g.origin.rpy))
+        if g.box is not None:
+            shape = Shape("box", size=_t(g.box.size))
+        elif g.cylinder is not None:
+            shape = Shape("cylinder", radius=float(g.cylinder.radius), length=float(g.cylinder.length))
+        elif g.sphere is not None:
+            shape = Shape("sphere", radius=float(g.sphere.radius))
+        else:
+            if not os.path.isfile(g.mesh):
+                problems.append(marks.problem(path + ("mesh",), f"mesh file '{_show(g.mesh)}' does not exist"))
+                return None
+            if os.path.splitext(g.mesh)[1].lower() not in (".stl", ".obj", ".dae"):
+                problems.append(marks.problem(path + ("mesh",),
+                                              f"mesh file '{_show(g.mesh)}' has an unsupported format (use STL, OBJ or DAE)"))
+                return None
+            if g.scale is not None:
+                s = g.scale if isinstance(g.scale, list) else [g.scale] * 3
+                scale = _t(s)
+            else:
+                f = UNITS[g.units or r.units]
+                scale = (f, f, f)
+            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((g.mesh, scale, policy)))}"
+            shape = Shape("mesh", mesh=MeshRef(g.mesh, scale, sources[g.mesh], key, policy))
+        return Geom(shape, origin, (0.0, 0.0, 0.0), g.material, g.recenter)
+
+    links: list[Link] = []
+    for name, link in r.links.items():
+        lp = ("links", name)
+        ispec = link.inertial
+        policy = (ispec.open_mesh if ispec and ispec.open_mesh else None) or r.open_mesh
+        visuals = []
+        for i, g in _indexed(link.visual):
+            geom = make_geom(g, lp + ("visual",) + i, name, policy)
+            if geom is not None:
+                visuals.append(geom)
+        collisions = []
+        if link.collision == "visual":
+            collisions = [replace(v, material=None) for v in visuals]
+        elif link.collision != "none":
+            for i, g in _indexed(link.collision):
+                if g.material is not None:
+                    problems.append(marks.problem(lp + ("collision",) + i + ("material",),
+                                                  "collision geometry has no material"))
+                geom = make_geom(g, lp + ("collision",) + i, name, policy)
+                if geom is not None:
+                    collisions.append(geom)
+        spec = _inertial_spec(ispec, r.density)
+        source = visuals if spec.source == "visual" else collisions
+        if spec.mode in ("density", "mass") and not source:
+            if ispec is None:
+                spec = InertialSpec("none")
+            else:
+                problems.append(marks.problem(lp + ("inertial",),
+                                              f"computing the inertial needs {spec.source} geometry, and the link has none"))
+        if spec.mode == "explicit":
+            problems.extend(_check_explicit(spec.explicit, marks, lp + ("inertial",)))
+        links.append(Link(name, tuple(visuals), tuple(collisions), spec,
+                          spec.explicit if spec.mode == "explicit" else None))
+
+    link_names = [link.name for link in links]
+    joints: list[Joint] = []
+    for name, j in r.joints.items():
+        jp = ("joints", name)
+        for end in ("parent", "child"):
+            value = getattr(j, end)
+            if value not in r.links:
+                problems.append(marks.problem(jp + (end,), _unknown("link", value, link_names)))
+        if j.parent == j.child:
+            problems.append(marks.problem(jp + ("child",), f"a joint cannot connect link '{j.child}' to itself"))
+        axis = np.asarray(j.axis, dtype=float)
+        norm = float(np.linalg.norm(axis))
+        axis = _t(axis / norm) if norm > 0 else (1.0, 0.0, 0.0)
+        limit = None
+        if j.limit is not None:
+            limit = Limit(j.limit.lower, j.limit.upper, j.limit.effort, j.limit.velocity)
+            if j.type in ("continuous",):
+                limit = Limit(None, None, j.limit.effort, j.limit.velocity)
+                if j.limit.lower is not None or j.limit.upper is not None:
+                    problems.append(marks.problem(jp + ("limit",),
+                                                  "a continuous joint has no lower or upper limit (use revolute)"))
+            if j.type in ("fixed", "floating", "planar"):
+                problems.append(marks.problem(jp + ("limit",), f"a {j.type} joint takes no limit"))
+        dyn = Dynamics(j.dynamics.damping, j.dynamics.friction) if j.dynamics else None
+        mimic = None
+        if j.mimic is not None:
+            mimic = Mimic(j.mimic.joint, j.mimic.multiplier, j.mimic.offset)
+            if j.mimic.joint not in r.joints:
+                problems.append(marks.problem(jp + ("mimic", "joint"), _unknown("joint", j.mimic.joint, list(r.joints))))
+            elif j.mimic.joint == name:
+                problems.append(marks.problem(jp + ("mimic", "joint"), "a joint cannot mimic itself"))
+            elif r.joints[j.mimic.joint].type in ("fixed", "floating", "planar"):
+                problems.append(marks.problem(jp + ("mimic", "joint"),
+                                              f"joint '{j.mimic.joint}' is {r.joints[j.mimic.joint].type} and cannot be mimicked"))
+            if j.type not in ("revolute", "continuous", "prismatic"):
+                problems.append(marks.problem(jp + ("mimic",), f"a {j.type} joint cannot mimic another joint"))
+        joints.append(Joint(name, j.type, j.parent, j.child, Pose(_t(j.origin.xyz), _t(j.origin.rpy)),
+                            axis, limit, dyn, mimic))
+
+    problems.extend(_check_tree(link_names, joints, marks))
+    if problems:
+        raise RecipeError(problems)
+
+    md = r.metadata
+    metadata = Metadata(md.version, md.description, tuple(Author(a.name, a.email) for a in md.authors), md.license)
+    return Robot(r.robot, tuple(links), tuple(joints), materials, metadata)
+
+
+def _indexed(value):
+    if value is None:
+        return []
+    if isinstance(value, list):
+        return [((i,), g) for i, g in enumerate(value)]
+    return [((), value)]
+
+
+def _geoms(value):
+    if value is None or isinstance(value, str):
+        return []
+    return value if isinstance(value, list) else [value]
+
+
+def _show(path: str) -> str:
+    from robotkit.errors import display_path
+
+    return display_path(path)
+
+
+def _unknown(kind: str, value: str, known) -> str:
+    import difflib
+
+    msg = f"no {kind} named '{value}'"
+    close = difflib.get_close_matches(value, list(known), n=1)
+    return msg + (f" (did you mean '{close[0]}'?)" if close else "")
+
+
+def _inertial_spec(spec, default_density: float) -> InertialSpec:
+    if spec is None:
+        return InertialSpec("density", density=default_density)
+    if spec.inertia is not None:
+        t = spec.inertia
+        com = _t(spec.com) if spec.com is not None else (0.0, 0.0, 0.0)
+        explicit = Inertial(float(spec.mass), com, (t.ixx, t.ixy, t.ixz, t.iyy, t.iyz, t.izz))
+        return InertialSpec("explicit", mass=float(spec.mass), source=spec.source, explicit=explicit)
+    if spec.mass is not None:
+        return InertialSpec("mass", mass=float(spec.mass), source=spec.source)
+    return InertialSpec("density", density=float(spec.density or default_density), source=spec.source)
+
+
+def _check_explicit(inertial: Inertial, marks, path) -> list[Problem]:
+    out = []
+    I = inertial.tensor()
+    eig = np.linalg.eigvalsh(I)
+    if not np.all(np.isfinite(I)):
+        out.append(marks.problem(path + ("inertia",), "inertia must be finite"))
+    elif eig.min() <= 0:
+        out.append(marks.problem(path + ("inertia",),
+                                 f"inertia is not positive definite (principal moments {', '.join(f'{e:.6g}' for e in eig)})"))
+    else:
+        a, b, c = eig
+        if a + b < c * (1 - 1e-9):
+            out.append(marks.problem(path + ("inertia",),
+                                     f"principal moments {a:.6g}, {b:.6g}, {c:.6g} violate the triangle inequality "
+                                     "(no real body has them)"))
+    return out
+
+
+def _check_tree(link_names: list[str], joints: list[Joint], marks) -> list[Problem]:
+    problems: list[Problem] = []
+    known = set(link_names)
+    parent_of: dict[str, str] = {}
+    for j in joints:
+        if j.child in parent_of and j.child in known:
+            problems.append(marks.problem(("joints", j.name, "child"),
+                                          f"link '{j.child}' already has a parent (joint '{parent_of[j.child]}'); "
+                                          "a link has at most one"))
+        else:
+            parent_of.setdefault(j.child, j.name)
+    roots = [n for n in link_names if n not in parent_of]
+    if len(roots) > 1:
+        problems.append(marks.problem(("links",), f"the links form {len(roots)} separate trees with roots "
+                                      f"{', '.join(repr(n) for n in roots)}; connect them with joints so one root remains"))
+    # cycles: follow parents from every link
+    by_child = {j.child: j for j in joints if j.child in known and j.parent in known}
+    reported: set[frozenset] = set()
+    for start in link_names:
+        seen: list[str] = []
+        node = start
+        while node in by_child and node not in seen:
+            seen.append(node)
+            node = by_child[node].parent
+        if node in seen:
+            cycle = seen[seen.index(node):]
+            key = frozenset(cycle)
+            if key not in reported:
+                reported.add(key)
+                names = sorted(by_child[n].name for n in cycle)
+                problems.append(marks.problem(("joints", names[0]),
+                                              f"joints {', '.join(repr(n) for n in names)} form a cycle"))
+    if not roots and not reported and link_names:
+        problems.append(marks.problem(("links",), "every link is some joint's child: there is no root link"))
+    return problems
+
+
+# ---------------------------------------------------------------- mesh-dependent values
+
+
+def geom_mass_props(geom: Geom, facts: dict) -> tuple[float, np.ndarray, np.ndarray]:
+    """(volume, com, inertia at unit density) of a geometry in its link frame."""
+    from robotkit.mesh import inertia as mi
+
+    s = geom.shape
+    if s.kind == "box":
+        p = mi.box_props(s.size)
+    elif s.kind == "cylinder":
+        p = mi.cylinder_props(s.radius, s.length)
+    elif s.kind == "sphere":
+        p = mi.sphere_props(s.radius)
+    else:
+        f = facts[s.mesh.key]
+        p = mi.MassProps(f["volume"], np.asarray(f["com"]), np.asarray(f["inertia"]))
+    T = geom.pose.matrix()
+    R = T[:3, :3]
+    return p.volume, R @ p.com + T[:3, 3], R @ p.inertia @ R.T
+
+
+def recenter_offset(geom: Geom, facts: dict) -> tuple[float, float, float]:
+    if geom.shape.kind != "mesh" or geom.recenter == "none":
+        return (0.0, 0.0, 0.0)
+    f = facts[geom.shape.mesh.key]
+    c = np.asarray(f["com"]) if geom.recenter == "com" else 0.5 * (np.asarray(f["bbox_min"]) + np.asarray(f["bbox_max"]))
+    return tuple(float(-v) + 0.0 for v in c)
+
+
+def compute_inertial(link: Link, facts: dict) -> Inertial | None:
+    """The link's inertial from its spec and the (recentered) source geometry."""
+    from robotkit.mesh.inertia import combine
+
+    spec = link.inertial_spec
+    if spec.mode == "explicit":
+        return spec.explicit
+    if spec.mode == "none":
+        return None
+    parts = [geom_mass_props(g, facts) for g in link.source_geoms()]
+    volume = sum(v for v, _, _ in parts)
+    density = spec.density if spec.mode == "density" else spec.mass / volume
+    mass, com, I = combine([(v * density, c, Ic * density) for v, c, Ic in parts])
+    return Inertial.from_tensor(mass, _snap(com, _size(link, facts)), _snap(I, float(np.abs(I).max())))
+
+
+def _snap(values, scale: float, rel: float = 1e-12):
+    """Zero out float round-off (below ``rel`` of the quantity's scale), e.g. products of
+    inertia of a symmetric part that come out as 1e-18 instead of 0."""
+    values = np.array(values, dtype=float)
+    values[np.abs(values) < rel * scale] = 0.0
+    return values
+
+
+def _size(link: Link, facts: dict) -> float:
+    sizes = [1e-3]
+    for g in link.source_geoms():
+        s = g.shape
+        if s.kind == "mesh":
+            f = facts[s.mesh.key]
+            sizes.append(float(np.max(np.abs(f["bbox_max"] + f["bbox_min"]))))
+        sizes.append(float(np.max(np.abs(g.pose.xyz))))
+    return max(sizes)
+
+
+def finalize(robot: Robot, facts: dict, inertials: dict | None = None) -> Robot:
+    """Fill recentering offsets and inertials; ``inertials`` (by link) wins when given."""
+    links = []
+    for link in robot.links:
+        link = _with_offsets(link, facts)
+        if inertials is not None and link.name in inertials:
+            inertial = inertials[link.name]
+        else:
+            inertial = compute_inertial(link, facts)
+        links.append(replace(link, inertial=inertial))
+    return replace(robot, links=tuple(links))
+
+
+def inertial_to_json(inertial: Inertial | None):
+    if inertial is None:
+        return None
+    return {"mass": inertial.mass, "com": list(inertial.com), "inertia": list(inertial.inertia)}
+
+
+def inertial_from_json(data) -> Inertial | None:
+    if data is None:
+        return None
+    return Inertial(data["mass"], tuple(data["com"]), tuple(data["inertia"]))
+
+
+def link_frame_poses(robot: Robot, q: dict[str, float] | None = None) -> dict[str, np.ndarray]:
+    """4x4 pose of every link frame relative to the root at joint positions ``q``."""
+    q = q or {}
+    T = {robot.root: np.eye(4)}
+    children: dict[str, list[Joint]] = {}
+    for j in robot.joints:
+        children.setdefault(j.parent, []).append(j)
+    stack = [robot.root]
+    while stack:
+        parent = stack.pop()
+        for j in children.get(parent, []):
+            M = T[parent] @ j.origin.matrix()
+            value = q.get(j.name, 0.0)
+            if j.mimic is not None:
+                value = j.mimic.multiplier * q.get(j.mimic.joint, 0.0) + j.mimic.offset
+            axis = np.asarray(j.axis)
+            if j.type in ("revolute", "continuous") and value:
+                M = M @ _axis_angle(axis, value)
+            elif j.type == "prismatic" and value:
+                D = np.eye(4)
+                D[:3, 3] = axis * value
+                M = M @ D
+            T[j.child] = M
+            stack.append(j.child)
+    return T
+
+
+def _axis_angle(axis, angle) -> np.ndarray:
+    x, y, z = axis
+    c, s = math.cos(angle), math.sin(angle)
+    C = 1 - c
+    M = np.eye(4)
+    M[:3, :3] = [[c + x * x * C, x * y * C - z * s, x * z * C + y * s],
+                 [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
+                 [z * x * C - y * s, z * y * C + x * s, c + z * z * C]]
+    return M
+
+
+__all__ = ["resolve", "finalize", "compute_inertial", "rpy_matrix"]
+
+
+def finalize_link_inertial(link: Link, facts: dict) -> Inertial | None:
+    """One link's inertial, with recentering offsets applied to its geometry first."""
+    return compute_inertial(_with_offsets(link, facts), facts)
+
+
+def _with_offsets(link: Link, facts: dict) -> Link:
+    def fix(geoms):
+        return tuple(replace(g, offset=recenter_offset(g, facts)) for g in geoms)
+
+    return replace(link, visuals=fix(link.visuals), collisions=fix(link.collisions))

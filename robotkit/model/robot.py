@@ -1,0 +1,238 @@
+"""The resolved robot model: plain frozen data in SI units, independent of any format.
+
+Every frame is explicit:
+
+- a joint's ``origin`` is the pose of the child link frame in the parent link frame;
+- a geometry's pose in its link frame is ``origin`` composed with a translation
+  by ``offset`` (the recentering shift, metres, in the geometry frame);
+- an :class:`Inertial` holds the mass, the centre of mass in the link frame and
+  the inertia tensor about the centre of mass, expressed in the link axes.
+
+Values that need mesh work (mesh facts, recentering offsets, computed
+inertials) are filled in by :func:`robotkit.model.resolve.finalize`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+Vec3 = tuple[float, float, float]
+
+
+def rpy_matrix(rpy) -> np.ndarray:
+    """Rotation matrix of fixed-axis roll, pitch, yaw: R = Rz(y) Ry(p) Rx(r)."""
+    r, p, y = (float(a) for a in rpy)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array([
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ])
+
+
+def matrix_rpy(R: np.ndarray) -> Vec3:
+    """Fixed-axis roll, pitch, yaw of a rotation matrix (inverse of :func:`rpy_matrix`)."""
+    sp = -float(R[2, 0])
+    if abs(sp) >= 1.0 - 1e-12:  # gimbal lock: put everything in yaw
+        p = math.copysign(math.pi / 2, sp)
+        r = 0.0
+        y = math.atan2(-float(R[0, 1]), float(R[1, 1]))
+    else:
+        p = math.asin(sp)
+        r = math.atan2(float(R[2, 1]), float(R[2, 2]))
+        y = math.atan2(float(R[1, 0]), float(R[0, 0]))
+    return (r, p, y)
+
+
+@dataclass(frozen=True)
+class Pose:
+    xyz: Vec3 = (0.0, 0.0, 0.0)
+    rpy: Vec3 = (0.0, 0.0, 0.0)
+
+    def matrix(self) -> np.ndarray:
+        T = np.eye(4)
+        T[:3, :3] = rpy_matrix(self.rpy)
+        T[:3, 3] = self.xyz
+        return T
+
+    def then(self, offset: Vec3) -> "Pose":
+        """This pose followed by a translation ``offset`` in its own frame."""
+        if not any(offset):
+            return self
+        t = np.asarray(self.xyz) + rpy_matrix(self.rpy) @ np.asarray(offset, dtype=float)
+        return Pose(tuple(float(v) for v in t), self.rpy)
+
+
+@dataclass(frozen=True)
+class MeshRef:
+    """A mesh file and how its coordinates map to metres."""
+
+    source: str
+    """Absolute path of the source file."""
+    scale: Vec3
+    """Per-axis factor from file units to metres."""
+    file_name: str
+    """Output name under ``meshes/visual/``."""
+    key: str
+    """Unit-of-work key: one mesh task per (file, scale, open-mesh policy)."""
+    open_mesh: str = "error"
+
+
+@dataclass(frozen=True)
+class Shape:
+    kind: str  # mesh | box | cylinder | sphere
+    size: Vec3 | None = None  # box
+    radius: float | None = None  # cylinder, sphere
+    length: float | None = None  # cylinder
+    mesh: MeshRef | None = None
+
+
+@dataclass(frozen=True)
+class Geom:
+    shape: Shape
+    origin: Pose = Pose()
+    offset: Vec3 = (0.0, 0.0, 0.0)
+    material: str | None = None
+    recenter: str = "none"  # none | bbox | com: how ``offset`` is derived
+
+    @property
+    def pose(self) -> Pose:
+        return self.origin.then(self.offset)
+
+
+@dataclass(frozen=True)
+class Inertial:
+    mass: float
+    com: Vec3
+    inertia: tuple[float, float, float, float, float, float]
+    """ixx, ixy, ixz, iyy, iyz, izz about the centre of mass, link axes."""
+
+    def tensor(self) -> np.ndarray:
+        ixx, ixy, ixz, iyy, iyz, izz = self.inertia
+        return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+
+    @staticmethod
+    def from_tensor(mass: float, com, I: np.ndarray) -> "Inertial":
+        I = 0.5 * (np.asarray(I, dtype=float) + np.asarray(I, dtype=float).T)
+        return Inertial(float(mass), tuple(float(c) for c in com),
+                        (float(I[0, 0]), float(I[0, 1]), float(I[0, 2]),
+                         float(I[1, 1]), float(I[1, 2]), float(I[2, 2])))
+
+
+@dataclass(frozen=True)
+class InertialSpec:
+    """How a link's inertial is obtained (see the recipe's ``inertial``)."""
+
+    mode: str  # density | mass | explicit | none
+    density: float | None = None
+    mass: float | None = None
+    source: str = "visual"
+    explicit: Inertial | None = None
+
+
+@dataclass(frozen=True)
+class Link:
+    name: str
+    visuals: tuple[Geom, ...] = ()
+    collisions: tuple[Geom, ...] = ()
+    inertial_spec: InertialSpec = InertialSpec("none")
+    inertial: Inertial | None = None
+
+    def source_geoms(self) -> tuple[Geom, ...]:
+        return self.collisions if self.inertial_spec.source == "collision" else self.visuals
+
+
+@dataclass(frozen=True)
+class Limit:
+    lower: float | None = None
+    upper: float | None = None
+    effort: float | None = None
+    velocity: float | None = None
+
+
+@dataclass(frozen=True)
+class Dynamics:
+    damping: float = 0.0
+    friction: float = 0.0
+
+
+@dataclass(frozen=True)
+class Mimic:
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    origin: Pose = Pose()
+    axis: Vec3 = (1.0, 0.0, 0.0)
+    limit: Limit | None = None
+    dynamics: Dynamics | None = None
+    mimic: Mimic | None = None
+
+
+@dataclass(frozen=True)
+class Material:
+    name: str
+    rgba: tuple[float, float, float, float]
+    gazebo: str | None = None
+
+
+@dataclass(frozen=True)
+class Author:
+    name: str
+    email: str | None = None
+
+
+@dataclass(frozen=True)
+class Metadata:
+    version: str = "1.0"
+    description: str = ""
+    authors: tuple[Author, ...] = ()
+    license: str | None = None
+
+
+@dataclass(frozen=True)
+class Robot:
+    name: str
+    links: tuple[Link, ...]
+    joints: tuple[Joint, ...] = ()
+    materials: tuple[Material, ...] = ()
+    metadata: Metadata = field(default_factory=Metadata)
+
+    def link(self, name: str) -> Link:
+        for link in self.links:
+            if link.name == name:
+                return link
+        raise KeyError(name)
+
+    def joint(self, name: str) -> Joint:
+        for joint in self.joints:
+            if joint.name == name:
+                return joint
+        raise KeyError(name)
+
+    @property
+    def root(self) -> str:
+        children = {j.child for j in self.joints}
+        return next(link.name for link in self.links if link.name not in children)
+
+    def meshes(self) -> dict[str, MeshRef]:
+        """Every distinct mesh unit of work, by key, in a stable order."""
+        out: dict[str, MeshRef] = {}
+        for link in self.links:
+            for geom in link.visuals + link.collisions:
+                if geom.shape.mesh is not None:
+                    out.setdefault(geom.shape.mesh.key, geom.shape.mesh)
+        return dict(sorted(out.items()))
+
+    def to_dict(self) -> dict:
+        return asdict(self)

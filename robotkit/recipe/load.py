@@ -1,0 +1,380 @@
+"""Read a recipe: YAML with line marks, includes, defaults, schema validation.
+
+Every problem found is collected as a :class:`Problem` naming the file, the
+line and the dotted key; :func:`load_recipe` raises one :class:`RecipeError`
+holding all of them.
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from robotkit.errors import Problem, RecipeError
+
+Path_ = tuple  # a key path: ("links", "base", "visual", 0, "mesh")
+
+
+@dataclass
+class Marks:
+    """Where each key path of the merged recipe data was written."""
+
+    where: dict[Path_, tuple[str, int]] = field(default_factory=dict)
+    # key paths whose value came from ``defaults`` -> the defaults path
+    from_defaults: dict[Path_, Path_] = field(default_factory=dict)
+
+    def locate(self, path: Path_) -> tuple[str | None, int | None]:
+        for n in range(len(path), -1, -1):
+            if path[:n] in self.where:
+                return self.where[path[:n]]
+        return None, None
+
+    def problem(self, path: Path_, message: str) -> Problem:
+        key_path = path
+        for n in range(len(path), 0, -1):
+            if path[:n] in self.from_defaults:
+                key_path = self.from_defaults[path[:n]] + path[n:]
+                break
+        file, line = self.locate(path)
+        return Problem(message, file=file, line=line, key=dotted(key_path))
+
+
+def dotted(path: Path_) -> str:
+    out = ""
+    for part in path:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+# ---------------------------------------------------------------- YAML with marks
+
+
+class _Loader(yaml.SafeLoader):
+    pass
+
+
+def _read_yaml(file: Path, problems: list[Problem]):
+    """Parse ``file``; return (data, marks) with one mark per key path."""
+    try:
+        text = file.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        problems.append(Problem("file not found", file=str(file)))
+        return None, {}
+    except (OSError, UnicodeDecodeError) as exc:
+        problems.append(Problem(f"cannot read file: {exc}", file=str(file)))
+        return None, {}
+    try:
+        node = yaml.compose(text, Loader=_Loader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = mark.line + 1 if mark is not None else None
+        what = getattr(exc, "problem", None) or str(exc)
+        problems.append(Problem(f"invalid YAML: {what}", file=str(file), line=line))
+        return None, {}
+    if node is None:
+        problems.append(Problem("the file is empty", file=str(file)))
+        return None, {}
+    marks: dict[Path_, tuple[str, int]] = {}
+    constructor = _Loader(text)
+    data = _construct(node, (), str(file), marks, problems, constructor)
+    return data, marks
+
+
+def _construct(node, path, file, marks, problems, constructor):
+    marks.setdefault(path, (file, node.start_mark.line + 1))
+    if isinstance(node, yaml.MappingNode):
+        out = {}
+        for key_node, value_node in node.value:
+            if not isinstance(key_node, yaml.ScalarNode):
+                problems.append(Problem("mapping keys must be plain names", file=file,
+                                        line=key_node.start_mark.line + 1, key=dotted(path)))
+                continue
+            key = constructor.construct_object(key_node)
+            if not isinstance(key, str):
+                key = str(key)
+            sub = path + (key,)
+            if key in out:
+                problems.append(Problem(f"duplicate key (first given on line {marks[sub][1]})",
+                                        file=file, line=key_node.start_mark.line + 1, key=dotted(sub)))
+                continue
+            marks[sub] = (file, key_node.start_mark.line + 1)
+            out[key] = _construct(value_node, sub, file, marks, problems, constructor)
+        return out
+    if isinstance(node, yaml.SequenceNode):
+        return [_construct(item, path + (i,), file, marks, problems, constructor)
+                for i, item in enumerate(node.value)]
+    return constructor.construct_object(node)
+
+
+# ---------------------------------------------------------------- includes and defaults
+
+MERGED_SECTIONS = ("materials", "links", "joints")
+
+
+def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = ()):
+    """Read ``file`` and, recursively, the files it includes; merge their sections."""
+    data, marks = _read_yaml(file, problems)
+    if data is None:
+        return None, marks
+    if not isinstance(data, dict):
+        problems.append(Problem("a recipe must be a mapping of keys", file=str(file), line=1))
+        return None, marks
+    includes = data.get("include", [])
+    if not isinstance(includes, list):
+        return data, marks  # the schema reports the type
+    for i, inc in enumerate(includes):
+        if not isinstance(inc, str):
+            continue
+        inc_path = (file.parent / inc).resolve()
+        where = marks.get(("include", i), (str(file), None))
+        if inc_path in seen or inc_path == file:
+            problems.append(Problem(f"'{inc}' includes itself (include cycle)", file=where[0],
+                                    line=where[1], key=f"include[{i}]"))
+            continue
+        if not inc_path.is_file():
+            problems.append(Problem(f"included file '{inc}' does not exist", file=where[0],
+                                    line=where[1], key=f"include[{i}]"))
+            continue
+        sub, sub_marks = _gather(inc_path, problems, seen + (file,))
+        if sub is None:
+            continue
+        for key in sub:
+            if key not in MERGED_SECTIONS + ("include",):
+                f, line = sub_marks[(key,)]
+                problems.append(Problem(
+                    f"an included file may only hold {', '.join(MERGED_SECTIONS)}", file=f, line=line, key=key))
+        for section in MERGED_SECTIONS:
+            items = sub.get(section)
+            if not isinstance(items, dict):
+                continue
+            target = data.setdefault(section, {})
+            if not isinstance(target, dict):
+                continue
+            if (section,) not in marks:
+                marks[(section,)] = sub_marks[(section,)]
+            for name, value in items.items():
+                if name in target:
+                    f, line = marks[(section, name)]
+                    f2, line2 = sub_marks[(section, name)]
+                    problems.append(Problem(
+                        f"defined twice: here and in {_rel(f)}:{line}", file=f2, line=line2, key=f"{section}.{name}"))
+                    continue
+                target[name] = value
+                for p, m in sub_marks.items():
+                    if p[:2] == (section, name):
+                        marks[p] = m
+    return data, marks
+
+
+def _rel(path: str) -> str:
+    from robotkit.errors import display_path
+
+    return display_path(path)
+
+
+def _deep_merge(base, over, base_path, over_path, marks: Marks):
+    """``over`` wins; dictionaries merge key by key."""
+    if isinstance(base, dict) and isinstance(over, dict):
+        out = dict(over)
+        for k, v in base.items():
+            if k in over:
+                out[k] = _deep_merge(v, over[k], base_path + (k,), over_path + (k,), marks)
+            else:
+                out[k] = v
+                _copy_marks(base_path + (k,), over_path + (k,), marks)
+        return out
+    return over
+
+
+def _copy_marks(src: Path_, dst: Path_, marks: Marks):
+    for p, m in list(marks.where.items()):
+        if p[: len(src)] == src:
+            marks.where[dst + p[len(src):]] = m
+    marks.from_defaults[dst] = src
+
+
+def _apply_defaults(data: dict, marks: Marks):
+    defaults = data.get("defaults")
+    if not isinstance(defaults, dict):
+        return
+    for kind, section in (("link", "links"), ("joint", "joints")):
+        base = defaults.get(kind)
+        items = data.get(section)
+        if not isinstance(base, dict) or not base or not isinstance(items, dict):
+            continue
+        for name, value in items.items():
+            if value is None:
+                value = {}
+            if isinstance(value, dict):
+                items[name] = _deep_merge(base, value, ("defaults", kind), (section, name), marks)
+
+
+def _absolute_meshes(data: dict, marks: Marks):
+    """Turn every mesh path into an absolute one, relative to the file that wrote it."""
+    links = data.get("links")
+    if not isinstance(links, dict):
+        return
+    for name, link in links.items():
+        if not isinstance(link, dict):
+            continue
+        for kind in ("visual", "collision"):
+            geoms = link.get(kind)
+            items = [(None, geoms)] if isinstance(geoms, dict) else (
+                list(enumerate(geoms)) if isinstance(geoms, list) else [])
+            for i, g in items:
+                if isinstance(g, dict) and isinstance(g.get("mesh"), str):
+                    path = ("links", name, kind) + (() if i is None else (i,)) + ("mesh",)
+                    file, _ = marks.locate(path)
+                    base = Path(file).parent if file else Path.cwd()
+                    g["mesh"] = os.path.normpath(str((base / g["mesh"]).absolute()))
+
+
+# ---------------------------------------------------------------- schema errors
+
+_TAGS = {"keyword", "shape", "shapes", "number", "vector"}
+
+
+def _fields_at(model, loc):
+    """The field names a model accepts at ``loc`` (for did-you-mean)."""
+    from pydantic import BaseModel
+
+    tp = model
+    for part in loc:
+        tp = _unwrap(tp)
+        if isinstance(part, int) or part in _TAGS:
+            args = typing.get_args(tp)
+            tp = args[0] if args else tp
+            continue
+        if isinstance(tp, type) and issubclass(tp, BaseModel):
+            if part not in tp.model_fields:
+                return []
+            tp = tp.model_fields[part].annotation
+        elif typing.get_origin(tp) is dict:
+            tp = typing.get_args(tp)[1]
+        else:
+            return []
+    tp = _unwrap(tp)
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        return list(tp.model_fields)
+    return []
+
+
+def _unwrap(tp):
+    """Strip Annotated, Optional and unions down to the model or container that matters."""
+    while True:
+        origin = typing.get_origin(tp)
+        if origin is typing.Annotated:
+            tp = typing.get_args(tp)[0]
+            continue
+        if origin in (typing.Union, getattr(__import__("types"), "UnionType")):
+            from pydantic import BaseModel
+
+            args = [a for a in typing.get_args(tp) if a is not type(None)]
+            pick = [a for a in args if isinstance(_unwrap(a), type) and issubclass(_unwrap(a), BaseModel)]
+            pick = pick or [a for a in args if typing.get_origin(_unwrap(a)) in (list, dict)]
+            tp = pick[0] if pick else args[0]
+            continue
+        return tp
+
+
+def _message(err: dict) -> str:
+    kind = err["type"]
+    ctx = err.get("ctx", {})
+    got = err.get("input")
+    if kind == "extra_forbidden":
+        return "unknown key"
+    if kind == "missing":
+        return "required key is missing"
+    if kind == "greater_than":
+        return f"must be > {ctx['gt']}"
+    if kind == "greater_than_equal":
+        return f"must be >= {ctx['ge']}"
+    if kind == "less_than":
+        return f"must be < {ctx['lt']}"
+    if kind == "less_than_equal":
+        return f"must be <= {ctx['le']}"
+    if kind in ("float_parsing", "float_type", "int_parsing", "int_type", "finite_number"):
+        return f"must be a number (got {got!r})"
+    if kind == "string_type":
+        return f"must be a string (got {got!r})"
+    if kind == "bool_type" or kind == "bool_parsing":
+        return f"must be true or false (got {got!r})"
+    if kind == "literal_error":
+        return f"must be one of {ctx['expected']} (got {got!r})"
+    if kind in ("dict_type", "model_type", "model_attributes_type"):
+        return f"must be a mapping (got {got!r})"
+    if kind == "list_type":
+        return f"must be a list (got {got!r})"
+    if kind in ("too_short", "too_long"):
+        if ctx.get("field_type") == "List":
+            n = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
+            return f"must have {n} values (got {ctx.get('actual_length')})"
+    if kind == "value_error":
+        return str(ctx.get("error", err["msg"]))
+    if kind in ("union_tag_invalid", "union_tag_not_found"):
+        return f"has the wrong form (got {got!r})"
+    msg = err["msg"]
+    return msg[:1].lower() + msg[1:]
+
+
+def schema_problems(exc, marks: Marks, model) -> list[Problem]:
+    out: list[Problem] = []
+    seen = set()
+    for err in exc.errors(include_url=False):
+        loc = tuple(p for p in err["loc"] if p not in _TAGS)
+        msg = _message(err)
+        if err["type"] == "extra_forbidden" and loc:
+            choices = _fields_at(model, [p for p in err["loc"][:-1]])
+            close = difflib.get_close_matches(str(loc[-1]), choices, n=1)
+            if close:
+                msg += f" (did you mean '{close[0]}'?)"
+            elif choices:
+                msg += f" (expected one of: {', '.join(choices)})"
+        problem = marks.problem(loc, msg)
+        if str(problem) not in seen:
+            seen.add(str(problem))
+            out.append(problem)
+    return out
+
+
+# ---------------------------------------------------------------- entry point
+
+
+@dataclass
+class LoadedRecipe:
+    file: Path
+    recipe: "object"  # robotkit.recipe.schema.Recipe
+    marks: Marks
+    files: list[str]  # every YAML file read (for dependency tracking)
+
+
+def load_recipe(file: str | os.PathLike) -> LoadedRecipe:
+    from pydantic import ValidationError
+
+    from robotkit.recipe.schema import Recipe
+
+    file = Path(file).absolute()
+    problems: list[Problem] = []
+    data, where = _gather(file, problems)
+    marks = Marks(where=where)
+    if data is None:
+        raise RecipeError(problems)
+    _apply_defaults(data, marks)
+    _absolute_meshes(data, marks)
+    recipe = None
+    try:
+        recipe = Recipe.model_validate(data)
+    except ValidationError as exc:
+        problems.extend(schema_problems(exc, marks, Recipe))
+    if problems:
+        raise RecipeError(problems)
+    files = sorted({f for f, _ in where.values()})
+    return LoadedRecipe(file=file, recipe=recipe, marks=marks, files=files)

@@ -1,0 +1,184 @@
+"""doit task dictionaries for a resolved robot: one task per unit of work.
+
+- ``<robot>:mesh:<key>``: load one mesh (file, scale, open-mesh policy), repair,
+  record its unit-density mass properties as JSON (state folder);
+- ``<robot>:copy:<file>``: the visual mesh file into ``meshes/visual/``;
+- ``<robot>:inertial:<link>``: one link's inertial from its mesh facts;
+- ``<robot>:<output>``: one output file per registered emitter.
+
+Every task names its inputs (``file_dep``), outputs (``targets``) and the
+recipe values that matter (``config_changed``), so doit reruns exactly what
+an edit affects.  The same task list serves ``robotkit build`` and ``doit``
+(dodo.py).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import asdict
+from pathlib import Path
+
+from doit.tools import config_changed
+
+from robotkit import actions
+from robotkit.emit import TEMPLATES
+from robotkit.emit.env import template_dirs
+from robotkit.model.robot import Robot
+
+STATE = ".robotkit"  # below the output folder: doit's database and intermediate JSON
+
+# output name -> (emitter, path below the robot folder)
+OUTPUTS = {
+    "urdf": lambda r: f"urdf/{r.name}.urdf",
+    "model.config": lambda r: "model.config",
+    "package.xml": lambda r: "package.xml",
+    "CMakeLists.txt": lambda r: "CMakeLists.txt",
+}
+
+
+def _template_files(emitter: str) -> list[str]:
+    out = []
+    for name in TEMPLATES[emitter]:
+        for d in template_dirs():
+            p = Path(d) / name
+            if p.is_file():
+                out.append(str(p))
+                break
+    return out
+
+
+def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None) -> list[dict]:
+    """The task dicts that build ``robot`` into ``out_dir/<robot>/``.
+
+    ``where`` maps a mesh key to the recipe location naming it (for messages).
+    """
+    out_dir = Path(out_dir).absolute()
+    root = out_dir / robot.name
+    state = out_dir / STATE / robot.name
+    where = where or {}
+    tasks: list[dict] = []
+
+    facts: dict[str, str] = {}
+    for key, mesh in robot.meshes().items():
+        target = str(state / "mesh" / f"{key}.json")
+        facts[key] = target
+        tasks.append({
+            "name": f"{robot.name}:mesh:{key}",
+            "doc": f"mass properties of {os.path.basename(mesh.source)}",
+            "actions": [(actions.mesh_facts, [mesh.source, list(mesh.scale), mesh.open_mesh,
+                                              where.get(key, {}), target])],
+            "file_dep": [mesh.source],
+            "targets": [target],
+            "uptodate": [config_changed({"scale": list(mesh.scale), "policy": mesh.open_mesh,
+                                         "version": actions.FACTS_VERSION})],
+            "clean": True,
+        })
+
+    copies: dict[str, str] = {}
+    for mesh in robot.meshes().values():
+        copies.setdefault(mesh.file_name, mesh.source)
+    for file_name, source in sorted(copies.items()):
+        target = str(root / "meshes" / "visual" / file_name)
+        tasks.append({
+            "name": f"{robot.name}:copy:{file_name}",
+            "doc": f"visual mesh {file_name}",
+            "actions": [(actions.copy_file, [source, target])],
+            "file_dep": [source],
+            "targets": [target],
+            "clean": True,
+        })
+
+    inertials: dict[str, str] = {}
+    for link in robot.links:
+        if link.inertial_spec.mode not in ("density", "mass"):
+            continue
+        keys = sorted({g.shape.mesh.key for g in link.source_geoms() if g.shape.mesh is not None})
+        deps = {k: facts[k] for k in keys}
+        target = str(state / "inertial" / f"{link.name}.json")
+        inertials[link.name] = target
+        tasks.append({
+            "name": f"{robot.name}:inertial:{link.name}",
+            "doc": f"inertial of link {link.name}",
+            "actions": [(actions.link_inertial, [link, deps, target])],
+            "file_dep": list(deps.values()),
+            "targets": [target],
+            "uptodate": [config_changed({"link": asdict(link), "version": actions.FACTS_VERSION})],
+            "clean": True,
+        })
+
+    # outputs need the facts of recentered meshes (their offsets) and every inertial
+    recentered = sorted({g.shape.mesh.key for link in robot.links for g in link.visuals + link.collisions
+                         if g.shape.mesh is not None and g.recenter != "none"})
+    out_facts = {k: facts[k] for k in recentered}
+    structure = robot.to_dict()
+    options = {"model.config": {"sdf": f"urdf/{robot.name}.urdf"}}
+    for emitter, rel in OUTPUTS.items():
+        target = str(root / rel(robot))
+        opts = options.get(emitter, {})
+        tasks.append({
+            "name": f"{robot.name}:{emitter}",
+            "doc": f"{rel(robot)}",
+            "actions": [(actions.emit, [emitter, robot, out_facts, inertials, target, opts])],
+            "file_dep": list(out_facts.values()) + list(inertials.values()) + _template_files(emitter),
+            "targets": [target],
+            "uptodate": [config_changed({"robot": structure, "options": opts})],
+            "clean": True,
+        })
+    return tasks
+
+
+def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
+    """Recipe location (file, line, key) of the first geometry naming each mesh key."""
+    marks = loaded.marks
+    out: dict[str, dict] = {}
+    for name, link in loaded.recipe.links.items():
+        for kind in ("visual", "collision"):
+            value = getattr(link, kind)
+            if value is None or isinstance(value, str):
+                continue
+            items = [((i,), g) for i, g in enumerate(value)] if isinstance(value, list) else [((), value)]
+            for idx, g in items:
+                if g.mesh is None:
+                    continue
+                path = ("links", name, kind) + idx + ("mesh",)
+                for geom in robot.link(name).visuals + robot.link(name).collisions:
+                    m = geom.shape.mesh
+                    if m is not None and m.source == g.mesh and m.key not in out:
+                        p = marks.problem(path, "")
+                        out[m.key] = {"file": p.file, "line": p.line, "key": p.key}
+    return out
+
+
+def load_robots(recipe_files) -> list[tuple[object, Robot]]:
+    """Load and resolve every recipe; all problems of all recipes together."""
+    from robotkit.errors import Problem, RobotkitError
+    from robotkit.model.resolve import resolve
+    from robotkit.recipe.load import load_recipe
+
+    problems: list[Problem] = []
+    robots = []
+    names: dict[str, str] = {}
+    for f in recipe_files:
+        try:
+            loaded = load_recipe(f)
+            robot = resolve(loaded)
+        except RobotkitError as exc:
+            problems.extend(exc.problems)
+            continue
+        if robot.name in names:
+            problems.append(Problem(f"robot '{robot.name}' is also built by {names[robot.name]}",
+                                    file=str(loaded.file), line=loaded.marks.where.get(("robot",), (None, None))[1],
+                                    key="robot"))
+            continue
+        names[robot.name] = str(f)
+        robots.append((loaded, robot))
+    if problems:
+        raise RobotkitError(problems)
+    return robots
+
+
+def all_tasks(recipe_files, out_dir) -> list[dict]:
+    tasks = []
+    for loaded, robot in load_robots(recipe_files):
+        tasks.extend(robot_tasks(robot, out_dir, mesh_locations(loaded, robot)))
+    return tasks

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs robotkit into ./.venv (Debian 12 / Python >= 3.11). With --test, also what the
+# tests need: pytest and MuJoCo from PyPI, and the validators check_urdf (liburdfdom-tools)
+# and `ign sdf` (libsdformat-dev, ignition-tools) from Debian's packages.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+apt_need=()
+python3 -c "import ensurepip, venv" 2>/dev/null || apt_need+=(python3-venv)
+if [ "${1:-}" = "--test" ]; then
+  command -v check_urdf >/dev/null || apt_need+=(liburdfdom-tools)
+  command -v ign >/dev/null || apt_need+=(libsdformat-dev ignition-tools)
+fi
+if [ ${#apt_need[@]} -gt 0 ]; then
+  sudo=""; [ "$(id -u)" = 0 ] || sudo="sudo"
+  echo "installing Debian packages: ${apt_need[*]}" >&2
+  $sudo apt-get update -qq || true
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${apt_need[@]}" >/dev/null \
+    || echo "warning: could not install ${apt_need[*]}; the tests that need them will fail under CI" >&2
+fi
+
+[ -x .venv/bin/python ] || python3 -m venv .venv
+extra=""; [ "${1:-}" = "--test" ] && extra="[test]"
+.venv/bin/python -m pip install -q --disable-pip-version-check -e ".${extra}" 2>&1 | grep -v "^WARNING: Location" || true
+.venv/bin/python -c "import robotkit" # fail loudly if the install did not work
