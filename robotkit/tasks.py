@@ -15,7 +15,7 @@ an edit affects.  The same task list serves ``robotkit build`` and ``doit``
 from __future__ import annotations
 
 import os
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 from doit.tools import config_changed
@@ -27,13 +27,15 @@ from robotkit.model.robot import Robot
 
 STATE = ".robotkit"  # below the output folder: doit's database and intermediate JSON
 
-# output name -> (emitter, path below the robot folder)
+# emitter -> path below the robot folder
 OUTPUTS = {
     "urdf": lambda r: f"urdf/{r.name}.urdf",
     "model.config": lambda r: "model.config",
     "package.xml": lambda r: "package.xml",
     "CMakeLists.txt": lambda r: "CMakeLists.txt",
 }
+# emitters that read only the robot's name and metadata (no geometry, no inertials)
+METADATA_ONLY = {"model.config", "package.xml", "CMakeLists.txt"}
 
 
 def _template_files(emitter: str) -> list[str]:
@@ -74,16 +76,17 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
-    copies: dict[str, str] = {}
-    for mesh in robot.meshes().values():
-        copies.setdefault(mesh.file_name, mesh.source)
-    for file_name, source in sorted(copies.items()):
+    copies: dict[str, tuple[str, str]] = {}
+    for key, mesh in robot.meshes().items():
+        copies.setdefault(mesh.file_name, (mesh.source, facts[key]))
+    for file_name, (source, checked) in sorted(copies.items()):
         target = str(root / "meshes" / "visual" / file_name)
         tasks.append({
             "name": f"{robot.name}:copy:{file_name}",
             "doc": f"visual mesh {file_name}",
             "actions": [(actions.copy_file, [source, target])],
-            "file_dep": [source],
+            # after its mesh task: a file that cannot be read is never copied
+            "file_dep": [source, checked],
             "targets": [target],
             "clean": True,
         })
@@ -115,13 +118,19 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     for emitter, rel in OUTPUTS.items():
         target = str(root / rel(robot))
         opts = options.get(emitter, {})
+        if emitter in METADATA_ONLY:
+            subject = replace(robot, links=(), joints=(), materials=())
+            reads: dict = {"name": robot.name, "metadata": asdict(robot.metadata)}
+            facts_in, inertials_in = {}, {}
+        else:
+            subject, reads, facts_in, inertials_in = robot, structure, out_facts, inertials
         tasks.append({
             "name": f"{robot.name}:{emitter}",
             "doc": f"{rel(robot)}",
-            "actions": [(actions.emit, [emitter, robot, out_facts, inertials, target, opts])],
-            "file_dep": list(out_facts.values()) + list(inertials.values()) + _template_files(emitter),
+            "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts])],
+            "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter),
             "targets": [target],
-            "uptodate": [config_changed({"robot": structure, "options": opts})],
+            "uptodate": [config_changed({"robot": reads, "options": opts})],
             "clean": True,
         })
     return tasks

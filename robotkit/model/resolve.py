@@ -163,7 +163,8 @@ def resolve(loaded: LoadedRecipe) -> Robot:
         joints.append(Joint(name, j.type, j.parent, j.child, Pose(_t(j.origin.xyz), _t(j.origin.rpy)),
                             axis, limit, dyn, mimic))
 
-    problems.extend(_check_tree(link_names, joints, marks))
+    if loaded.partial != "tree":  # joints dropped as invalid would show as false tree problems
+        problems.extend(_check_tree(link_names, joints, marks))
     if problems:
         raise RecipeError(problems)
 

@@ -285,9 +285,14 @@ def _unwrap(tp):
         return tp
 
 
+def _num(x) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
 def _message(err: dict) -> str:
     kind = err["type"]
-    ctx = err.get("ctx", {})
+    ctx = {k: _num(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v
+           for k, v in err.get("ctx", {}).items()}
     got = err.get("input")
     if kind == "extra_forbidden":
         return "unknown key"
@@ -354,6 +359,7 @@ class LoadedRecipe:
     recipe: "object"  # robotkit.recipe.schema.Recipe
     marks: Marks
     files: list[str]  # every YAML file read (for dependency tracking)
+    partial: bool | str = False  # True: invalid parts were neutralised; "tree": joints dropped too
 
 
 def load_recipe(file: str | os.PathLike) -> LoadedRecipe:
@@ -370,11 +376,71 @@ def load_recipe(file: str | os.PathLike) -> LoadedRecipe:
     _apply_defaults(data, marks)
     _absolute_meshes(data, marks)
     recipe = None
+    partial = False
     try:
         recipe = Recipe.model_validate(data)
     except ValidationError as exc:
         problems.extend(schema_problems(exc, marks, Recipe))
-    if problems:
-        raise RecipeError(problems)
+        recipe, partial = _salvage(data, exc)
     files = sorted({f for f, _ in where.values()})
-    return LoadedRecipe(file=file, recipe=recipe, marks=marks, files=files)
+    loaded = LoadedRecipe(file=file, recipe=recipe, marks=marks, files=files, partial=partial)
+    if problems:
+        # Check what is valid too, so the user sees every problem in one go.
+        if recipe is not None:
+            from robotkit.model.resolve import resolve
+
+            try:
+                resolve(loaded)
+            except RecipeError as exc:
+                problems.extend(exc.problems)
+        problems.sort(key=lambda p: (p.file != str(file), p.file or "", p.line or 0))
+        raise RecipeError(problems)
+    return loaded
+
+
+def _salvage(data: dict, exc):
+    """The recipe with its invalid parts replaced by neutral ones, for further checking.
+
+    Returns (recipe or None, partial): None when the remaining data still fails.
+    """
+    from pydantic import ValidationError
+
+    from robotkit.recipe.schema import Recipe
+
+    data = dict(data)
+    bad_links, bad_joints, bad_top = set(), set(), set()
+    for err in exc.errors(include_url=False):
+        loc = err["loc"]
+        if len(loc) >= 2 and loc[0] == "links":
+            bad_links.add(loc[1])
+        elif len(loc) >= 2 and loc[0] == "joints":
+            bad_joints.add(loc[1])
+        elif loc:
+            bad_top.add(loc[0])
+        else:
+            return None, True
+    if "robot" in bad_top:
+        data["robot"] = "robot"
+        bad_top.discard("robot")
+    for key in bad_top:
+        if key in ("links", "joints", "materials") and not isinstance(data.get(key), dict):
+            data[key] = {}
+        elif key not in ("links", "joints", "materials"):
+            data.pop(key, None)
+    dropped = False
+    if isinstance(data.get("links"), dict):
+        data["links"] = {k: ({} if k in bad_links else v) for k, v in data["links"].items()}
+    if isinstance(data.get("joints"), dict):
+        joints = {}
+        for name, j in data["joints"].items():
+            if name not in bad_joints:
+                joints[name] = j
+            elif isinstance(j, dict) and isinstance(j.get("parent"), str) and isinstance(j.get("child"), str):
+                joints[name] = {"type": "fixed", "parent": j["parent"], "child": j["child"]}
+            else:
+                dropped = True
+        data["joints"] = joints
+    try:
+        return Recipe.model_validate(data), True if not dropped else "tree"
+    except ValidationError:
+        return None, True

@@ -1,0 +1,48 @@
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+ASSETS = REPO.parent / "shared" / "assets"
+RECIPES = REPO / "recipes"
+GOLDEN = Path(__file__).resolve().parent / "golden"
+
+
+@pytest.fixture
+def assets() -> Path:
+    if not ASSETS.is_dir():
+        pytest.fail(f"test assets not found at {ASSETS} (CI clones the repository next to shared/)")
+    return ASSETS
+
+
+def write_recipe(folder: Path, text: str, name: str = "robot.yaml", meshes: dict | None = None) -> Path:
+    """Write a recipe (dedented) and optional meshes {file name: trimesh or path} into ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for file_name, mesh in (meshes or {}).items():
+        dst = folder / file_name
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(mesh, (str, Path)):
+            shutil.copyfile(mesh, dst)
+        else:
+            mesh.export(dst)
+    path = folder / name
+    path.write_text(textwrap.dedent(text).lstrip(), encoding="utf-8")
+    return path
+
+
+def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """Run the robotkit command in a separate process, as a user would."""
+    return subprocess.run([sys.executable, "-m", "robotkit", *map(str, args)], capture_output=True,
+                          text=True, cwd=cwd)
+
+
+def tree_bytes(folder: Path) -> dict[str, bytes]:
+    """Every output file below ``folder`` (state folder excluded), by relative path."""
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*"))
+            if p.is_file() and ".robotkit" not in p.parts}
