@@ -131,6 +131,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter),
             "targets": [target],
             "uptodate": [config_changed({"robot": reads, "options": opts})],
+            # no output is written while any mesh of the robot fails
+            "task_dep": [f"{robot.name}:mesh:{k}" for k in facts],
             "clean": True,
         })
     return tasks

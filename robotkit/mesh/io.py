@@ -34,6 +34,10 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
         raise fail(f"mesh file '{name}' has an unsupported format (use STL, OBJ or DAE)")
     if not os.path.isfile(path):
         raise fail(f"mesh file '{name}' does not exist")
+    if ext == ".stl":
+        problem = _stl_problem(path)
+        if problem:
+            raise fail(f"mesh file '{name}' {problem}")
     try:
         loaded = trimesh.load(path, force="mesh", process=True)
     except Exception as exc:  # trimesh raises many kinds on corrupt input
@@ -48,6 +52,24 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
     if np.prod(scale) < 0:  # a mirroring scale turns the winding inside out
         mesh.invert()
     return mesh
+
+
+def _stl_problem(path: str) -> str | None:
+    """Why a binary STL cannot be complete, or None (ASCII STL is left to the parser)."""
+    size = os.path.getsize(path)
+    if size == 0:
+        return "is empty"
+    with open(path, "rb") as f:
+        head = f.read(84)
+    if head[:5].lower() == b"solid" and b"facet" in open(path, "rb").read(4096):
+        return None  # ASCII
+    if size < 84:
+        return f"is truncated ({size} bytes, shorter than a binary STL header)"
+    count = int.from_bytes(head[80:84], "little")
+    if size < 84 + 50 * count:
+        return (f"is truncated: its header announces {count} triangles "
+                f"({84 + 50 * count} bytes), the file has {size} bytes")
+    return None
 
 
 def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):

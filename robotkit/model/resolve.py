@@ -244,7 +244,8 @@ def _check_tree(link_names: list[str], joints: list[Joint], marks) -> list[Probl
         else:
             parent_of.setdefault(j.child, j.name)
     roots = [n for n in link_names if n not in parent_of]
-    if len(roots) > 1:
+    dangling = any(j.parent not in known or j.child not in known for j in joints)
+    if len(roots) > 1 and not dangling:  # a joint naming a missing link is reported already
         problems.append(marks.problem(("links",), f"the links form {len(roots)} separate trees with roots "
                                       f"{', '.join(repr(n) for n in roots)}; connect them with joints so one root remains"))
     # cycles: follow parents from every link
