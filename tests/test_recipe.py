@@ -243,3 +243,12 @@ def test_lidar_mast_example_converts_millimetres_exactly(tmp_path, assets):
     joint = root.find("joint[@name='scan_joint']")
     assert joint.get("type") == "continuous"
     assert joint.find("limit").attrib == {"effort": "0.5", "velocity": "31.4"}
+
+
+def test_reference_docs_are_current():
+    """docs/recipe.md and docs/recipe.schema.json are generated from the schema (robotkit schema)."""
+    from robotkit.recipe.reference import json_schema, markdown
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    assert (docs / "recipe.schema.json").read_text() == json_schema(), "run: robotkit schema > docs/recipe.schema.json"
+    assert (docs / "recipe.md").read_text() == markdown(), "run: robotkit schema --markdown > docs/recipe.md"
