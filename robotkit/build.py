@@ -152,17 +152,19 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         raise RobotkitError([Problem(line) for line in lines])
     if rc not in (0,) and not result.errors:
         result.errors.append(("doit", f"doit exited with status {rc}"))
-    result.warnings = collect_warnings(out, result.robots)
+    result.warnings = collect_warnings(tasks)
     return result
 
 
-def collect_warnings(out: Path, robots: list[str]) -> list[str]:
-    """Warnings recorded by mesh tasks (shown on every build, not only the one that ran them)."""
-    from robotkit.tasks import STATE
-
+def collect_warnings(tasks: list[dict]) -> list[str]:
+    """Warnings recorded by this build's mesh tasks (shown on every build, not only the one
+    that ran them, so a no-op rebuild does not hide them)."""
     seen: list[str] = []
-    for name in robots:
-        for path in sorted((out / STATE / name / "mesh").glob("*.json")):
+    for task in tasks:
+        if ":mesh:" not in task["name"]:
+            continue
+        for path in task["targets"]:
+            path = Path(path)
             try:
                 data = json.loads(path.read_text(encoding="utf-8"))
             except (OSError, ValueError):
