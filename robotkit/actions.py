@@ -15,7 +15,7 @@ import shutil
 from robotkit.errors import Problem, RobotkitError
 from robotkit.ioutil import write_if_changed
 
-FACTS_VERSION = 1
+FACTS_VERSION = 2
 
 
 def _user_errors_fail(fn):
@@ -65,6 +65,7 @@ def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
         "com": [float(v) for v in props.com],
         "inertia": [[float(v) for v in row] for row in np.asarray(props.inertia)],
         "used": used,
+        "convex": bool(vol_mesh.is_convex),
         "repairs": repairs,
         "warnings": [f"{_where_text(where)}{w}" for w in warnings],
     }
@@ -116,7 +117,18 @@ def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[s
     from robotkit.emit import EMITTERS
 
     full = _finalized(robot, fact_paths, inertial_paths)
+    if options.get("facts"):
+        options = dict(options, facts=read_facts(fact_paths))
     write_if_changed(target, EMITTERS[emitter](full, **options))
+
+
+@_user_errors_fail
+def convert_mesh(source: str, target: str):
+    """A mesh in a format MuJoCo reads (binary STL, same units as the source, byte-reproducible)."""
+    from robotkit.mesh.io import load_mesh
+
+    mesh = load_mesh(source)
+    write_if_changed(target, mesh.export(file_type="stl"))
 
 
 @_user_errors_fail

@@ -152,8 +152,22 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         raise RobotkitError([Problem(line) for line in lines])
     if rc not in (0,) and not result.errors:
         result.errors.append(("doit", f"doit exited with status {rc}"))
-    result.warnings = collect_warnings(tasks)
+    result.warnings = collect_warnings(tasks) + collect_losses(out, result.robots)
     return result
+
+
+def collect_losses(out: Path, robots: list[str]) -> list[str]:
+    """What each output format could not express (from each robot's report.json)."""
+    lines = []
+    names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF"}
+    for name in robots:
+        try:
+            data = json.loads((out / name / "report.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        for fmt, items in sorted(data.get("losses", {}).items()):
+            lines.extend(f"{name}: {names.get(fmt, fmt)}: {item}" for item in items)
+    return lines
 
 
 def collect_warnings(tasks: list[dict]) -> list[str]:

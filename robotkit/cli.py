@@ -41,6 +41,15 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--height", type=float, default=2.0, metavar="H", help="wall height in metres (default: 2.0)")
     w.add_argument("--unknown-as-wall", action="store_true", help="treat unknown cells as walls")
 
+    c = sub.add_parser("check", help="validate a recipe, a build folder, or a URDF/SDF/MJCF file",
+                       description="Run the validators, the URDF/SDF/MJCF equivalence check and a MuJoCo "
+                                   "smoke test. Exit 0 when clean, 1 when problems are found, 2 for bad input.")
+    c.add_argument("path", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
+    c.add_argument("--format", choices=["text", "json"], default="text", help="report format (default: text)")
+    c.add_argument("--fail-on", choices=["error", "warning"], default="error",
+                   help="lowest severity that makes the exit status 1 (default: error)")
+    c.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+
     s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
     s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
     return p
@@ -59,7 +68,7 @@ def main(argv: list[str] | None = None) -> int:
     from robotkit.errors import RobotkitError
 
     try:
-        return {"build": _build, "world": _world, "schema": _schema}[args.command](args)
+        return {"build": _build, "world": _world, "schema": _schema, "check": _check}[args.command](args)
     except RobotkitError as exc:
         for line in exc.lines():
             print(line, file=sys.stderr)
@@ -105,6 +114,15 @@ def _world(args) -> int:
     for p in paths:
         print(os.path.relpath(p))
     return 0
+
+
+def _check(args) -> int:
+    from robotkit.checks import check, render
+
+    findings = check(args.path, args.out)
+    sys.stdout.write(render(findings, args.format))
+    levels = ("error",) if args.fail_on == "error" else ("error", "warning")
+    return 1 if any(f.severity in levels for f in findings) else 0
 
 
 def _schema(args) -> int:

@@ -30,12 +30,16 @@ STATE = ".robotkit"  # below the output folder: doit's database and intermediate
 # emitter -> path below the robot folder
 OUTPUTS = {
     "urdf": lambda r: f"urdf/{r.name}.urdf",
+    "sdf": lambda r: "model.sdf",
+    "mjcf": lambda r: f"mjcf/{r.name}.xml",
+    "mjcf-scene": lambda r: "mjcf/scene.xml",
+    "report": lambda r: "report.json",
     "model.config": lambda r: "model.config",
     "package.xml": lambda r: "package.xml",
     "CMakeLists.txt": lambda r: "CMakeLists.txt",
 }
 # emitters that read only the robot's name and metadata (no geometry, no inertials)
-METADATA_ONLY = {"model.config", "package.xml", "CMakeLists.txt"}
+METADATA_ONLY = {"model.config", "package.xml", "CMakeLists.txt", "mjcf-scene"}
 
 
 def _template_files(emitter: str) -> list[str]:
@@ -91,6 +95,21 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
+    from robotkit.emit.mjcf import converted_meshes
+
+    for rel, source in sorted(converted_meshes(robot).items()):
+        target = str(root / "meshes" / rel)
+        key = next(k for k, m in robot.meshes().items() if m.source == source)
+        tasks.append({
+            "name": f"{robot.name}:convert:{rel}",
+            "doc": f"meshes/{rel} for MuJoCo",
+            "actions": [(actions.convert_mesh, [source, target])],
+            "file_dep": [source, facts[key]],
+            "targets": [target],
+            "uptodate": [config_changed({"version": actions.FACTS_VERSION})],
+            "clean": True,
+        })
+
     inertials: dict[str, str] = {}
     for link in robot.links:
         if link.inertial_spec.mode not in ("density", "mass"):
@@ -114,11 +133,13 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                          if g.shape.mesh is not None and g.recenter != "none"})
     out_facts = {k: facts[k] for k in recentered}
     structure = robot.to_dict()
-    options = {"model.config": {"sdf": f"urdf/{robot.name}.urdf"}}
+    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}}
     for emitter, rel in OUTPUTS.items():
         target = str(root / rel(robot))
         opts = options.get(emitter, {})
-        if emitter in METADATA_ONLY:
+        if emitter == "report":
+            subject, reads, facts_in, inertials_in = robot, structure, facts, inertials
+        elif emitter in METADATA_ONLY:
             subject = replace(robot, links=(), joints=(), materials=())
             reads: dict = {"name": robot.name, "metadata": asdict(robot.metadata)}
             facts_in, inertials_in = {}, {}

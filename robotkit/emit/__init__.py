@@ -31,17 +31,51 @@ def _cmakelists(robot, **_):
     return render_cmakelists(robot)
 
 
+def _sdf(robot, **_):
+    from robotkit.emit.sdf import render_sdf
+
+    return render_sdf(robot)
+
+
+def _mjcf(robot, **_):
+    from robotkit.emit.mjcf import render_mjcf
+
+    return render_mjcf(robot)
+
+
+def _mjcf_scene(robot, **_):
+    from robotkit.emit.mjcf import render_scene
+
+    return render_scene(robot)
+
+
+def _report(robot, facts=None, **_):
+    import json
+
+    from robotkit.emit.report import report
+
+    return json.dumps(report(robot, facts or {}), indent=1, sort_keys=True) + "\n"
+
+
 EMITTERS = {
     "urdf": _urdf,
+    "sdf": _sdf,
+    "mjcf": _mjcf,
+    "mjcf-scene": _mjcf_scene,
     "model.config": _model_config,
     "package.xml": _package_xml,
     "CMakeLists.txt": _cmakelists,
+    "report": _report,
 }
 
 # the templates each emitter renders (their edits must rebuild the output)
 TEMPLATES = {
     "urdf": ["urdf/robot.urdf.j2"],
+    "sdf": ["sdf/model.sdf.j2"],
+    "mjcf": ["mjcf/robot.xml.j2"],
+    "mjcf-scene": ["mjcf/scene.xml.j2"],
     "model.config": ["gazebo/model.config.j2"],
     "package.xml": ["ros/package.xml.j2"],
     "CMakeLists.txt": ["ros/CMakeLists.txt.j2"],
+    "report": [],
 }

@@ -41,6 +41,7 @@ def context(robot: Robot) -> dict:
             "collisions": [geom_context(robot, g) for g in link.collisions],
             "inertial": link.inertial,
             "gazebo_material": gazebo_material,
+            "contact": link.contact if link.collisions else None,
         })
     return {
         "robot": robot,

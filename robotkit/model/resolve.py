@@ -20,7 +20,7 @@ import numpy as np
 
 from robotkit.errors import Problem, RecipeError
 from robotkit.model.robot import (
-    Author, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
+    Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
     Metadata, Mimic, Pose, Robot, Shape, rpy_matrix,
 )
 from robotkit.recipe.load import LoadedRecipe
@@ -121,8 +121,12 @@ def resolve(loaded: LoadedRecipe) -> Robot:
                                               f"computing the inertial needs {spec.source} geometry, and the link has none"))
         if spec.mode == "explicit":
             problems.extend(_check_explicit(spec.explicit, marks, lp + ("inertial",)))
+        contact = None
+        if link.contact is not None:
+            c = link.contact
+            contact = Contact(c.mu1, c.mu2 if c.mu2 is not None else c.mu1, c.kp, c.kd)
         links.append(Link(name, tuple(visuals), tuple(collisions), spec,
-                          spec.explicit if spec.mode == "explicit" else None))
+                          spec.explicit if spec.mode == "explicit" else None, contact))
 
     link_names = [link.name for link in links]
     joints: list[Joint] = []
@@ -147,7 +151,7 @@ def resolve(loaded: LoadedRecipe) -> Robot:
                                                   "a continuous joint has no lower or upper limit (use revolute)"))
             if j.type in ("fixed", "floating", "planar"):
                 problems.append(marks.problem(jp + ("limit",), f"a {j.type} joint takes no limit"))
-        dyn = Dynamics(j.dynamics.damping, j.dynamics.friction) if j.dynamics else None
+        dyn = Dynamics(j.dynamics.damping, j.dynamics.friction, j.dynamics.armature) if j.dynamics else None
         mimic = None
         if j.mimic is not None:
             mimic = Mimic(j.mimic.joint, j.mimic.multiplier, j.mimic.offset)
@@ -170,7 +174,7 @@ def resolve(loaded: LoadedRecipe) -> Robot:
 
     md = r.metadata
     metadata = Metadata(md.version, md.description, tuple(Author(a.name, a.email) for a in md.authors), md.license)
-    return Robot(r.robot, tuple(links), tuple(joints), materials, metadata)
+    return Robot(r.robot, tuple(links), tuple(joints), materials, metadata, r.self_collide)
 
 
 def _indexed(value):

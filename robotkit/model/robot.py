@@ -134,12 +134,21 @@ class InertialSpec:
 
 
 @dataclass(frozen=True)
+class Contact:
+    mu1: float | None = None
+    mu2: float | None = None
+    kp: float | None = None
+    kd: float | None = None
+
+
+@dataclass(frozen=True)
 class Link:
     name: str
     visuals: tuple[Geom, ...] = ()
     collisions: tuple[Geom, ...] = ()
     inertial_spec: InertialSpec = InertialSpec("none")
     inertial: Inertial | None = None
+    contact: Contact | None = None
 
     def source_geoms(self) -> tuple[Geom, ...]:
         return self.collisions if self.inertial_spec.source == "collision" else self.visuals
@@ -157,6 +166,7 @@ class Limit:
 class Dynamics:
     damping: float = 0.0
     friction: float = 0.0
+    armature: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -207,6 +217,7 @@ class Robot:
     joints: tuple[Joint, ...] = ()
     materials: tuple[Material, ...] = ()
     metadata: Metadata = field(default_factory=Metadata)
+    self_collide: bool = False
 
     def link(self, name: str) -> Link:
         for link in self.links:

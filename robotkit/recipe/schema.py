@@ -178,6 +178,19 @@ CollisionSpec = Annotated[
 ]
 
 
+class Contact(Strict):
+    """Surface friction and contact parameters of a link's collision geometry."""
+
+    mu1: NonNegative | None = None
+    """Coulomb friction coefficient along the first friction direction (URDF gazebo mu1, SDF ode mu, MJCF sliding friction)."""
+    mu2: NonNegative | None = None
+    """Coulomb friction coefficient along the second direction (URDF gazebo mu2, SDF ode mu2). Default: mu1."""
+    kp: Positive | None = None
+    """Contact stiffness in N/m (URDF gazebo kp, SDF ode kp)."""
+    kd: NonNegative | None = None
+    """Contact damping in N s/m (URDF gazebo kd, SDF ode kd)."""
+
+
 class Link(Strict):
     visual: Shapes | None = None
     """Visual geometry: one shape or a list of shapes."""
@@ -185,6 +198,8 @@ class Link(Strict):
     """Collision geometry: ``visual`` (the same shapes as the visual), ``none``, or shapes of its own."""
     inertial: Inertial | None = None
     """Mass properties. Default: computed from the geometry at the recipe's density; a link with no geometry gets none."""
+    contact: Contact | None = None
+    """Friction and contact parameters of the link's collision geometry."""
 
 
 class Limit(Strict):
@@ -203,6 +218,8 @@ class Dynamics(Strict):
     """Viscous damping (N m s/rad or N s/m)."""
     friction: NonNegative = 0.0
     """Coulomb friction (N m or N)."""
+    armature: NonNegative = 0.0
+    """Reflected rotor inertia (kg m^2 or kg); MJCF only (listed as not expressible for URDF and SDF)."""
 
 
 class Mimic(Strict):
@@ -285,6 +302,8 @@ class Recipe(Strict):
     """Default density in kg/m^3 for inertials computed from geometry."""
     open_mesh: Literal["error", "hull"] = "error"
     """Default policy for meshes that are not closed volumes after safe repair."""
+    self_collide: bool = False
+    """Whether the robot's links collide with each other (Gazebo's ``self_collide``; MJCF contact filtering). Links joined by a joint never collide."""
     metadata: Metadata = Metadata()
     materials: dict[str, Material] = {}
     defaults: Defaults = Defaults()

@@ -1,0 +1,195 @@
+"""Robot -> MJCF (templates/mjcf/robot.xml.j2) and a scene that includes it (scene.xml.j2).
+
+Body names are link names and joint names are joint names.  Each body's frame is its
+link frame; inertials carry the full tensor (``fullinertia``); visual geoms neither collide
+nor add mass; mesh assets carry their scale.  A root link named ``world`` becomes the
+worldbody (its floating children get free joints); any other root is welded to the world.
+What MJCF cannot express is listed by :func:`losses`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from robotkit.emit.env import render
+from robotkit.model.robot import Geom, Robot
+
+WORLD = "world"
+MJCF_MESH_EXT = (".stl", ".obj")
+
+
+def quat(rpy) -> tuple[float, float, float, float]:
+    """(w, x, y, z) of fixed-axis roll, pitch, yaw (URDF convention)."""
+    r, p, y = (0.5 * float(a) for a in rpy)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    q = (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+         cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy)
+    return q if q[0] >= 0 else tuple(-v for v in q)
+
+
+def mesh_file(mesh) -> str:
+    """The mesh file MJCF reads, relative to the robot's meshes/ folder (MuJoCo reads no DAE)."""
+    stem, ext = os.path.splitext(mesh.file_name)
+    if ext.lower() in MJCF_MESH_EXT:
+        return f"visual/{mesh.file_name}"
+    return f"mjcf/{stem}.stl"
+
+
+def converted_meshes(robot: Robot) -> dict[str, str]:
+    """Meshes that need converting for MJCF: output path below meshes/ -> source file."""
+    out = {}
+    for mesh in robot.meshes().values():
+        rel = mesh_file(mesh)
+        if rel.startswith("mjcf/"):
+            out.setdefault(rel, mesh.source)
+    return out
+
+
+def losses(robot: Robot, facts: dict | None = None) -> list[str]:
+    out = []
+    for rel, src in sorted(converted_meshes(robot).items()):
+        out.append(f"mesh '{os.path.basename(src)}': MuJoCo reads no {os.path.splitext(src)[1].upper()[1:]}; "
+                   f"converted to meshes/{rel} (the file's own colours and textures are dropped, "
+                   "the recipe's material is used)")
+    children = {j.child: j for j in robot.joints}
+    for j in robot.joints:
+        if j.type == "planar":
+            out.append(f"joint '{j.name}': MJCF has no planar joint; written as slides "
+                       f"'{j.name}_x', '{j.name}_y' and hinge '{j.name}_rz'")
+        if j.type == "floating" and j.parent != WORLD:
+            out.append(f"joint '{j.name}': MuJoCo allows free joints only on bodies of the world; "
+                       f"link '{j.child}' is welded to '{j.parent}'")
+        if j.limit is not None and j.limit.velocity is not None and j.type not in ("fixed",):
+            out.append(f"joint '{j.name}': MJCF has no velocity limit ({j.limit.velocity:g} not enforced)")
+    for link in robot.links:
+        c = link.contact
+        if c is not None and c.mu2 is not None and c.mu1 is not None and c.mu2 != c.mu1:
+            out.append(f"link '{link.name}': MuJoCo friction is isotropic; mu2 {c.mu2:g} dropped, mu1 {c.mu1:g} used")
+        for g in link.collisions:
+            if g.shape.mesh is not None and facts is not None:
+                f = facts.get(g.shape.mesh.key)
+                if f is not None and not f.get("convex", True):
+                    out.append(f"link '{link.name}': collision mesh '{g.shape.mesh.file_name}' is not convex; "
+                               "MuJoCo collides with its convex hull")
+    del children
+    return out
+
+
+def _geom(robot: Robot, geom: Geom, name: str, assets: dict) -> dict:
+    s = geom.shape
+    pose = geom.pose
+    ctx = {"name": name, "pos": pose.xyz, "quat": quat(pose.rpy), "type": s.kind,
+           "material": geom.material}
+    if s.kind == "mesh":
+        key = (mesh_file(s.mesh), s.mesh.scale)
+        ctx["mesh"] = assets[key]["name"]
+    elif s.kind == "box":
+        ctx["size"] = tuple(v / 2 for v in s.size)
+    elif s.kind == "cylinder":
+        ctx["size"] = (s.radius, s.length / 2)
+    else:
+        ctx["size"] = (s.radius,)
+    return ctx
+
+
+def _assets(robot: Robot) -> dict:
+    assets: dict = {}
+    used_names: set[str] = set()
+    for link in robot.links:
+        for g in link.visuals + link.collisions:
+            m = g.shape.mesh
+            if m is None:
+                continue
+            key = (mesh_file(m), m.scale)
+            if key in assets:
+                continue
+            base = os.path.splitext(m.file_name)[0]
+            name, n = base, 1
+            while name in used_names:
+                n += 1
+                name = f"{base}_{n}"
+            used_names.add(name)
+            assets[key] = {"name": name, "file": key[0], "scale": m.scale if any(v != 1 for v in m.scale) else None}
+    return assets
+
+
+def _plane_axes(normal) -> tuple[tuple, tuple]:
+    n = np.asarray(normal, dtype=float)
+    helper = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 1.0, 0])
+    u = np.cross(n, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(n, u)
+    return tuple(u), tuple(v)
+
+
+def context(robot: Robot) -> dict:
+    assets = _assets(robot)
+    by_parent: dict[str, list] = {}
+    for j in robot.joints:
+        by_parent.setdefault(j.parent, []).append(j)
+    links = {link.name: link for link in robot.links}
+    contacts = {}
+
+    def joints_of(j) -> list[dict]:
+        if j.type in ("revolute", "continuous", "prismatic"):
+            d = {"name": j.name, "type": "slide" if j.type == "prismatic" else "hinge", "axis": j.axis}
+            if j.type != "continuous":
+                d["range"] = (j.limit.lower, j.limit.upper)
+            if j.limit is not None and j.limit.effort:
+                d["frcrange"] = j.limit.effort
+            if j.dynamics is not None:
+                d.update(damping=j.dynamics.damping, friction=j.dynamics.friction, armature=j.dynamics.armature)
+            return [d]
+        if j.type == "planar":
+            u, v = _plane_axes(j.axis)
+            return [{"name": f"{j.name}_x", "type": "slide", "axis": u},
+                    {"name": f"{j.name}_y", "type": "slide", "axis": v},
+                    {"name": f"{j.name}_rz", "type": "hinge", "axis": j.axis}]
+        if j.type == "floating" and j.parent == WORLD:
+            return [{"name": j.name, "type": "free"}]
+        return []
+
+    def body(name: str, joint) -> dict:
+        link = links[name]
+        c = link.contact
+        friction = c.mu1 if c is not None else None
+        solref = (-c.kp, -(c.kd or 0.0)) if c is not None and c.kp is not None else None
+        return {
+            "name": name,
+            "pos": joint.origin.xyz if joint is not None else (0.0, 0.0, 0.0),
+            "quat": quat(joint.origin.rpy) if joint is not None else (1.0, 0.0, 0.0, 0.0),
+            "joints": joints_of(joint) if joint is not None else [],
+            "inertial": link.inertial,
+            "visuals": [_geom(robot, g, f"{name}_visual_{i}", assets) for i, g in enumerate(link.visuals)],
+            "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets), friction=friction, solref=solref)
+                           for i, g in enumerate(link.collisions)],
+            "children": [body(j.child, j) for j in by_parent.get(name, [])],
+        }
+
+    root = robot.root
+    if root == WORLD:
+        world = body(root, None)
+        world_geoms = world["visuals"] + world["collisions"]
+        bodies = world["children"]
+    else:
+        world_geoms = []
+        bodies = [body(root, None)]
+    equalities = [{"name": f"{j.name}_mimic", "joint1": j.name, "joint2": j.mimic.joint,
+                   "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
+                  for j in robot.joints if j.mimic is not None]
+    del contacts
+    excludes = [(j.parent, j.child) for j in robot.joints if j.parent != WORLD]
+    return {"robot": robot, "excludes": excludes, "assets": sorted(assets.values(), key=lambda a: a["name"]),
+            "materials": robot.materials, "world_geoms": world_geoms, "bodies": bodies,
+            "equalities": equalities}
+
+
+def render_mjcf(robot: Robot) -> str:
+    return render("mjcf/robot.xml.j2", **context(robot))
+
+
+def render_scene(robot: Robot) -> str:
+    return render("mjcf/scene.xml.j2", robot=robot)

@@ -1,0 +1,45 @@
+"""Checks on built outputs: cross-format equivalence and a simulation smoke test."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def equivalence(robot_dir: str | Path, tol: float = 1e-9, configs: int = 100) -> dict[str, list[str]]:
+    """Compare the URDF, SDF and MJCF of a build folder pairwise; {comparison: differences}."""
+    from robotkit.verify import kinematics as k
+
+    robot_dir = Path(robot_dir)
+    name = robot_dir.name
+    urdf = robot_dir / "urdf" / f"{name}.urdf"
+    u = k.read_urdf(urdf)
+    m = k.read_mjcf(robot_dir / "mjcf" / f"{name}.xml")
+    s = k.read_sdf(robot_dir / "model.sdf")
+    g = k.read_urdf_via_libsdformat(urdf)
+    return {
+        "URDF (MuJoCo) vs MJCF (MuJoCo)": k.compare(u, m, tol, configs, ignore=("velocity",)),
+        "URDF (MuJoCo) vs SDF": k.compare(u, s, tol, configs, ignore=("mimic",)),
+        "URDF (libsdformat) vs SDF": k.compare(g, s, tol, configs, ignore=("mimic",)),
+    }
+
+
+def smoke_test(scene: str | Path, seconds: float = 3.0) -> list[str]:
+    """Step a MuJoCo scene; problems if it produces NaN, explodes, or does not come to rest."""
+    import mujoco
+    import numpy as np
+
+    model = mujoco.MjModel.from_xml_path(str(scene))
+    data = mujoco.MjData(model)
+    steps = int(seconds / model.opt.timestep)
+    problems = []
+    for i in range(steps):
+        mujoco.mj_step(model, data)
+        if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()):
+            return [f"simulation produced NaN or inf after {i * model.opt.timestep:.3f} s"]
+        if np.abs(data.qvel).max(initial=0.0) > 1e3:
+            return [f"simulation exploded after {i * model.opt.timestep:.3f} s (|qvel| {np.abs(data.qvel).max():.3g})"]
+    speed = float(np.abs(data.qvel).max(initial=0.0))
+    if speed > 1e-2:
+        problems.append(f"still moving after {seconds:g} s (max |qvel| {speed:.3g}); "
+                        "a robot that slides or drifts on the spot usually has wrong inertials")
+    return problems

@@ -1,0 +1,392 @@
+"""A neutral kinematic and inertial view of a robot, read back from each output format by
+a parser that is not robotkit's emitter, and compared.
+
+- URDF: MuJoCo's own URDF compiler (plus the XML for what MuJoCo ignores: velocity limits);
+- MJCF: MuJoCo;
+- SDF: an SDF frame-graph reader here (``relative_to``, ``attached_to``, ``expressed_in``),
+  applied both to our model.sdf and to libsdformat's conversion of our URDF (`ign sdf -p`).
+
+:func:`compare` reports every difference in links, joints, masses, centres of mass,
+inertia tensors (link axes), limits, damping, friction, and link poses relative to the
+root at random joint configurations.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+
+import numpy as np
+
+WORLD = "world"
+
+
+@dataclass
+class KLink:
+    name: str
+    mass: float = 0.0
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+
+
+@dataclass
+class KJoint:
+    name: str
+    type: str  # revolute | continuous | prismatic | fixed | floating | planar
+    parent: str
+    child: str
+    T_pj: np.ndarray  # parent link frame -> joint frame at q = 0
+    T_jc: np.ndarray  # joint frame -> child link frame
+    axis: np.ndarray  # in the joint frame
+    lower: float | None = None
+    upper: float | None = None
+    effort: float | None = None
+    velocity: float | None = None
+    damping: float | None = None
+    friction: float | None = None
+    mimic: tuple[str, float, float] | None = None  # leader, multiplier, offset
+
+
+@dataclass
+class KModel:
+    source: str
+    links: dict[str, KLink]
+    joints: dict[str, KJoint]  # by name; fixed joints may be unnamed in some readers
+
+    def parent_of(self) -> dict[str, KJoint]:
+        return {j.child: j for j in self.joints.values()}
+
+    def root(self) -> str:
+        children = {j.child for j in self.joints.values()}
+        roots = [n for n in self.links if n not in children]
+        return roots[0]
+
+    def fk(self, q: dict[str, float]) -> dict[str, np.ndarray]:
+        parent_of = self.parent_of()
+        out: dict[str, np.ndarray] = {}
+
+        def pose(link: str) -> np.ndarray:
+            if link in out:
+                return out[link]
+            j = parent_of.get(link)
+            if j is None:
+                out[link] = np.eye(4)
+                return out[link]
+            value = q.get(j.name, 0.0)
+            if j.mimic is not None:
+                value = j.mimic[1] * q.get(j.mimic[0], 0.0) + j.mimic[2]
+            M = np.eye(4)
+            if j.type in ("revolute", "continuous"):
+                M[:3, :3] = axis_angle(j.axis, value)
+            elif j.type == "prismatic":
+                M[:3, 3] = j.axis * value
+            out[link] = pose(j.parent) @ j.T_pj @ M @ j.T_jc
+            return out[link]
+
+        for name in self.links:
+            pose(name)
+        return out
+
+
+def axis_angle(axis, angle) -> np.ndarray:
+    x, y, z = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    c, s = math.cos(angle), math.sin(angle)
+    C = 1 - c
+    return np.array([[c + x * x * C, x * y * C - z * s, x * z * C + y * s],
+                     [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
+                     [z * x * C - y * s, z * y * C + x * s, c + z * z * C]])
+
+
+def rpy_matrix(r, p, y) -> np.ndarray:
+    return axis_angle((0, 0, 1), y) @ axis_angle((0, 1, 0), p) @ axis_angle((1, 0, 0), r)
+
+
+def _T(xyz, R) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = xyz
+    return T
+
+
+def _quat_R(q) -> np.ndarray:
+    w, x, y, z = (float(v) for v in q)
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+# ---------------------------------------------------------------- MuJoCo (MJCF and URDF)
+
+
+def from_mujoco(model, source: str) -> KModel:
+    import mujoco
+
+    links: dict[str, KLink] = {}
+    joints: dict[str, KJoint] = {}
+    names = {b: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(model.nbody)}
+    for b in range(1, model.nbody):
+        name = names[b]
+        R = _quat_R(model.body_iquat[b])
+        links[name] = KLink(name, float(model.body_mass[b]), np.array(model.body_ipos[b], dtype=float),
+                            R @ np.diag(model.body_inertia[b]) @ R.T)
+        parent = names[int(model.body_parentid[b])]
+        T_pb = _T(model.body_pos[b], _quat_R(model.body_quat[b]))
+        jids = [j for j in range(model.njnt) if model.jnt_bodyid[j] == b]
+        if not jids:
+            if parent != WORLD or b != 1:
+                joints[f"(fixed {name})"] = KJoint(f"(fixed {name})", "fixed", parent, name, T_pb, np.eye(4),
+                                                   np.array([1.0, 0, 0]))
+            continue
+        j = jids[0]
+        jname = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)
+        jtype = int(model.jnt_type[j])
+        dof = int(model.jnt_dofadr[j])
+        if jtype == mujoco.mjtJoint.mjJNT_FREE:
+            joints[jname] = KJoint(jname, "floating", parent, name, T_pb, np.eye(4), np.array([1.0, 0, 0]))
+            continue
+        kind = "prismatic" if jtype == mujoco.mjtJoint.mjJNT_SLIDE else "revolute"
+        limited = bool(model.jnt_limited[j])
+        if kind == "revolute" and not limited:
+            kind = "continuous"
+        lower, upper = (float(model.jnt_range[j][0]), float(model.jnt_range[j][1])) if limited else (None, None)
+        effort = None
+        if model.jnt_actfrclimited[j]:
+            effort = float(model.jnt_actfrcrange[j][1])
+        T_jc = np.eye(4)
+        T_jc[:3, 3] = -np.asarray(model.jnt_pos[j])
+        T_pj = T_pb.copy()
+        T_pj[:3, 3] = T_pb[:3, 3] + T_pb[:3, :3] @ np.asarray(model.jnt_pos[j])
+        joints[jname] = KJoint(jname, kind, parent, name, T_pj, T_jc, np.array(model.jnt_axis[j], dtype=float),
+                               lower, upper, effort, None, float(model.dof_damping[dof]),
+                               float(model.dof_frictionloss[dof]))
+    for e in range(model.neq):
+        if model.eq_type[e] == mujoco.mjtEq.mjEQ_JOINT:
+            j1 = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, int(model.eq_obj1id[e]))
+            j2 = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, int(model.eq_obj2id[e]))
+            data = model.eq_data[e]
+            joints[j1].mimic = (j2, float(data[1]), float(data[0]))
+    return KModel(source, links, joints)
+
+
+def read_mjcf(path) -> KModel:
+    import mujoco
+
+    return from_mujoco(mujoco.MjModel.from_xml_path(str(path)), f"MJCF {path}")
+
+
+def read_urdf(path) -> KModel:
+    """Our URDF through MuJoCo's URDF compiler (fixed joints kept), plus velocity limits
+    and names from the XML, which MuJoCo ignores."""
+    import mujoco
+
+    text = open(path, encoding="utf-8").read()
+    # geometry plays no part in the comparison; meshes (DAE among them) need not load
+    text = re.sub(r"<mesh\b[^>]*/>", '<sphere radius="0.001"/>', text)
+    extension = ('<mujoco><compiler fusestatic="false" discardvisual="false" balanceinertia="false" '
+                 'inertiafromgeom="false"/></mujoco>')
+    text = re.sub(r"(<robot[^>]*>)", r"\1" + extension, text, count=1)
+    model = from_mujoco(mujoco.MjModel.from_xml_string(text), f"URDF {path} (MuJoCo)")
+    root = ET.fromstring(text)
+    for j in root.iter("joint"):
+        name = j.get("name")
+        limit = j.find("limit")
+        if name in model.joints and limit is not None and limit.get("velocity") is not None:
+            model.joints[name].velocity = float(limit.get("velocity"))
+        if name in model.joints and limit is not None and limit.get("effort") is not None:
+            model.joints[name].effort = float(limit.get("effort"))
+    # name fixed joints as the URDF does
+    fixed = {j.find("child").get("link"): j.get("name") for j in root.iter("joint") if j.get("type") == "fixed"}
+    for key in [k for k, v in model.joints.items() if v.type == "fixed"]:
+        j = model.joints.pop(key)
+        j.name = fixed.get(j.child, key)
+        model.joints[j.name] = j
+    return model
+
+
+# ---------------------------------------------------------------- SDF
+
+
+def _pose(el) -> tuple[np.ndarray, str | None]:
+    p = el.find("pose") if el is not None else None
+    if p is None:
+        return np.eye(4), None
+    v = [float(x) for x in (p.text or "0 0 0 0 0 0").split()]
+    return _T(v[:3], rpy_matrix(*v[3:6])), p.get("relative_to")
+
+
+def read_sdf_text(text: str, source: str) -> KModel:
+    root = ET.fromstring(text)
+    model = root.find("model")
+    frames: dict[str, tuple[np.ndarray, str]] = {}  # name -> (pose, relative_to)
+    link_els = {lk.get("name"): lk for lk in model.findall("link")}
+    joint_els = {j.get("name"): j for j in model.findall("joint")}
+    for name, lk in link_els.items():
+        T, rel = _pose(lk)
+        frames[name] = (T, rel or "__model__")
+    for name, j in joint_els.items():
+        T, rel = _pose(j)
+        frames[name] = (T, rel or j.find("child").text.strip())
+    for f in model.findall("frame"):
+        T, rel = _pose(f)
+        frames[f.get("name")] = (T, rel or f.get("attached_to") or "__model__")
+    resolved: dict[str, np.ndarray] = {"__model__": np.eye(4)}
+
+    def world(name: str, depth=0) -> np.ndarray:
+        if name in resolved:
+            return resolved[name]
+        if depth > 100:
+            raise ValueError(f"{source}: frame cycle at '{name}'")
+        T, rel = frames[name]
+        resolved[name] = world(rel, depth + 1) @ T
+        return resolved[name]
+
+    links = {}
+    for name, lk in link_els.items():
+        inertial = lk.find("inertial")
+        if inertial is None:
+            links[name] = KLink(name)
+            continue
+        T, _ = _pose(inertial)
+        mass = float(inertial.findtext("mass", "0"))
+        i = inertial.find("inertia")
+        g = {k: float(i.findtext(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")} if i is not None else {}
+        I = np.array([[g.get("ixx", 0), g.get("ixy", 0), g.get("ixz", 0)],
+                      [g.get("ixy", 0), g.get("iyy", 0), g.get("iyz", 0)],
+                      [g.get("ixz", 0), g.get("iyz", 0), g.get("izz", 0)]])
+        R = T[:3, :3]
+        links[name] = KLink(name, mass, T[:3, 3].copy(), R @ I @ R.T)
+    joints = {}
+    for name, j in joint_els.items():
+        parent, child = j.find("parent").text.strip(), j.find("child").text.strip()
+        if parent == WORLD:
+            continue
+        X_j = world(name)
+        X_p, X_c = world(parent), world(child)
+        kind = j.get("type")
+        axis_el = j.find("axis")
+        axis = np.array([0, 0, 1.0])
+        lower = upper = effort = velocity = damping = friction = None
+        if axis_el is not None:
+            xyz = axis_el.find("xyz")
+            axis = np.array([float(v) for v in xyz.text.split()])
+            expressed = xyz.get("expressed_in")
+            if expressed:
+                axis = np.linalg.inv(X_j[:3, :3]) @ (world(expressed)[:3, :3] @ axis)
+            lim = axis_el.find("limit")
+            if lim is not None:
+                lo, hi = lim.findtext("lower"), lim.findtext("upper")
+                if lo is not None and abs(float(lo)) < 1e15:
+                    lower, upper = float(lo), float(hi)
+                if lim.findtext("effort") is not None:
+                    effort = float(lim.findtext("effort"))
+                if lim.findtext("velocity") is not None:
+                    velocity = float(lim.findtext("velocity"))
+            dyn = axis_el.find("dynamics")
+            if dyn is not None:
+                damping = float(dyn.findtext("damping", "0"))
+                friction = float(dyn.findtext("friction", "0"))
+        if kind == "revolute" and lower is None:
+            kind = "continuous"
+        joints[name] = KJoint(name, kind, parent, child, np.linalg.inv(X_p) @ X_j, np.linalg.inv(X_j) @ X_c,
+                              axis / np.linalg.norm(axis), lower, upper, effort, velocity, damping, friction)
+    return KModel(source, links, joints)
+
+
+def read_sdf(path) -> KModel:
+    return read_sdf_text(open(path, encoding="utf-8").read(), f"SDF {path}")
+
+
+def read_urdf_via_libsdformat(path) -> KModel:
+    """libsdformat's own reading of the URDF (`ign sdf -p`), as SDF."""
+    import subprocess
+
+    proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
+    if proc.returncode != 0 or "<sdf" not in proc.stdout:
+        raise RuntimeError(f"ign sdf -p {path} failed: {proc.stderr.strip() or proc.stdout.strip()}")
+    return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)")
+
+
+# ---------------------------------------------------------------- comparison
+
+
+def _close(a, b, tol, scale=1.0) -> bool:
+    return bool(np.all(np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)) <= tol * max(scale, 1e-300)))
+
+
+def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: int = 0,
+            ignore: tuple[str, ...] = ()) -> list[str]:
+    """Every difference between two readings of a robot, as sentences; [] when equivalent.
+
+    ``ignore`` names joint attributes one side cannot hold (e.g. "velocity" for MJCF)."""
+    diffs: list[str] = []
+    la = {n for n in a.links if n != WORLD}
+    lb = {n for n in b.links if n != WORLD}
+    if la != lb:
+        diffs.append(f"links differ: only in {a.source}: {sorted(la - lb)}; only in {b.source}: {sorted(lb - la)}")
+    pa, pb = a.parent_of(), b.parent_of()
+    for name in sorted(la & lb):
+        ja, jb = pa.get(name), pb.get(name)
+        par_a = ja.parent if ja else None
+        par_b = jb.parent if jb else None
+        if (par_a or WORLD) != (par_b or WORLD) and not ({par_a, par_b} <= {None, WORLD}):
+            diffs.append(f"link '{name}': parent '{par_a}' in {a.source}, '{par_b}' in {b.source}")
+        A, B = a.links[name], b.links[name]
+        if not _close(A.mass, B.mass, tol, abs(A.mass)):
+            diffs.append(f"link '{name}': mass {A.mass!r} vs {B.mass!r}")
+        size = max(1.0, float(np.abs(A.com).max()))
+        if A.mass > 0 and not _close(A.com, B.com, tol, size):
+            diffs.append(f"link '{name}': centre of mass {A.com.tolist()} vs {B.com.tolist()}")
+        scale = float(np.abs(A.inertia).max())
+        if A.mass > 0 and not _close(A.inertia, B.inertia, tol, scale):
+            diffs.append(f"link '{name}': inertia tensor {A.inertia.tolist()} vs {B.inertia.tolist()}")
+    movable = ("revolute", "continuous", "prismatic")
+    ma = {n: j for n, j in a.joints.items() if j.type in movable}
+    mb = {n: j for n, j in b.joints.items() if j.type in movable}
+    if set(ma) != set(mb):
+        diffs.append(f"movable joints differ: {sorted(ma)} in {a.source}, {sorted(mb)} in {b.source}")
+    for name in sorted(set(ma) & set(mb)):
+        A, B = ma[name], mb[name]
+        if A.type != B.type:
+            diffs.append(f"joint '{name}': type {A.type} vs {B.type}")
+        for attr in ("lower", "upper", "effort", "velocity", "damping", "friction"):
+            va, vb = getattr(A, attr), getattr(B, attr)
+            if attr in ignore or va is None or vb is None:
+                continue
+            if not _close(va, vb, tol, max(abs(va), 1.0)):
+                diffs.append(f"joint '{name}': {attr} {va!r} vs {vb!r}")
+        if (A.mimic is None) != (B.mimic is None) and "mimic" not in ignore:
+            diffs.append(f"joint '{name}': mimic {A.mimic} vs {B.mimic}")
+        elif A.mimic and B.mimic and (A.mimic[0] != B.mimic[0] or not _close(A.mimic[1:], B.mimic[1:], tol)):
+            diffs.append(f"joint '{name}': mimic {A.mimic} vs {B.mimic}")
+    if diffs:
+        return diffs
+    if "mimic" in ignore:  # one side cannot hold mimic relations: move both by the other's
+        import copy
+
+        b = copy.deepcopy(b)
+        for name, j in b.joints.items():
+            if j.mimic is None and name in a.joints and a.joints[name].mimic is not None:
+                j.mimic = a.joints[name].mimic
+    rng = np.random.default_rng(seed)
+    names = sorted(ma)
+    root_a, root_b = a.root(), b.root()
+    for k in range(configs):
+        q = {}
+        for n in names:
+            j = ma[n]
+            lo, hi = (j.lower, j.upper) if j.lower is not None else ((-math.pi, math.pi) if j.type != "prismatic" else (-1, 1))
+            q[n] = float(rng.uniform(lo, hi)) if k else 0.0
+        Ta, Tb = a.fk(q), b.fk(q)
+        ra, rb = np.linalg.inv(Ta[root_a]), np.linalg.inv(Tb[root_b])
+        for name in sorted(la & lb):
+            A, B = ra @ Ta[name], rb @ Tb[name]
+            size = max(1.0, float(np.abs(A[:3, 3]).max()))
+            if not (_close(A[:3, 3], B[:3, 3], tol, size) and _close(A[:3, :3], B[:3, :3], tol)):
+                diffs.append(f"link '{name}': pose differs at configuration {q}: "
+                             f"{A[:3, 3].tolist()} vs {B[:3, 3].tolist()}")
+                return diffs
+    return diffs
