@@ -252,3 +252,28 @@ def test_reference_docs_are_current():
     docs = Path(__file__).resolve().parents[1] / "docs"
     assert (docs / "recipe.schema.json").read_text() == json_schema(), "run: robotkit schema > docs/recipe.schema.json"
     assert (docs / "recipe.md").read_text() == markdown(), "run: robotkit schema --markdown > docs/recipe.md"
+
+
+def test_urdf_extras_are_copied_verbatim(tmp_path):
+    recipe = write_recipe(tmp_path, """
+        robot: extra
+        links: {a: {visual: {box: {size: [1, 1, 1]}}}}
+        urdf_extras:
+          - <gazebo><plugin name="p" filename="libp.so"><rate>10</rate></plugin></gazebo>
+        """)
+    urdf = built_urdf(recipe, tmp_path / "out")
+    assert '  <gazebo><plugin name="p" filename="libp.so"><rate>10</rate></plugin></gazebo>\n' in urdf.read_text()
+
+
+def test_urdf_extras_must_be_well_formed(tmp_path):
+    from robotkit.errors import RobotkitError
+
+    recipe = write_recipe(tmp_path, """
+        robot: extra
+        links: {a: {}}
+        urdf_extras: ["<gazebo><plugin></gazebo>"]
+        """)
+    with pytest.raises(RobotkitError) as err:
+        build([recipe], tmp_path / "out")
+    assert err.value.lines() == [f"{recipe}:3: urdf_extras: urdf_extras[0] is not well-formed XML: "
+                                 "mismatched tag: line 1, column 18"]

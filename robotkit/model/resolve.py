@@ -174,7 +174,7 @@ def resolve(loaded: LoadedRecipe) -> Robot:
 
     md = r.metadata
     metadata = Metadata(md.version, md.description, tuple(Author(a.name, a.email) for a in md.authors), md.license)
-    return Robot(r.robot, tuple(links), tuple(joints), materials, metadata, r.self_collide)
+    return Robot(r.robot, tuple(links), tuple(joints), materials, metadata, r.self_collide, tuple(r.urdf_extras))
 
 
 def _indexed(value):

@@ -218,6 +218,7 @@ class Robot:
     materials: tuple[Material, ...] = ()
     metadata: Metadata = field(default_factory=Metadata)
     self_collide: bool = False
+    urdf_extras: tuple[str, ...] = ()
 
     def link(self, name: str) -> Link:
         for link in self.links:

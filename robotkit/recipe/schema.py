@@ -304,6 +304,8 @@ class Recipe(Strict):
     """Default policy for meshes that are not closed volumes after safe repair."""
     self_collide: bool = False
     """Whether the robot's links collide with each other (Gazebo's ``self_collide``; MJCF contact filtering). Links joined by a joint never collide."""
+    urdf_extras: list[str] = []
+    """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML."""
     metadata: Metadata = Metadata()
     materials: dict[str, Material] = {}
     defaults: Defaults = Defaults()
@@ -314,6 +316,18 @@ class Recipe(Strict):
     @classmethod
     def _robot_name(cls, v):
         return check_name(v)
+
+    @field_validator("urdf_extras")
+    @classmethod
+    def _well_formed(cls, v):
+        import xml.etree.ElementTree as ET
+
+        for i, text in enumerate(v):
+            try:
+                ET.fromstring(text)
+            except ET.ParseError as exc:
+                raise ValueError(f"urdf_extras[{i}] is not well-formed XML: {exc}") from None
+        return v
 
     @field_validator("materials", "links", "joints")
     @classmethod
