@@ -45,7 +45,10 @@ def _parser() -> argparse.ArgumentParser:
                        description="Run the validators, the URDF/SDF/MJCF equivalence check and a MuJoCo "
                                    "smoke test. Exit 0 when clean, 1 when problems are found, 2 for bad input.")
     c.add_argument("path", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
-    c.add_argument("--format", choices=["text", "json"], default="text", help="report format (default: text)")
+    c.add_argument("--format", choices=["text", "json", "junit", "github"], default="text",
+                   help="report format: text for people, json, junit (CI test reporters), github (annotations)")
+    c.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
+                   help="where package://PKG/ meshes of a URDF are (repeatable)")
     c.add_argument("--fail-on", choices=["error", "warning"], default="error",
                    help="lowest severity that makes the exit status 1 (default: error)")
     c.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
@@ -119,8 +122,15 @@ def _world(args) -> int:
 def _check(args) -> int:
     from robotkit.checks import check, render
 
-    findings = check(args.path, args.out)
-    sys.stdout.write(render(findings, args.format))
+    packages = {}
+    for item in args.package_path:
+        pkg, sep, folder = item.partition("=")
+        if not sep or not pkg or not folder:
+            print(f"robotkit: error: --package-path takes PKG=DIR (got '{item}')", file=sys.stderr)
+            return 2
+        packages[pkg] = folder
+    findings = check(args.path, args.out, packages)
+    sys.stdout.write(render(findings, args.format, args.path))
     levels = ("error",) if args.fail_on == "error" else ("error", "warning")
     return 1 if any(f.severity in levels for f in findings) else 0
 

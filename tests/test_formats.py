@@ -120,7 +120,7 @@ def test_equivalence_finds_a_moved_joint_axis(examples, tmp_path):
 
 def test_check_command_on_a_build_folder(examples, tmp_path):
     proc = run_cli("check", examples / "turret_bot")
-    assert (proc.returncode, proc.stdout) == (0, "ok: no problems found\n"), proc.stderr
+    assert (proc.returncode, proc.stdout) == (0, f"{examples / 'turret_bot'}: ok, no problems found\n"), proc.stderr
     robot = _copy(examples, tmp_path)
     sdf = robot / "model.sdf"
     sdf.write_text(sdf.read_text().replace("<xyz>0 0 1</xyz>", "<xyz>0 1 0</xyz>"))

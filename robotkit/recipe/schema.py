@@ -302,6 +302,8 @@ class Recipe(Strict):
     """Default density in kg/m^3 for inertials computed from geometry."""
     open_mesh: Literal["error", "hull"] = "error"
     """Default policy for meshes that are not closed volumes after safe repair."""
+    measured_mass: Positive | None = None
+    """The robot's total mass as weighed, in kg; `robotkit check` compares it with the sum of the links' masses."""
     self_collide: bool = False
     """Whether the robot's links collide with each other (Gazebo's ``self_collide``; MJCF contact filtering). Links joined by a joint never collide."""
     urdf_extras: list[str] = []

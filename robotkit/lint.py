@@ -1,0 +1,457 @@
+"""Physics lints: is the description physically plausible, not just parseable?
+
+Every rule reads a neutral :class:`LinkFacts` view (mass, centre of mass, inertia about it
+in link axes, and the link's geometry measured from its primitives and mesh files), so the
+same rules run on robotkit's own builds and on any URDF a user already has.  Each finding
+names the link or joint and says how to fix it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from robotkit.errors import Problem, RobotkitError
+
+# thresholds (documented in docs/checks.md)
+MIN_MASS = 1e-6  # kg: sdformat drops lighter links (sdformat #199)
+DENSITY_RANGE = (10.0, 25000.0)  # kg/m^3: aerogel-ish foams to osmium
+PART_SIZE_RANGE = (1e-4, 10.0)  # m
+BOX_ERROR, BOX_WARNING = 3.0, 1.5
+FACE_BUDGET = 200_000  # visual faces per link before rendering rates suffer
+COLLISION_VOLUME_RANGE = (0.5, 2.0)  # collision / visual volume
+MASS_TOLERANCE = 0.10  # declared total mass vs computed
+
+
+@dataclass(frozen=True)
+class Finding:
+    severity: str  # error | warning
+    check: str  # rule name, e.g. "implied-density"
+    subject: str  # "link 'base'", "joint 'j1'", a file or the robot
+    message: str
+    hint: str = ""
+    file: str | None = None
+    line: int | None = None
+
+    def __str__(self) -> str:
+        hint = f" (hint: {self.hint})" if self.hint else ""
+        return f"{self.severity}: {self.subject}: {self.message}{hint} [{self.check}]"
+
+
+@dataclass
+class GeomFacts:
+    role: str  # visual | collision
+    kind: str  # mesh | box | cylinder | sphere
+    name: str  # file name or primitive
+    points: np.ndarray  # (n, 3) representative points in the link frame (vertices or box corners)
+    volume: float | None  # closed volume in m^3 (None: open mesh or unknown)
+    extent: float  # largest size of the part in metres
+    faces: int = 0
+    com: np.ndarray | None = None  # centroid of the volume, link frame (closed geometry only)
+    inertia: np.ndarray | None = None  # unit-density inertia about ``com``, link axes
+
+
+@dataclass
+class LinkFacts:
+    name: str
+    mass: float | None = None
+    com: np.ndarray | None = None
+    inertia: np.ndarray | None = None  # about com, link axes
+    geoms: list[GeomFacts] = field(default_factory=list)
+
+    def role(self, role: str) -> list[GeomFacts]:
+        return [g for g in self.geoms if g.role == role]
+
+
+@dataclass
+class JointFacts:
+    name: str
+    type: str
+    lower: float | None = None
+    upper: float | None = None
+    effort: float | None = None
+    velocity: float | None = None
+    mimic: str | None = None
+
+
+# ---------------------------------------------------------------- reading a URDF
+
+
+def _floats(text: str | None, n: int, default: float = 0.0) -> list[float]:
+    if not text:
+        return [default] * n
+    return [float(v) for v in text.split()]
+
+
+def _origin(el) -> np.ndarray:
+    from robotkit.model.robot import rpy_matrix
+
+    T = np.eye(4)
+    o = el.find("origin") if el is not None else None
+    if o is not None:
+        T[:3, :3] = rpy_matrix(_floats(o.get("rpy"), 3))
+        T[:3, 3] = _floats(o.get("xyz"), 3)
+    return T
+
+
+def resolve_uri(uri: str, base: Path, package_paths: dict[str, str]) -> Path | None:
+    if uri.startswith("package://") or uri.startswith("model://"):
+        pkg, _, rest = uri.split("://", 1)[1].partition("/")
+        if pkg in package_paths:
+            return Path(package_paths[pkg]) / rest
+        for parent in [base, *base.parents][:4]:  # the URDF inside its own package (pkg/urdf/x.urdf)
+            if parent.name == pkg:
+                return parent / rest
+        return None
+    if uri.startswith("file://"):
+        return Path(uri[7:])
+    return base / uri
+
+
+def _box_points(size) -> np.ndarray:
+    s = np.asarray(size, dtype=float) / 2
+    return np.array([[x, y, z] for x in (-s[0], s[0]) for y in (-s[1], s[1]) for z in (-s[2], s[2])])
+
+
+def _geom_facts(el, role: str, base: Path, package_paths: dict[str, str], subject: str,
+                problems: list[Finding], cache: dict) -> GeomFacts | None:
+    g = el.find("geometry")
+    if g is None or len(g) == 0:
+        return None
+    shape = g[0]
+    T = _origin(el)
+    kind = shape.tag
+    from robotkit.mesh import inertia as mi
+
+    props = None
+    if kind == "box":
+        size = _floats(shape.get("size"), 3)
+        pts, extent, name, faces, props = _box_points(size), max(size), "box", 12, mi.box_props(size)
+    elif kind == "cylinder":
+        r, h = float(shape.get("radius")), float(shape.get("length"))
+        angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+        ring = np.stack([r * np.cos(angles), r * np.sin(angles)], axis=1)
+        pts = np.vstack([np.column_stack([ring, np.full(16, z)]) for z in (-h / 2, h / 2)])
+        extent, name, faces, props = max(2 * r, h), "cylinder", 0, mi.cylinder_props(r, h)
+    elif kind == "sphere":
+        r = float(shape.get("radius"))
+        pts, extent, name, faces = _box_points([2 * r] * 3) * 0.577, 2 * r, "sphere", 0
+        props = mi.sphere_props(r)
+    elif kind == "mesh":
+        uri = shape.get("filename", "")
+        path = resolve_uri(uri, base, package_paths)
+        name = os.path.basename(uri)
+        if path is None or not path.is_file():
+            problems.append(Finding("warning", "mesh-file", subject,
+                                    f"{role} mesh '{uri}' cannot be found, so its geometry is not checked",
+                                    "give --package-path PKG=DIR"))
+            return None
+        scale = np.asarray(_floats(shape.get("scale"), 3, 1.0))
+        key = (str(path), tuple(scale))
+        if key not in cache:
+            cache[key] = _mesh_facts(path, scale)
+        mesh_pts, props, faces = cache[key]
+        if mesh_pts is None:
+            problems.append(Finding("warning", "mesh-file", subject, f"{role} mesh '{name}' cannot be read"))
+            return None
+        pts = mesh_pts
+        extent = float((pts.max(axis=0) - pts.min(axis=0)).max())
+    else:
+        return None
+    R, t = T[:3, :3], T[:3, 3]
+    pts = pts @ R.T + t
+    if props is None:
+        return GeomFacts(role, kind, name, pts, None, extent, faces)
+    return GeomFacts(role, kind, name, pts, props.volume, extent, faces, R @ props.com + t, R @ props.inertia @ R.T)
+
+
+def _mesh_facts(path: Path, scale: np.ndarray):
+    try:
+        from robotkit.mesh.inertia import mesh_mass_properties
+        from robotkit.mesh.io import load_mesh
+
+        mesh = load_mesh(str(path), tuple(scale))
+    except (RobotkitError, ValueError, OSError):
+        return None, None, 0
+    props = None
+    if mesh.is_volume:
+        props = mesh_mass_properties(mesh.vertices, mesh.faces)
+    pts = np.asarray(mesh.vertices)
+    if len(pts) > 4096:  # the hull's vertices bound the same box and the same "inside"
+        try:
+            pts = np.asarray(mesh.convex_hull.vertices)
+        except Exception:  # degenerate (flat) meshes have no hull
+            pass
+    return pts, props, len(mesh.faces)
+
+
+def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
+                    text: str | None = None) -> tuple[list[LinkFacts], list[JointFacts], list[Finding]]:
+    package_paths = package_paths or {}
+    try:
+        root = ET.fromstring(text if text is not None else path.read_text(encoding="utf-8"))
+    except ET.ParseError as exc:
+        raise RobotkitError(Problem(f"not well-formed XML: {exc}", file=str(path))) from None
+    if root.tag != "robot":
+        raise RobotkitError(Problem(f"not a URDF (the root element is <{root.tag}>, not <robot>)", file=str(path)))
+    problems: list[Finding] = []
+    cache: dict = {}
+    links = []
+    for el in root.findall("link"):
+        name = el.get("name")
+        subject = f"link '{name}'"
+        facts = LinkFacts(name)
+        inertial = el.find("inertial")
+        if inertial is not None:
+            T = _origin(inertial)
+            m = inertial.find("mass")
+            facts.mass = float(m.get("value")) if m is not None else 0.0
+            i = inertial.find("inertia")
+            a = {k: float(i.get(k, 0)) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")} if i is not None else {}
+            I = np.array([[a.get("ixx", 0), a.get("ixy", 0), a.get("ixz", 0)],
+                          [a.get("ixy", 0), a.get("iyy", 0), a.get("iyz", 0)],
+                          [a.get("ixz", 0), a.get("iyz", 0), a.get("izz", 0)]])
+            R = T[:3, :3]
+            facts.com, facts.inertia = T[:3, 3], R @ I @ R.T
+        for role in ("visual", "collision"):
+            for g in el.findall(role):
+                gf = _geom_facts(g, role, path.parent, package_paths, subject, problems, cache)
+                if gf is not None:
+                    facts.geoms.append(gf)
+        links.append(facts)
+    joints = []
+    for el in root.findall("joint"):
+        lim = el.find("limit")
+        mimic = el.find("mimic")
+
+        def num(attr):
+            return float(lim.get(attr)) if lim is not None and lim.get(attr) is not None else None
+
+        joints.append(JointFacts(el.get("name"), el.get("type"), num("lower"), num("upper"), num("effort"),
+                                 num("velocity"), mimic.get("joint") if mimic is not None else None))
+    return links, joints, problems
+
+
+# ---------------------------------------------------------------- the rules
+
+
+def lint(links: list[LinkFacts], joints: list[JointFacts], declared_mass: float | None = None) -> list[Finding]:
+    out: list[Finding] = []
+    for link in links:
+        out += lint_link(link)
+    out += lint_joints(joints)
+    if declared_mass is not None:
+        total = sum(l.mass or 0.0 for l in links)
+        if abs(total - declared_mass) > MASS_TOLERANCE * declared_mass:
+            out.append(Finding("error", "total-mass", "robot",
+                               f"the links weigh {total:.4g} kg in total, the declared mass is {declared_mass:.4g} kg "
+                               f"({(total / declared_mass - 1) * 100:+.0f}%)",
+                               "check densities and which links have inertials; or update measured_mass"))
+    return out
+
+
+def lint_link(link: LinkFacts) -> list[Finding]:
+    out: list[Finding] = []
+    s = f"link '{link.name}'"
+
+    def add(sev, check, msg, hint=""):
+        out.append(Finding(sev, check, s, msg, hint))
+
+    parts = [g for g in link.geoms]
+    for g in parts:
+        if g.extent > PART_SIZE_RANGE[1]:
+            add("error", "part-size", f"{g.role} {g.name} is {g.extent:.4g} m across",
+                "a mesh in millimetres used as metres? set units: mm (URDF: scale=\"0.001 0.001 0.001\")")
+        elif 0 < g.extent < PART_SIZE_RANGE[0]:
+            add("error", "part-size", f"{g.role} {g.name} is {g.extent * 1000:.3g} mm across",
+                "a mesh in metres scaled as millimetres? check its units or scale")
+        if g.role == "visual" and g.faces > FACE_BUDGET:
+            add("warning", "face-budget", f"visual mesh {g.name} has {g.faces} faces (budget {FACE_BUDGET})",
+                "decimate it for rendering")
+    if link.mass is None:
+        return out
+    if not math.isfinite(link.mass) or link.mass <= 0:
+        add("error", "mass", f"mass is {link.mass!r}", "a body needs a positive mass")
+        return out
+    if link.mass < MIN_MASS:
+        add("warning", "tiny-mass", f"mass {link.mass:.3g} kg is below {MIN_MASS:g} kg",
+            "URDF->SDF conversion drops such links with their frames (sdformat #199)")
+    I = link.inertia
+    if I is None or not np.all(np.isfinite(I)):
+        add("error", "inertia", "inertia is not a finite tensor")
+        return out
+    eig = np.linalg.eigvalsh(0.5 * (I + I.T))
+    if eig.min() <= 0:
+        add("error", "inertia", "inertia is not positive definite (principal moments "
+            + ", ".join(f"{e:.4g}" for e in eig) + ")", "compute it from the geometry instead of typing it")
+        return out
+    a, b, c = eig
+    if a + b < c * (1 - 1e-9):
+        add("error", "triangle-inequality", f"principal moments {a:.4g}, {b:.4g}, {c:.4g} violate "
+            "the triangle inequality (I1 + I2 >= I3): no real body has them",
+            "compute the inertia from the geometry instead of typing it")
+        return out
+    volume = _link_volume(link)
+    if volume:
+        density = link.mass / volume
+        if density < DENSITY_RANGE[0]:
+            cause = ("the mass is the mesh volume at density 1, MeshLab's default"
+                     if abs(density - 1.0) < 0.05 else "the density or mass is far too low")
+            add("error", "implied-density", f"implied density {density:.3g} kg/m^3 (mass {link.mass:.4g} kg, "
+                f"volume {volume:.4g} m^3) is below {DENSITY_RANGE[0]:g}", cause)
+        elif density > DENSITY_RANGE[1]:
+            cause = ("the mass looks like grams written as kilograms" if density / 1000 < DENSITY_RANGE[1]
+                     else "the geometry is far too small for the mass (units?)")
+            add("error", "implied-density", f"implied density {density:.4g} kg/m^3 (mass {link.mass:.4g} kg, "
+                f"volume {volume:.4g} m^3) is above {DENSITY_RANGE[1]:g}", cause)
+    geometry = _geometry_props(link)
+    if geometry is not None:
+        out += _box_check_geometry(link, geometry, s)
+        out += _com_check(link, geometry, s)
+    points = _geometry_points(link)
+    if points is not None:
+        if geometry is None:
+            out += _box_check(link, eig, points, s)
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        margin = 1e-3 * max(float((hi - lo).max()), 1e-9)
+        if np.any(link.com < lo - margin) or np.any(link.com > hi + margin):
+            add("warning", "com-outside", f"centre of mass {np.round(link.com, 6).tolist()} lies outside the "
+                f"link's geometry (box {np.round(lo, 6).tolist()} .. {np.round(hi, 6).tolist()})",
+                "an inertial origin in the wrong frame or left out")
+    vis, col = _volume(link.role("visual")), _volume(link.role("collision"))
+    if vis and col and not (COLLISION_VOLUME_RANGE[0] <= col / vis <= COLLISION_VOLUME_RANGE[1]):
+        add("warning", "collision-volume", f"collision geometry has {col / vis:.3g}x the visual volume",
+            "the collision proxy is far from the visual shape")
+    return out
+
+
+def _volume(geoms: list[GeomFacts]) -> float | None:
+    if not geoms or any(g.volume is None for g in geoms):
+        return None
+    return sum(g.volume for g in geoms)
+
+
+def _link_volume(link: LinkFacts) -> float | None:
+    return _volume(link.role("visual")) or _volume(link.role("collision"))
+
+
+def _geometry_points(link: LinkFacts) -> np.ndarray | None:
+    geoms = link.role("visual") or link.role("collision")
+    if not geoms:
+        return None
+    return np.vstack([g.points for g in geoms])
+
+
+def _geometry_props(link: LinkFacts):
+    """(volume, com, unit-density inertia) of the link's closed geometry, or None."""
+    from robotkit.mesh.inertia import combine
+
+    geoms = link.role("visual") or link.role("collision")
+    if not geoms or any(g.inertia is None for g in geoms):
+        return None
+    volume, com, I = combine([(g.volume, g.com, g.inertia) for g in geoms])
+    return volume, com, I
+
+
+def _eq_box(diag, mass: float) -> np.ndarray:
+    """Edge lengths of the uniform box with these moments about its axes."""
+    a, b, c = diag
+    return np.sqrt(np.maximum(0.0, 6.0 / mass * np.array([b + c - a, a + c - b, a + b - c])))
+
+
+def _box_check_geometry(link: LinkFacts, geometry, s: str) -> list[Finding]:
+    """The equivalent inertia box (what Gazebo draws with View > Inertia) of the declared
+    inertia against that of the geometry at uniform density with the same mass, along the
+    geometry's principal axes (so a rotated or swapped tensor shows too)."""
+    volume, _, I_geom = geometry
+    vals, vecs = np.linalg.eigh(I_geom * (link.mass / volume))
+    declared = np.diag(vecs.T @ link.inertia @ vecs)
+    want, got = _eq_box(vals, link.mass), _eq_box(declared, link.mass)
+    worst, axis = 1.0, 0
+    for k in range(3):
+        if want[k] < 1e-9 * max(want.max(), 1e-12):
+            continue
+        ratio = max(got[k], 1e-12) / want[k]
+        ratio = ratio if ratio >= 1 else 1 / ratio
+        if ratio > worst:
+            worst, axis = ratio, k
+    if worst <= BOX_WARNING:
+        return []
+    direction = "larger" if got[axis] > want[axis] else "smaller"
+    return [Finding("error" if worst > BOX_ERROR else "warning", "inertia-box", s,
+                    f"the equivalent inertia box ({' x '.join(f'{d:.3g}' for d in got)} m) is {worst:.3g}x {direction} "
+                    f"than the geometry's at uniform density ({' x '.join(f'{d:.3g}' for d in want)} m)",
+                    "the inertia does not fit the part: hand-typed, rotated, or in the wrong units?")]
+
+
+def _com_check(link: LinkFacts, geometry, s: str) -> list[Finding]:
+    volume, centroid, I_geom = geometry
+    vals, vecs = np.linalg.eigh(I_geom)
+    size = _eq_box(vals * 1.0, volume)  # the geometry's own equivalent box, along its principal axes
+    offset = np.abs(vecs.T @ (link.com - centroid))
+    rel = offset / np.maximum(size, 1e-12)
+    if rel.max() <= 0.1:
+        return []
+    return [Finding("warning", "com-offset", s,
+                    f"centre of mass {np.round(link.com, 6).tolist()} is {float(np.linalg.norm(link.com - centroid)):.4g} m "
+                    f"from the geometry's centroid {np.round(centroid, 6).tolist()}",
+                    "fine for a part with dense components inside; otherwise an origin left out or in the wrong frame")]
+
+
+def _box_check(link: LinkFacts, eig, points: np.ndarray, s: str) -> list[Finding]:
+    """Without a closed geometry: the equivalent inertia box against the geometry's extent
+    along the same principal axes.  A uniform body's box can exceed its extent by up to
+    sqrt(3) (mass at the ends), so only larger boxes beyond that are flagged."""
+    vals, vecs = np.linalg.eigh(0.5 * (link.inertia + link.inertia.T))
+    m = link.mass
+    dims = np.sqrt(np.maximum(0.0, 6.0 / m * np.array([vals[1] + vals[2] - vals[0],
+                                                       vals[0] + vals[2] - vals[1],
+                                                       vals[0] + vals[1] - vals[2]])))
+    local = (points - link.com) @ vecs
+    extent = local.max(axis=0) - local.min(axis=0)
+    worst, axis = 1.0, 0
+    for k in range(3):
+        if extent[k] <= 1e-9 and dims[k] <= 1e-9:
+            continue
+        ratio = max(dims[k], 1e-12) / max(extent[k], 1e-12)
+        if ratio > worst:
+            worst, axis = ratio, k
+    if worst <= math.sqrt(3) * BOX_WARNING:
+        return []
+    severity = "error" if worst > math.sqrt(3) * BOX_ERROR else "warning"
+    direction = "larger"
+    return [Finding(severity, "inertia-box", s,
+                    f"the equivalent inertia box ({' x '.join(f'{d:.3g}' for d in dims)} m) is {worst:.3g}x "
+                    f"{direction} than the geometry ({' x '.join(f'{e:.3g}' for e in extent)} m) along a principal axis",
+                    "the inertia does not fit the part: hand-typed or in the wrong units?")]
+
+
+def lint_joints(joints: list[JointFacts]) -> list[Finding]:
+    out = []
+    by_name = {j.name: j for j in joints}
+    for j in joints:
+        s = f"joint '{j.name}'"
+        if j.type in ("revolute", "prismatic"):
+            if j.lower is not None and j.upper is not None and j.lower >= j.upper:
+                out.append(Finding("error", "joint-limits", s, f"lower limit {j.lower:g} is not below upper {j.upper:g}"))
+            if j.effort is not None and j.effort <= 0:
+                out.append(Finding("error", "joint-limits", s, f"effort limit {j.effort:g} is not positive",
+                                   "a joint with zero effort cannot be driven"))
+            if j.velocity is not None and j.velocity <= 0:
+                out.append(Finding("error", "joint-limits", s, f"velocity limit {j.velocity:g} is not positive"))
+        seen = [j.name]
+        node = j
+        while node.mimic is not None and node.mimic in by_name:
+            if node.mimic in seen:
+                if j.name == min(seen[seen.index(node.mimic):]):
+                    out.append(Finding("error", "mimic-loop", s, "mimic joints form a loop: "
+                                       + " -> ".join(seen[seen.index(node.mimic):] + [node.mimic])))
+                break
+            seen.append(node.mimic)
+            node = by_name[node.mimic]
+    return out
