@@ -1,0 +1,448 @@
+"""Wall cells -> one closed, consistently oriented wall mesh, exact on the cell grid.
+
+The construction works in *grid coordinates* (x = image column, y = image rows - image
+row, in cells; grid point (0, 0) is the map origin) and only at the end maps the vertices
+into the map frame (resolution, origin and yaw), so every step is exact:
+
+1. The side walls are the outline of the wall region: on each grid line, the unit edges
+   between a wall cell and a non-wall cell, merged into straight segments, each extruded
+   into a quad that faces away from the wall.
+2. The top and bottom are the region inside the outline loops, triangulated by
+   manifold3d's polygon triangulator (which keeps every outline edge), with any flat
+   triangle it returns removed by an edge flip.  The result is checked (every cap
+   triangle faces up, the caps add up to the wall area, every edge has exactly two
+   faces); should a check fail, the caps are built from rectangles instead: the wall
+   cells merged into rectangles (:func:`rectangles`), each triangulated through every
+   rectangle corner on its perimeter so that faces meet edge to edge (no T-junctions),
+   with the side walls split at those corners too.
+
+Two wall cells that touch only at a corner (a "pinch", common in scanned maps) would make
+the vertical edge through that corner shared by four faces.  To keep every edge shared by
+exactly two faces, even after the STL is reloaded and its vertices merged, the faces of
+one of the two cells split that edge at half height with an extra vertex.
+
+The mesh has no duplicate or internal faces, every edge has exactly two faces, and its
+volume is exactly the wall area times the height.  :func:`rectangles` also gives the
+MuJoCo collision boxes (MuJoCo collides with the convex hull of a mesh).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def grid_mask(walls_image: np.ndarray) -> np.ndarray:
+    """Image-order mask (row 0 at the top) -> grid-order mask (row 0 at the bottom)."""
+    return np.ascontiguousarray(walls_image[::-1, :], dtype=bool)
+
+
+def _runs_merged(mask: np.ndarray) -> np.ndarray:
+    """Row runs of ``mask`` merged with identical runs in consecutive rows: (n, 4) [x0, y0, x1, y1]."""
+    rows, cols = mask.shape
+    pad = np.zeros((rows, cols + 2), dtype=np.int8)
+    pad[:, 1:-1] = mask
+    d = np.diff(pad, axis=1)
+    ys, xs = np.nonzero(d == 1)
+    _, xe = np.nonzero(d == -1)
+    order = np.lexsort((ys, xe, xs))
+    xs, xe, ys = xs[order], xe[order], ys[order]
+    new = np.ones(len(xs), dtype=bool)
+    new[1:] = (xs[1:] != xs[:-1]) | (xe[1:] != xe[:-1]) | (ys[1:] != ys[:-1] + 1)
+    first = np.flatnonzero(new)
+    last = np.r_[first[1:], len(xs)] - 1
+    return np.stack([xs[first], ys[first], xe[first], ys[last] + 1], axis=1).astype(np.int64)
+
+
+def rectangles(mask: np.ndarray) -> np.ndarray:
+    """Disjoint rectangles covering the True cells of a grid-order ``mask`` exactly.
+
+    Returns an int64 array (n, 4) of [x0, y0, x1, y1] (cells x0 <= x < x1, y0 <= y < y1),
+    sorted by y0 then x0.
+    """
+    by_rows = _runs_merged(mask)
+    by_cols = _runs_merged(mask.T)[:, [1, 0, 3, 2]]
+    rects = by_rows if len(by_rows) <= len(by_cols) else by_cols
+    return rects[np.lexsort((rects[:, 0], rects[:, 1]))]
+
+
+def _segments(types: np.ndarray, breaks: np.ndarray):
+    """Split each line of unit edges into segments between consecutive breaks.
+
+    ``types`` (lines, n): 0 no wall face, +1/-1 a face and its direction; ``breaks``
+    (lines, n + 1): the points where a segment must end.  Returns (line, start, end, type)
+    of every segment with a face.
+    """
+    n = types.shape[1]
+    flat = np.flatnonzero(breaks.ravel())
+    line, pos = np.divmod(flat, n + 1)
+    same = line[1:] == line[:-1]
+    line, start, end = line[:-1][same], pos[:-1][same], pos[1:][same]
+    kind = types[line, start]
+    keep = kind != 0
+    return line[keep], start[keep], end[keep], kind[keep]
+
+
+class _Grid:
+    """The padded wall mask and what the outline needs from it."""
+
+    def __init__(self, mask: np.ndarray):
+        self.mask = mask
+        self.rows, self.cols = mask.shape
+        g = np.zeros((self.rows + 2, self.cols + 2), dtype=np.int8)
+        g[1:-1, 1:-1] = mask
+        self.g = g
+        # the four cells around each grid point (y, x), shape (rows + 1, cols + 1)
+        sw, se, nw, ne = g[:-1, :-1] > 0, g[:-1, 1:] > 0, g[1:, :-1] > 0, g[1:, 1:] > 0
+        self.pinch_ne_sw = sw & ne & ~nw & ~se
+        self.pinch_nw_se = nw & se & ~sw & ~ne
+        self.pinch = self.pinch_ne_sw | self.pinch_nw_se
+        count = sw.astype(np.int8) + se + nw + ne
+        self.turns = (count == 1) | (count == 3) | self.pinch  # where the outline changes direction
+        self.pinch_y, self.pinch_x = np.nonzero(self.pinch)
+        self.pinch_index = np.full(self.pinch.shape, -1, dtype=np.int64)
+        self.pinch_index[self.pinch_y, self.pinch_x] = np.arange(len(self.pinch_x))
+        # unit edges: horizontal line y = j, +1 when the cell below is a wall and the one above is not;
+        # vertical line x = i, +1 when the cell on the left is a wall and the one on the right is not
+        self.th = g[:-1, 1:-1] - g[1:, 1:-1]
+        self.tv = (g[1:-1, :-1] - g[1:-1, 1:]).T
+
+    def outline(self, breaks: np.ndarray):
+        """Directed outline segments A -> B (the wall on the left), split at ``breaks`` (grid points).
+
+        Returns ax, ay, bx, by, am, bm: am / bm is the pinch index when the wall face of this
+        segment must split its vertical edge at A / B (see the module docstring), else -1.
+        """
+        j, xa, xb, kind = _segments(self.th, breaks)
+        west = kind > 0
+        low = self.pinch_index[j, xa]  # a pinch at the segment's west end belongs to this segment's cell
+        h = (np.where(west, xb, xa), j, np.where(west, xa, xb), j,
+             np.where(west, -1, low), np.where(west, low, -1))
+        i, ya, yb, kind = _segments(self.tv, breaks.T)
+        north = kind > 0
+        low = np.where(self.pinch_ne_sw[ya, i], self.pinch_index[ya, i], -1)
+        high = np.where(self.pinch_nw_se[yb, i], self.pinch_index[yb, i], -1)
+        v = (i, np.where(north, ya, yb), i, np.where(north, yb, ya),
+             np.where(north, low, high), np.where(north, high, low))
+        return tuple(np.concatenate(p) for p in zip(h, v))
+
+
+def _side_faces(a0, b0, ah, bh, am, bm) -> np.ndarray:
+    """Each segment's wall quad [A0, B0, Bh, Ah] (A0 bottom, Ah top) as triangles facing out."""
+    has_a, has_b = am >= 0, bm >= 0
+    plain, only_a, only_b, both = ~has_a & ~has_b, has_a & ~has_b, ~has_a & has_b, has_a & has_b
+    tri = lambda *cols: np.stack(cols, axis=1)  # noqa: E731
+    return np.concatenate([
+        tri(a0, b0, bh)[plain], tri(a0, bh, ah)[plain],
+        tri(b0, bh, ah)[only_a], tri(b0, ah, am)[only_a], tri(b0, am, a0)[only_a],
+        tri(a0, b0, bm)[only_b], tri(a0, bm, bh)[only_b], tri(a0, bh, ah)[only_b],
+        tri(a0, b0, bm)[both], tri(a0, bm, am)[both], tri(am, bm, bh)[both], tri(am, bh, ah)[both],
+    ])
+
+
+def _outline_caps(grid: _Grid, seg):
+    """Triangulate the region inside the outline loops (manifold3d's triangulator).
+
+    Returns (x, y, triangles) with the triangles indexing the points (x, y), or None when
+    the triangulator cannot be used (the caller then falls back to rectangles).
+    """
+    try:
+        import manifold3d
+    except ImportError:  # pragma: no cover - a dependency, but the fallback needs nothing
+        return None
+    ax, ay, bx, by = seg[:4]
+    n = len(ax)
+    width = grid.cols + 1
+    dx, dy = np.sign(bx - ax), np.sign(by - ay)
+    code = np.where(dx > 0, 0, np.where(dy > 0, 1, np.where(dx < 0, 2, 3)))  # E N W S
+    key = (ay * width + ax) * 4 + code
+    order = np.argsort(key)
+    sorted_key = key[order]
+
+    def find(k):
+        pos = np.clip(np.searchsorted(sorted_key, k), 0, n - 1)
+        return np.where(sorted_key[pos] == k, order[pos], -1)
+
+    end = (by * width + bx) * 4
+    left, right = find(end + (code + 1) % 4), find(end + (code + 3) % 4)
+    # at a pinch both turns exist: turning left keeps the two diagonal cells apart
+    succ = np.where(left >= 0, left, right)
+    if (succ < 0).any():
+        return None
+    # follow the successor permutation into loops
+    succ_list = succ.tolist()
+    seen = bytearray(n)
+    loops = []
+    for s in range(n):
+        if seen[s]:
+            continue
+        loop = []
+        while not seen[s]:
+            seen[s] = 1
+            loop.append(s)
+            s = succ_list[s]
+        loops.append(loop)
+    idx = np.fromiter((s for loop in loops for s in loop), dtype=np.int64, count=n)
+    polygons = []
+    for loop in loops:
+        pts = np.empty((len(loop), 2), dtype=np.float64)
+        pts[:, 0], pts[:, 1] = ax[loop], ay[loop]
+        polygons.append(pts)
+    try:
+        tris = np.asarray(manifold3d.triangulate(polygons), dtype=np.int64).reshape(-1, 3)
+    except Exception:  # noqa: BLE001 - any failure of the optional fast path falls back
+        return None
+    px, py = ax[idx], ay[idx]
+    tris = _flip_flat(px, py, tris)
+    return None if tris is None else (px, py, tris)
+
+
+def _cross(px, py, tris) -> np.ndarray:
+    """Twice the signed area of each triangle (exact: the points are on the integer grid)."""
+    x, y = px[tris], py[tris]
+    return (x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (y[:, 1] - y[:, 0]) * (x[:, 2] - x[:, 0])
+
+
+def _flip_flat(px, py, tris):
+    """Remove zero-area triangles by edge flips; None if a triangle is inverted or a flip fails.
+
+    The ear clipper may return a flat triangle (a, b, c) with c on the segment ab, when a
+    hole corner lies on the line of an outline edge.  Its neighbour across ab is (b, a, d);
+    both are replaced by (c, a, d) and (c, d, b), which cover the same area, keep every
+    other edge, and are not flat unless d is on the same line (then they are flipped in turn).
+    """
+    cross = _cross(px, py, tris)
+    if (cross < 0).any():
+        return None
+    flat = np.flatnonzero(cross == 0)
+    if len(flat) == 0:
+        return tris
+    tris = tris.copy()
+    owner = {}
+    for t, (a, b, c) in enumerate(tris.tolist()):
+        owner[a, b] = owner[b, c] = owner[c, a] = t
+    xs, ys = px.tolist(), py.tolist()
+
+    def is_flat(tri):
+        a, b, c = tri
+        return (xs[b] - xs[a]) * (ys[c] - ys[a]) - (ys[b] - ys[a]) * (xs[c] - xs[a]) == 0
+
+    def between(p, a, b):
+        return min(xs[a], xs[b]) <= xs[p] <= max(xs[a], xs[b]) and min(ys[a], ys[b]) <= ys[p] <= max(ys[a], ys[b])
+
+    queue = flat.tolist()
+    budget = 20 * len(queue) + 100
+    while queue:
+        budget -= 1
+        if budget < 0:
+            return None
+        t = queue.pop()
+        tri = tris[t].tolist()
+        if not is_flat(tri):
+            continue
+        for r in range(3):  # rotate so that c, the middle point, comes last
+            a, b, c = tri[r:] + tri[:r]
+            if between(c, a, b):
+                break
+        else:
+            return None
+        u = owner.get((b, a))
+        if u is None:
+            return None
+        d = [v for v in tris[u].tolist() if v not in (a, b)][0]
+        for e in ((a, b), (b, c), (c, a), (b, a), (a, d), (d, b)):
+            owner.pop(e, None)
+        tris[t], tris[u] = (c, a, d), (c, d, b)
+        owner[c, a] = owner[a, d] = owner[d, c] = t
+        owner[c, d] = owner[d, b] = owner[b, c] = u
+        queue.extend(x for x in (t, u) if is_flat(tris[x].tolist()))
+    return tris if (_cross(px, py, tris) > 0).all() else None
+
+
+def _rectangle_caps(grid: _Grid, rects: np.ndarray):
+    """Triangulate each rectangle through every rectangle corner on its perimeter.
+
+    Returns (corner mask, px, py, triangles, centres): triangles index the points
+    (px, py) and, as ``-1 - k``, the centre points ``centres[k]``.
+    """
+    rows, cols = grid.rows, grid.cols
+    n_rect = len(rects)
+    x0, y0, x1, y1 = rects.T
+    w, h = x1 - x0, y1 - y0
+    label = np.full((rows + 2, cols + 2), -1, dtype=np.int64)
+    area = w * h
+    rid = np.repeat(np.arange(n_rect), area)
+    k = np.arange(int(area.sum())) - np.repeat(np.cumsum(area) - area, area)
+    label[y0[rid] + k // w[rid] + 1, x0[rid] + k % w[rid] + 1] = rid
+
+    corner = np.zeros((rows + 1, cols + 1), dtype=bool)
+    corner[y0, x0] = corner[y0, x1] = corner[y1, x0] = corner[y1, x1] = True
+    vy, vx = np.nonzero(corner)
+
+    around = np.stack([label[vy, vx], label[vy, vx + 1], label[vy + 1, vx], label[vy + 1, vx + 1]], axis=1)
+    for j in range(1, 4):
+        dup = (around[:, j:j + 1] == around[:, :j]).any(axis=1)
+        around[dup, j] = -1
+    point, slot = np.nonzero(around >= 0)
+    prect = around[point, slot]
+    px, py = vx[point], vy[point]
+    X0, Y0, X1, Y1, W, H = x0[prect], y0[prect], x1[prect], y1[prect], w[prect], h[prect]
+    on_bottom, on_right, on_top = py == Y0, px == X1, py == Y1
+    t = np.where(on_bottom, px - X0,
+                 np.where(on_right, W + py - Y0, np.where(on_top, W + H + X1 - px, 2 * W + H + Y1 - py)))
+    order = np.lexsort((t, prect))
+    point, prect = point[order], prect[order]
+    edge = np.where(on_bottom, 0, np.where(on_right, 1, np.where(on_top, 2, 3)))[order]
+    is_corner = (((px == X0) | (px == X1)) & ((py == Y0) | (py == Y1)))[order]
+    count = np.bincount(prect, minlength=n_rect)
+    offset = np.cumsum(count) - count
+    extra = np.bincount(prect[~is_corner] * 4 + edge[~is_corner], minlength=4 * n_rect).reshape(n_rect, 4)
+    eb, er, et, el = extra.T
+    # fan from a corner whose two edges carry no extra vertex (start = its place in the order)
+    start = np.full(n_rect, -1, dtype=np.int64)
+    for ok, pos in (((et == 0) & (el == 0), 3 + eb + er + et), ((er == 0) & (et == 0), 2 + eb + er),
+                    ((eb == 0) & (er == 0), 1 + eb), ((eb == 0) & (el == 0), 0 * eb)):
+        start = np.where(ok, pos, start)
+
+    fan = np.flatnonzero(start >= 0)
+    m = count[fan] - 2
+    r = np.repeat(fan, m)
+    kk = np.arange(int(m.sum())) - np.repeat(np.cumsum(m) - m, m) + 1
+    s, n, o = start[r], count[r], offset[r]
+    corner_tris = np.stack([point[o + s], point[o + (s + kk) % n], point[o + (s + kk + 1) % n]], axis=1)
+
+    centred = np.flatnonzero(start < 0)
+    m = count[centred]
+    r = np.repeat(centred, m)
+    kk = np.arange(int(m.sum())) - np.repeat(np.cumsum(m) - m, m)
+    n, o = count[r], offset[r]
+    centre_of = np.full(n_rect, -1, dtype=np.int64)
+    centre_of[centred] = np.arange(len(centred))
+    centre_tris = np.stack([-1 - centre_of[r], point[o + kk], point[o + (kk + 1) % n]], axis=1)
+    centres = np.stack([(x0[centred] + x1[centred]) / 2.0, (y0[centred] + y1[centred]) / 2.0], axis=1)
+    return corner, vx, vy, np.concatenate([corner_tris, centre_tris]), centres
+
+
+def _closed(faces: np.ndarray, n_vertices: int) -> bool:
+    """Every directed edge once, and its reverse once: closed and consistently oriented."""
+    e = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+    key = e[:, 0] * n_vertices + e[:, 1]
+    rev = e[:, 1] * n_vertices + e[:, 0]
+    key_sorted = np.sort(key)
+    if (key_sorted[1:] == key_sorted[:-1]).any():
+        return False
+    pos = np.clip(np.searchsorted(key_sorted, rev), 0, len(key_sorted) - 1)
+    return bool((key_sorted[pos] == rev).all())
+
+
+def extrude(mask: np.ndarray, height: float, method: str = "outline"):
+    """Closed wall mesh of a grid-order ``mask``, in grid coordinates (z in metres).
+
+    ``method`` "outline" triangulates the top and bottom inside the outline (fewest
+    faces), falling back to "rectangles" if that fails its checks; "rectangles" builds
+    them from :func:`rectangles`.  Returns (vertices (n, 3) float64, faces (m, 3) int64);
+    x and y are in cells.
+    """
+    if method not in ("outline", "rectangles"):
+        raise ValueError(f"unknown method {method!r} (outline or rectangles)")
+    mask = np.asarray(mask, dtype=bool)
+    grid = _Grid(mask)
+    z = float(height)
+    width = grid.cols + 1
+    area = int(mask.sum())
+
+    for attempt in dict.fromkeys((method, "rectangles")):
+        if attempt == "outline":
+            seg = grid.outline(grid.turns)
+            caps = _outline_caps(grid, seg)
+            if caps is None:
+                continue
+            cx, cy, cap = caps
+            centres = np.zeros((0, 2))
+        else:
+            corner, cx, cy, cap, centres = _rectangle_caps(grid, rectangles(mask))
+            seg = grid.outline(corner | grid.turns)
+        ax, ay, bx, by, am, bm = seg
+        # vertices: grid points used (bottom, then top), centres (bottom, top), pinch splits
+        keys, inverse = np.unique(np.concatenate([cy * width + cx, ay * width + ax, by * width + bx]),
+                                  return_inverse=True)
+        n_v, n_c, n_p = len(keys), len(centres), len(grid.pinch_x)
+        cap_pt = inverse[:len(cx)]
+        a0 = inverse[len(cx):len(cx) + len(ax)]
+        b0 = inverse[len(cx) + len(ax):]
+        top = np.where(cap >= 0, cap_pt[np.maximum(cap, 0)] + n_v, 2 * n_v + n_c + (-1 - cap))
+        bottom = np.where(cap >= 0, cap_pt[np.maximum(cap, 0)], 2 * n_v + (-1 - cap))[:, ::-1]
+        pm = lambda p: np.where(p >= 0, 2 * n_v + 2 * n_c + p, -1)  # noqa: E731
+        side = _side_faces(a0, b0, a0 + n_v, b0 + n_v, pm(am), pm(bm))
+        faces = np.concatenate([top, bottom, side]).astype(np.int64)
+
+        gy, gx = np.divmod(keys, width)
+        vertices = np.concatenate([
+            np.stack([gx, gy, np.zeros(n_v)], 1),
+            np.stack([gx, gy, np.full(n_v, z)], 1),
+            np.column_stack([centres, np.zeros(n_c)]),
+            np.column_stack([centres, np.full(n_c, z)]),
+            np.stack([grid.pinch_x, grid.pinch_y, np.full(n_p, z / 2.0)], 1),
+        ]).astype(np.float64)
+        # the checks that make the result trustworthy: caps all face up and add up to the wall
+        # area (so they cover it once), and every edge is shared by exactly two faces
+        p = vertices[top]
+        cross = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - \
+                (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+        if (cross > 0).all() and cross.sum() == 2 * area and _closed(faces, len(vertices)):
+            return vertices, faces
+    raise AssertionError("wall mesh failed its closedness checks")  # a bug: the rectangle path is exact
+
+
+def wall_cells(occupancy_map, unknown_as_wall: bool = False) -> np.ndarray:
+    """Grid-order mask of the cells that become walls; MapError when there is none."""
+    from robotkit.errors import MapError
+
+    walls = occupancy_map.walls(unknown_as_wall)
+    if not walls.any():
+        om = occupancy_map
+        size = f"{om.cols} x {om.rows} px"
+        if unknown_as_wall:
+            detail = f"no occupied or unknown cell in '{om.image_name}' ({size}, all free)"
+        else:
+            detail = (f"no occupied cell in '{om.image_name}' ({size}: {int(om.free.sum())} free, "
+                      f"{int(om.unknown.sum())} unknown)")
+        raise MapError(om.problem(f"{detail}, so there is no wall to build"))
+    return grid_mask(walls)
+
+
+def check_height(height) -> float:
+    from robotkit.errors import MapError, Problem
+
+    try:
+        value = float(height)
+    except (TypeError, ValueError):
+        value = float("nan")
+    if isinstance(height, bool) or not (np.isfinite(value) and value > 0):
+        raise MapError(Problem(f"must be > 0 (metres), not {height}", key="height"))
+    return value
+
+
+def wall_mesh(occupancy_map, height: float = 2.0, *, unknown_as_wall: bool = False, method: str = "outline"):
+    """The walls of ``occupancy_map`` as one closed trimesh.Trimesh in the map frame (m).
+
+    z runs from 0 to ``height``; the map's yaw is applied, so the mesh is posed at the identity.
+    """
+    z = check_height(height)
+    mask = wall_cells(occupancy_map, unknown_as_wall)
+    return mask_mesh(mask, z, occupancy_map.grid_to_map(), method=method)
+
+
+def mask_mesh(mask: np.ndarray, height: float, grid_to_map: np.ndarray, method: str = "outline"):
+    """:func:`extrude` a grid-order mask and place it in the map frame: a trimesh.Trimesh."""
+    import trimesh
+
+    vertices, faces = extrude(mask, height, method=method)
+    vertices[:, :2] = to_map(vertices[:, :2], grid_to_map)
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+
+
+def to_map(points_xy: np.ndarray, grid_to_map: np.ndarray) -> np.ndarray:
+    """Grid coordinates (cells) -> map frame (m) with the 3x3 affine ``grid_to_map``."""
+    m = grid_to_map
+    x, y = points_xy[..., 0], points_xy[..., 1]
+    return np.stack([m[0, 0] * x + m[0, 1] * y + m[0, 2], m[1, 0] * x + m[1, 1] * y + m[1, 2]], axis=-1)
