@@ -148,3 +148,11 @@ def _same_file(a: str, b: str) -> bool:
     import filecmp
 
     return filecmp.cmp(a, b, shallow=False)
+
+
+@_user_errors_fail
+def world(map_yaml: str, out_dir: str, name: str, height: float, unknown_as_wall: bool):
+    """One world from an occupancy map (robotkit.world)."""
+    from robotkit.world import build_world
+
+    build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall)

@@ -132,7 +132,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     recentered = sorted({g.shape.mesh.key for link in robot.links for g in link.visuals + link.collisions
                          if g.shape.mesh is not None and g.recenter != "none"})
     out_facts = {k: facts[k] for k in recentered}
-    structure = robot.to_dict()
+    structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
     options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}}
     for emitter, rel in OUTPUTS.items():
         target = str(root / rel(robot))
@@ -156,7 +156,53 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "task_dep": [f"{robot.name}:mesh:{k}" for k in facts],
             "clean": True,
         })
+    return tasks + world_tasks(robot, out_dir)
+
+
+def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
+    """One task per world of the recipe: OUT/<world>/ with its five files."""
+    out_dir = Path(out_dir).absolute()
+    tasks = []
+    for w in robot.worlds:
+        root = out_dir / w.name
+        targets = [root / "model.config", root / "model.sdf", root / "meshes" / f"{w.name}.stl",
+                   root / f"{w.name}.world", root / "scene.xml"]
+        tasks.append({
+            "name": f"world:{w.name}",
+            "doc": f"world {w.name} from {os.path.basename(w.map)}",
+            "actions": [(actions.world, [w.map, str(out_dir), w.name, w.height, w.unknown_as_wall])],
+            "file_dep": [w.map] + _map_image(w.map),
+            "targets": [str(t) for t in targets],
+            "uptodate": [config_changed({"height": w.height, "unknown_as_wall": w.unknown_as_wall,
+                                         "templates": _world_templates()})],
+            "clean": True,
+        })
     return tasks
+
+
+def _map_image(map_yaml: str) -> list[str]:
+    """The image a map YAML names (cheap: the YAML only), when it exists; the task reports the rest."""
+    import yaml
+
+    try:
+        with open(map_yaml, encoding="utf-8") as f:
+            image = (yaml.safe_load(f) or {}).get("image")
+    except (OSError, yaml.YAMLError, AttributeError):
+        return []
+    path = Path(map_yaml).parent / str(image)
+    return [str(path)] if image and path.is_file() else []
+
+
+def _world_templates() -> list[str]:
+    out = []
+    for d in template_dirs():
+        for p in sorted((Path(d) / "world").glob("*.j2")):
+            out.append(p.read_text(encoding="utf-8"))
+        if out:
+            break
+    import hashlib
+
+    return [hashlib.sha1("".join(out).encode()).hexdigest()]
 
 
 def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
@@ -183,7 +229,7 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
 
 def load_robots(recipe_files) -> list[tuple[object, Robot]]:
     """Load and resolve every recipe; all problems of all recipes together."""
-    from robotkit.errors import Problem, RobotkitError
+    from robotkit.errors import Problem, RobotkitError, display_path
     from robotkit.model.resolve import resolve
     from robotkit.recipe.load import load_recipe
 
@@ -197,12 +243,15 @@ def load_robots(recipe_files) -> list[tuple[object, Robot]]:
         except RobotkitError as exc:
             problems.extend(exc.problems)
             continue
-        if robot.name in names:
-            problems.append(Problem(f"robot '{robot.name}' is also built by {names[robot.name]}",
-                                    file=str(loaded.file), line=loaded.marks.where.get(("robot",), (None, None))[1],
-                                    key="robot"))
+        outputs = [("robot",), *[("worlds", w.name) for w in robot.worlds]]
+        taken = [key for key in outputs if key[-1] in names or (key[0] == "worlds" and key[-1] == robot.name)]
+        if taken:
+            key = taken[0]
+            other = names.get(key[-1], display_path(str(f)))
+            problems.append(loaded.marks.problem(key, f"output folder '{key[-1]}' is also written by {other}"))
             continue
-        names[robot.name] = str(f)
+        names[robot.name] = display_path(str(f))
+        names.update({w.name: display_path(str(f)) for w in robot.worlds})
         robots.append((loaded, robot))
     if problems:
         raise RobotkitError(problems)

@@ -4,6 +4,7 @@ includes, the open-mesh policy, and the second example."""
 from __future__ import annotations
 
 import math
+import shutil
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -277,3 +278,38 @@ def test_urdf_extras_must_be_well_formed(tmp_path):
         build([recipe], tmp_path / "out")
     assert err.value.lines() == [f"{recipe}:3: urdf_extras: urdf_extras[0] is not well-formed XML: "
                                  "mismatched tag: line 1, column 18"]
+
+
+def test_recipe_worlds_are_doit_tasks(tmp_path, assets):
+    shutil.copytree(assets / "maps" / "turtlebot3_world", tmp_path / "maps" / "tb3")
+    recipe = write_recipe(tmp_path, """
+        robot: bot
+        links: {base: {visual: {box: {size: [0.2, 0.2, 0.1]}}}}
+        worlds:
+          tb3_world: {map: maps/tb3/map.yaml, height: 0.5}
+        """)
+    out = tmp_path / "out"
+    first = build([recipe], out)
+    assert "world:tb3_world" in first.ran
+    for rel in ("model.config", "model.sdf", "meshes/tb3_world.stl", "tb3_world.world", "scene.xml"):
+        assert (out / "tb3_world" / rel).is_file(), rel
+    assert build([recipe], out).ran == []
+    recipe.write_text(recipe.read_text().replace("height: 0.5", "height: 0.6"))
+    assert build([recipe], out).ran == ["world:tb3_world"]
+    mesh = trimesh.load(out / "tb3_world" / "meshes" / "tb3_world.stl")
+    assert mesh.bounds[1][2] == pytest.approx(0.6)
+
+
+def test_recipe_world_with_a_missing_map(tmp_path):
+    from robotkit.errors import RobotkitError
+
+    recipe = write_recipe(tmp_path, """
+        robot: bot
+        links: {base: {}}
+        worlds:
+          w: {map: nowhere.yaml}
+        """)
+    with pytest.raises(RobotkitError) as err:
+        build([recipe], tmp_path / "out")
+    assert [str(p).split(": ", 1)[1] for p in err.value.problems] == [
+        "worlds.w.map: map file '" + str(tmp_path / "nowhere.yaml") + "' does not exist"]

@@ -21,7 +21,7 @@ import numpy as np
 from robotkit.errors import Problem, RecipeError
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
-    Metadata, Mimic, Pose, Robot, Shape, rpy_matrix,
+    Metadata, Mimic, Pose, Robot, Shape, World, rpy_matrix,
 )
 from robotkit.recipe.load import LoadedRecipe
 from robotkit.recipe.schema import UNITS
@@ -167,6 +167,11 @@ def resolve(loaded: LoadedRecipe) -> Robot:
         joints.append(Joint(name, j.type, j.parent, j.child, Pose(_t(j.origin.xyz), _t(j.origin.rpy)),
                             axis, limit, dyn, mimic))
 
+    worlds = []
+    for name, w in r.worlds.items():
+        if not os.path.isfile(w.map):
+            problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' does not exist"))
+        worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall))
     if loaded.partial != "tree":  # joints dropped as invalid would show as false tree problems
         problems.extend(_check_tree(link_names, joints, marks))
     if problems:
@@ -174,7 +179,8 @@ def resolve(loaded: LoadedRecipe) -> Robot:
 
     md = r.metadata
     metadata = Metadata(md.version, md.description, tuple(Author(a.name, a.email) for a in md.authors), md.license)
-    return Robot(r.robot, tuple(links), tuple(joints), materials, metadata, r.self_collide, tuple(r.urdf_extras))
+    return Robot(r.robot, tuple(links), tuple(joints), materials, metadata, r.self_collide, tuple(r.urdf_extras),
+                 tuple(worlds))
 
 
 def _indexed(value):

@@ -211,6 +211,14 @@ class Metadata:
 
 
 @dataclass(frozen=True)
+class World:
+    name: str
+    map: str  # absolute path of the map_server YAML
+    height: float = 2.0
+    unknown_as_wall: bool = False
+
+
+@dataclass(frozen=True)
 class Robot:
     name: str
     links: tuple[Link, ...]
@@ -219,6 +227,7 @@ class Robot:
     metadata: Metadata = field(default_factory=Metadata)
     self_collide: bool = False
     urdf_extras: tuple[str, ...] = ()
+    worlds: tuple[World, ...] = ()
 
     def link(self, name: str) -> Link:
         for link in self.links:

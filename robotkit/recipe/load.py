@@ -218,7 +218,14 @@ def _apply_defaults(data: dict, marks: Marks):
 
 
 def _absolute_meshes(data: dict, marks: Marks):
-    """Turn every mesh path into an absolute one, relative to the file that wrote it."""
+    """Turn every mesh and map path into an absolute one, relative to the file that wrote it."""
+    worlds = data.get("worlds")
+    if isinstance(worlds, dict):
+        for name, w in worlds.items():
+            if isinstance(w, dict) and isinstance(w.get("map"), str):
+                file, _ = marks.locate(("worlds", name, "map"))
+                base = Path(file).parent if file else Path.cwd()
+                w["map"] = os.path.normpath(str((base / w["map"]).absolute()))
     links = data.get("links")
     if not isinstance(links, dict):
         return

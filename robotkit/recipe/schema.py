@@ -289,6 +289,17 @@ class Defaults(Strict):
     """Keys merged under every joint (same keys as a joint)."""
 
 
+class World(Strict):
+    """A world built from a ROS map_server occupancy map, written to ``OUT/<name>/``."""
+
+    map: str
+    """The map_server YAML file (relative to the recipe file that names it)."""
+    height: Positive = 2.0
+    """Wall height in metres."""
+    unknown_as_wall: bool = False
+    """Treat unknown cells as walls (default: free space)."""
+
+
 class Recipe(Strict):
     """A robot recipe: the one source of truth for a robot description."""
 
@@ -313,6 +324,8 @@ class Recipe(Strict):
     defaults: Defaults = Defaults()
     links: dict[str, Link]
     joints: dict[str, Joint] = {}
+    worlds: dict[str, World] = {}
+    """Worlds made from occupancy maps, by name (``robotkit world`` does the same from the command line)."""
 
     @field_validator("robot")
     @classmethod
@@ -331,7 +344,7 @@ class Recipe(Strict):
                 raise ValueError(f"urdf_extras[{i}] is not well-formed XML: {exc}") from None
         return v
 
-    @field_validator("materials", "links", "joints")
+    @field_validator("materials", "links", "joints", "worlds")
     @classmethod
     def _names(cls, v):
         for name in v:

@@ -1,0 +1,284 @@
+"""Mesh repair that reports what it changed.
+
+:func:`repair` works on a copy (the input is never modified) and only makes
+changes that keep the shape: it drops faces on non-finite vertices, merges
+coincident vertices, removes duplicate and degenerate faces, makes the
+winding consistent, fills *small* holes, and turns every closed body outward.
+The result keeps geometry only (visual data such as UVs and colours is not
+carried over: repaired meshes feed mass properties and collision geometry,
+visual meshes are copied verbatim).
+
+Library parts and hand-written parts:
+
+- merging, duplicate and degenerate faces, winding: trimesh
+  (``merge_vertices``, ``unique_faces``, ``nondegenerate_faces``,
+  ``trimesh.repair.fix_winding``);
+- hole filling is hand-written: ``trimesh.repair.fill_holes`` fills every
+  boundary cycle it finds (triangles and quads only unless ``use_fan``, and
+  fans from a vertex, wrong for non-convex holes).  Here boundary loops are
+  traced with their orientation, loops through a vertex shared by several
+  loops are left alone, and only loops of at most ``max_hole_edges`` edges are
+  closed: a triangle, a quad split along its shorter diagonal, larger loops by
+  a fan from a new vertex at the loop centroid;
+- orientation is hand-written: ``trimesh.repair.fix_inversion(multibody=True)``
+  makes every closed body's volume positive, which turns the inner shell of a
+  hollow part (a cavity, correctly inward) outward and adds the cavity's volume
+  instead of subtracting it.  Here a closed body lying entirely inside another
+  closed body (winding-number test) keeps the orientation most of its faces had
+  in the input, and every other closed body is made outward.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+DEFAULT_MAX_HOLE_EDGES = 16
+
+
+def repair(mesh, fill_holes: bool = True, *,
+           max_hole_edges: int = DEFAULT_MAX_HOLE_EDGES) -> tuple[trimesh.Trimesh, dict]:
+    """Return ``(repaired copy, report)``.
+
+    Report keys (counts are ints): ``vertices_in``, ``faces_in``,
+    ``nonfinite_faces_removed``, ``vertices_merged``, ``duplicate_faces_removed``,
+    ``degenerate_faces_removed``, ``unreferenced_vertices_removed``,
+    ``faces_flipped`` (input faces whose orientation changed),
+    ``bodies_inverted`` (closed bodies turned inside out as a whole),
+    ``nested_bodies`` (closed bodies inside another: cavities or embedded parts),
+    ``holes_found``, ``holes_filled``, ``faces_added``, ``vertices_added``,
+    ``holes_left`` (open loops too large or ambiguous to fill),
+    ``open_edges``, ``nonmanifold_edges``, ``vertices_out``, ``faces_out``,
+    ``watertight``, ``winding_consistent``, ``is_volume`` (closed, consistently
+    wound, positive volume: the mass properties can be trusted),
+    ``volume`` (m^3, signed, None unless watertight) and ``changed`` (bool).
+    """
+    V = np.array(mesh.vertices, dtype=np.float64).reshape(-1, 3)
+    F = np.array(mesh.faces, dtype=np.int64).reshape(-1, 3)
+    report: dict = {"vertices_in": int(len(V)), "faces_in": int(len(F))}
+
+    finite = np.isfinite(V).all(axis=1)
+    keep = finite[F].all(axis=1) if len(F) else np.zeros(0, bool)
+    report["nonfinite_faces_removed"] = int((~keep).sum())
+    F = F[keep]
+    V = np.where(finite[:, None], V, 0.0)
+
+    m = trimesh.Trimesh(V, F, process=False, validate=False)
+    n = len(m.vertices)
+    m.merge_vertices(merge_tex=True, merge_norm=True)
+    report["vertices_merged"] = n - len(m.vertices)
+
+    n = len(m.faces)
+    m.update_faces(m.unique_faces())
+    report["duplicate_faces_removed"] = n - len(m.faces)
+    n = len(m.faces)
+    m.update_faces(m.nondegenerate_faces())
+    report["degenerate_faces_removed"] = n - len(m.faces)
+    n = len(m.vertices)
+    m.remove_unreferenced_vertices()
+    report["unreferenced_vertices_removed"] = n - len(m.vertices)
+
+    before = np.array(m.faces)  # orientation reference for faces_flipped
+    if len(m.faces) and not m.is_winding_consistent:
+        trimesh.repair.fix_winding(m)
+
+    holes = _fill_holes(m, max_hole_edges if fill_holes else 0)
+    report.update(holes)
+
+    inverted, nested = _orient_bodies(m, before)
+    report["bodies_inverted"] = inverted
+    report["nested_bodies"] = nested
+    report["faces_flipped"] = int(_flipped(before, np.asarray(m.faces)[:len(before)]).sum())
+
+    open_edges, nonmanifold = _edge_counts(m)
+    report.update(open_edges=open_edges, nonmanifold_edges=nonmanifold,
+                  vertices_out=int(len(m.vertices)), faces_out=int(len(m.faces)),
+                  watertight=bool(m.is_watertight), winding_consistent=bool(m.is_winding_consistent),
+                  is_volume=bool(len(m.faces) > 0 and m.is_volume))
+    report["volume"] = float(m.volume) if report["watertight"] else None
+    report["changed"] = any(report[k] for k in (
+        "nonfinite_faces_removed", "vertices_merged", "duplicate_faces_removed", "degenerate_faces_removed",
+        "unreferenced_vertices_removed", "faces_flipped", "faces_added"))
+    return m, report
+
+
+def _flipped(before: np.ndarray, after: np.ndarray) -> np.ndarray:
+    """Per face: True if ``after`` is not a cyclic rotation of ``before`` (orientation reversed)."""
+    same = np.zeros(len(before), dtype=bool)
+    for k in range(3):
+        same |= (np.roll(before, k, axis=1) == after).all(axis=1)
+    return ~same
+
+
+def _edge_counts(m) -> tuple[int, int]:
+    if len(m.faces) == 0:
+        return 0, 0
+    counts = np.unique(trimesh.grouping.hashable_rows(m.edges_sorted), return_counts=True)[1]
+    return int((counts == 1).sum()), int((counts > 2).sum())
+
+
+def _fill_holes(m, max_edges: int) -> dict:
+    """Close boundary loops of at most ``max_edges`` edges, in place; return counts."""
+    out = {"holes_found": 0, "holes_filled": 0, "faces_added": 0, "vertices_added": 0, "holes_left": 0}
+    if len(m.faces) == 0:
+        return out
+    edges = np.asarray(m.edges)  # directed, 3 per face, in face order
+    single = trimesh.grouping.group_rows(np.sort(edges, axis=1), require_count=1)
+    if len(single) == 0:
+        return out
+    # a hole is walked against the direction of the faces around it: its edges are b -> a
+    starts, ends = edges[single, 1], edges[single, 0]
+    order = np.lexsort((ends, starts))
+    starts, ends = starts[order], ends[order]
+    uniq, first, count = np.unique(starts, return_index=True, return_counts=True)
+    nxt = {int(s): int(ends[i]) for s, i, c in zip(uniq, first, count) if c == 1}
+    pinched = {int(s) for s, c in zip(uniq, count) if c > 1}
+    # holes = connected groups of boundary edges (loops sharing a vertex count as one)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    bverts, bidx = np.unique(np.concatenate([starts, ends]), return_inverse=True)
+    nb = len(bverts)
+    graph = coo_matrix((np.ones(len(starts)), (bidx[:len(starts)], bidx[len(starts):])), shape=(nb, nb))
+    out["holes_found"] = int(connected_components(graph, directed=True, connection="weak")[0])
+    visited: set[int] = set()
+    loops = []
+    for s in uniq.tolist():
+        if s in visited or s in pinched:
+            continue
+        loop, v = [], s
+        while v not in visited and v in nxt:
+            visited.add(v)
+            loop.append(v)
+            v = nxt[v]
+        if v == s and len(loop) >= 3:  # else it ran into a pinched vertex: left open
+            loops.append(loop)
+    V = np.asarray(m.vertices)
+    new_faces, new_vertices = [], []
+    nv = len(V)
+    for loop in loops:
+        k = len(loop)
+        if k > max_edges:
+            continue
+        if k == 3:
+            new_faces.append(loop)
+        elif k == 4:
+            a, b, c, d = loop
+            if np.linalg.norm(V[a] - V[c]) <= np.linalg.norm(V[b] - V[d]):
+                new_faces += [[a, b, c], [a, c, d]]
+            else:
+                new_faces += [[a, b, d], [b, c, d]]
+        else:
+            new_vertices.append(V[loop].mean(axis=0))
+            c = nv + len(new_vertices) - 1
+            new_faces += [[loop[i], loop[(i + 1) % k], c] for i in range(k)]
+        out["holes_filled"] += 1
+    out["holes_left"] = out["holes_found"] - out["holes_filled"]
+    if new_faces:
+        V2 = np.vstack([V] + ([np.array(new_vertices)] if new_vertices else []))
+        F2 = np.vstack([np.asarray(m.faces), np.array(new_faces, dtype=np.int64)])
+        m.vertices = V2
+        m.faces = F2
+        out["faces_added"] = len(new_faces)
+        out["vertices_added"] = len(new_vertices)
+    return out
+
+
+def _orient_bodies(m, before: np.ndarray) -> tuple[int, int]:
+    """Make closed bodies outward (nested ones keep their input majority); return (inverted, nested)."""
+    if len(m.faces) == 0:
+        return 0, 0
+    F = np.asarray(m.faces)
+    nf = len(F)
+    labels = trimesh.graph.connected_component_labels(m.face_adjacency, node_count=nf)
+    nb = int(labels.max()) + 1
+    # a body is closed when each of its edges is used by exactly two faces, in opposite directions
+    edges = np.asarray(m.edges)
+    face_of_edge = np.repeat(np.arange(nf), 3)
+    _, inv, cnt = np.unique(trimesh.grouping.hashable_rows(np.sort(edges, axis=1)),
+                            return_inverse=True, return_counts=True)
+    bad_edge = cnt[inv] != 2
+    _, inv, cnt = np.unique(trimesh.grouping.hashable_rows(edges), return_inverse=True, return_counts=True)
+    bad_edge |= cnt[inv] != 1
+    body_bad = np.zeros(nb, dtype=bool)
+    body_bad[labels[face_of_edge[bad_edge]]] = True
+    # signed volume per body about the mesh's bounding-box centre
+    V = np.asarray(m.vertices)
+    ref = 0.5 * (V.min(axis=0) + V.max(axis=0))
+    tri = V[F] - ref
+    six = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))
+    vol = np.bincount(labels, weights=six, minlength=nb) / 6.0
+    scale = float(np.abs(six).sum()) / 6.0 or 1.0
+    closed = np.nonzero(~body_bad & (np.abs(vol) > 1e-12 * scale))[0]
+    if len(closed) == 0:
+        return 0, 0
+    # input majority orientation of each body (before winding fixes)
+    flipped = _flipped(before, F[:len(before)])
+    votes = np.bincount(labels[:len(before)], weights=np.where(flipped, -1.0, 1.0), minlength=nb)
+    nested = _nested(V, F, labels, closed, vol)
+    flip_body = np.zeros(nb, dtype=bool)
+    inverted = 0
+    for b in closed:
+        if nested[b]:
+            want_positive = (vol[b] > 0) == (votes[b] >= 0)  # keep what most input faces said
+        else:
+            want_positive = True
+        if (vol[b] > 0) != want_positive:
+            flip_body[b] = True
+            inverted += 1
+    if inverted:
+        fl = flip_body[labels]
+        F2 = F.copy()
+        F2[fl] = F2[fl][:, ::-1]
+        m.faces = F2
+    return inverted, int(sum(bool(nested[b]) for b in closed))
+
+
+def _nested(V, F, labels, closed, vol) -> dict:
+    """For each closed body: is it entirely inside another closed body?"""
+    nested = {int(b): False for b in closed}
+    if len(closed) < 2:
+        return nested
+    fmin = V[F].min(axis=1)
+    fmax = V[F].max(axis=1)
+    nb = int(labels.max()) + 1
+    lo = np.full((nb, 3), np.inf)
+    hi = np.full((nb, 3), -np.inf)
+    np.minimum.at(lo, labels, fmin)
+    np.maximum.at(hi, labels, fmax)
+    lo, hi = lo[closed], hi[closed]
+    faces_of = None
+    for a in range(0, len(closed), 512):
+        inside = ((lo[a:a + 512, None] >= lo[None]) & (hi[a:a + 512, None] <= hi[None])).all(axis=2)
+        inside[np.arange(len(inside)), np.arange(a, a + len(inside))] = False
+        for i, j in zip(*np.nonzero(inside)):
+            bi, bj = int(closed[a + i]), int(closed[j])
+            if nested[bi]:
+                continue
+            if faces_of is None:
+                order = np.argsort(labels, kind="stable")
+                bounds = np.searchsorted(labels[order], np.arange(nb + 1))
+                faces_of = (order, bounds)
+            order, bounds = faces_of
+            fi = F[order[bounds[bi]:bounds[bi + 1]]]
+            fj = F[order[bounds[bj]:bounds[bj + 1]]]
+            pts = V[np.unique(fi)]
+            if len(pts) > 16:
+                pts = pts[np.linspace(0, len(pts) - 1, 16).astype(int)]
+            w = _winding_numbers(pts, V[fj]) * np.sign(vol[bj])
+            if (w > 0.5).all():
+                nested[bi] = True
+    return nested
+
+
+def _winding_numbers(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Generalised winding number of each point w.r.t. a closed triangle set (Van Oosterom-Strackee)."""
+    out = np.zeros(len(points))
+    for k, p in enumerate(points):
+        a, b, c = (triangles[:, i] - p for i in range(3))
+        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
+        num = np.einsum("ij,ij->i", a, np.cross(b, c))
+        den = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", b, c) * la
+               + np.einsum("ij,ij->i", c, a) * lb)
+        out[k] = 2.0 * np.arctan2(num, den).sum() / (4.0 * np.pi)
+    return out
