@@ -116,7 +116,7 @@ def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[s
     """Render one output file of a finalized robot through a registered emitter."""
     from robotkit.emit import EMITTERS
 
-    full = _finalized(robot, fact_paths, inertial_paths)
+    full = robot if options.get("raw") else _finalized(robot, fact_paths, inertial_paths)
     if options.get("facts"):
         options = dict(options, facts=read_facts(fact_paths))
     write_if_changed(target, EMITTERS[emitter](full, **options))

@@ -40,7 +40,9 @@ def validate_sdf(path: Path) -> list[Finding]:
                         "apt install ignition-tools libsdformat-dev")]
     rc, out = _run(["ign", "sdf", "-k", str(path)])
     if rc != 0 or "Valid" not in out:
-        return [Finding("error", "ign sdf -k", str(path), line) for line in (out.splitlines() or [f"exit {rc}"])]
+        # the first "Error Code" is the cause; the rest unwinds the element stack
+        lines = [line for line in out.splitlines() if line.startswith("Error Code")] or out.splitlines()
+        return [Finding("error", "ign sdf -k", str(path), (lines or [f"exit status {rc}"])[0])]
     return []
 
 
@@ -81,8 +83,10 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
     if any(f.severity == "error" for f in findings):
         return findings
     try:
-        for what, diffs in equivalence(robot_dir).items():
+        notes: list[str] = []
+        for what, diffs in equivalence(robot_dir, notes=notes).items():
             findings += [Finding("error", "equivalence", f"robot '{name}'", f"{what}: {d}") for d in diffs]
+        findings += [Finding("warning", "equivalence", f"robot '{name}'", n) for n in notes]
     except (RuntimeError, ValueError) as exc:
         findings.append(Finding("warning", "equivalence", f"robot '{name}'", str(exc)))
     findings += [Finding("error", "simulation", f"robot '{name}'", p,

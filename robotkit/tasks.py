@@ -37,9 +37,12 @@ OUTPUTS = {
     "model.config": lambda r: "model.config",
     "package.xml": lambda r: "package.xml",
     "CMakeLists.txt": lambda r: "CMakeLists.txt",
+    "controllers": lambda r: "config/controllers.yaml",
 }
 # emitters that read only the robot's name and metadata (no geometry, no inertials)
 METADATA_ONLY = {"model.config", "package.xml", "CMakeLists.txt", "mjcf-scene"}
+# emitters that read the robot's structure but no inertial or mesh fact
+STRUCTURE_ONLY = {"controllers"}
 
 
 def _template_files(emitter: str) -> list[str]:
@@ -133,12 +136,18 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                          if g.shape.mesh is not None and g.recenter != "none"})
     out_facts = {k: facts[k] for k in recentered}
     structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
-    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}}
+    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True}}
     for emitter, rel in OUTPUTS.items():
+        if emitter == "controllers" and not robot.actuators:
+            continue
         target = str(root / rel(robot))
         opts = options.get(emitter, {})
         if emitter == "report":
             subject, reads, facts_in, inertials_in = robot, structure, facts, inertials
+        elif emitter in STRUCTURE_ONLY:
+            subject, facts_in, inertials_in = robot, {}, {}
+            reads = {"name": robot.name, "ros_control": robot.ros_control,
+                     "actuators": [asdict(a) for a in robot.actuators]}
         elif emitter in METADATA_ONLY:
             subject = replace(robot, links=(), joints=(), materials=())
             reads: dict = {"name": robot.name, "metadata": asdict(robot.metadata)}

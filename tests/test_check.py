@@ -210,4 +210,6 @@ def test_examples_check_clean(tmp_path, name):
     proc = run_cli("check", RECIPES / f"{name}.yaml", "--out", tmp_path, "--format", "json")
     data = json.loads(proc.stdout)
     assert proc.returncode == 0 and data["errors"] == 0, proc.stdout
-    assert [f for f in data["findings"] if f["check"] != "build"] == []
+    # allowed: what a format cannot express (build) and a comparison libsdformat cannot make
+    assert [f for f in data["findings"] if f["check"] != "build"
+            and not (f["check"] == "equivalence" and "not compared" in f["message"])] == []

@@ -57,6 +57,12 @@ def _report(robot, facts=None, **_):
     return json.dumps(report(robot, facts or {}), indent=1, sort_keys=True) + "\n"
 
 
+def _controllers(robot, raw=True, **_):
+    from robotkit.emit.controllers import render_controllers
+
+    return render_controllers(robot)
+
+
 EMITTERS = {
     "urdf": _urdf,
     "sdf": _sdf,
@@ -66,16 +72,18 @@ EMITTERS = {
     "package.xml": _package_xml,
     "CMakeLists.txt": _cmakelists,
     "report": _report,
+    "controllers": _controllers,
 }
 
 # the templates each emitter renders (their edits must rebuild the output)
 TEMPLATES = {
-    "urdf": ["urdf/robot.urdf.j2"],
-    "sdf": ["sdf/model.sdf.j2"],
+    "urdf": ["urdf/robot.urdf.j2", "sensors/sdf.j2", "sensors/classic.j2"],
+    "sdf": ["sdf/model.sdf.j2", "sensors/sdf.j2"],
     "mjcf": ["mjcf/robot.xml.j2"],
     "mjcf-scene": ["mjcf/scene.xml.j2"],
     "model.config": ["gazebo/model.config.j2"],
     "package.xml": ["ros/package.xml.j2"],
     "CMakeLists.txt": ["ros/CMakeLists.txt.j2"],
     "report": [],
+    "controllers": [],
 }

@@ -75,7 +75,9 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
                     out.append(f"link '{link.name}': collision mesh '{g.shape.mesh.file_name}' is not convex; "
                                "MuJoCo collides with its convex hull")
     del children
-    return out
+    from robotkit.emit.sensors import losses as sensor_losses
+
+    return out + sensor_losses(robot)["mjcf"]
 
 
 def _geom(robot: Robot, geom: Geom, name: str, assets: dict) -> dict:
@@ -152,8 +154,16 @@ def context(robot: Robot) -> dict:
             return [{"name": j.name, "type": "free"}]
         return []
 
+    from robotkit.emit.sensors import mjcf_context
+
+    sens = mjcf_context(robot)
+
     def body(name: str, joint) -> dict:
         link = links[name]
+        extras = sens["bodies"].get(name, {"cameras": [], "sites": []})
+        for site in extras["sites"]:
+            if site.get("touch"):
+                site["size"], site["pos"] = _touch_volume(link)
         c = link.contact
         friction = c.mu1 if c is not None else None
         solref = (-c.kp, -(c.kd or 0.0)) if c is not None and c.kp is not None else None
@@ -167,6 +177,8 @@ def context(robot: Robot) -> dict:
             "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets), friction=friction, solref=solref)
                            for i, g in enumerate(link.collisions)],
             "children": [body(j.child, j) for j in by_parent.get(name, [])],
+            "cameras": extras["cameras"],
+            "sites": extras["sites"],
         }
 
     root = robot.root
@@ -177,14 +189,52 @@ def context(robot: Robot) -> dict:
     else:
         world_geoms = []
         bodies = [body(root, None)]
+        if robot.base == "free":
+            bodies[0]["joints"] = [{"name": f"{root}_free", "type": "free"}]
     equalities = [{"name": f"{j.name}_mimic", "joint1": j.name, "joint2": j.mimic.joint,
                    "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
                   for j in robot.joints if j.mimic is not None]
     del contacts
     excludes = [(j.parent, j.child) for j in robot.joints if j.parent != WORLD]
-    return {"robot": robot, "excludes": excludes, "assets": sorted(assets.values(), key=lambda a: a["name"]),
+    joint_by_name = {j.name: j for j in robot.joints}
+    actuators = []
+    for a in robot.actuators:
+        j = joint_by_name[a.joint]
+        effort = j.limit.effort if j.limit is not None and j.limit.effort else None
+        act = {"name": f"{a.joint}_{a.interface}", "joint": a.joint, "effort": effort}
+        if a.interface == "position":
+            act.update(kind="position", kp=a.p, kv=a.d,
+                       ctrlrange=(j.limit.lower, j.limit.upper) if j.type != "continuous" else None)
+        elif a.interface == "velocity":
+            act.update(kind="velocity", kv=a.p, ctrlrange=(-j.limit.velocity, j.limit.velocity)
+                       if j.limit is not None and j.limit.velocity else None)
+        else:
+            act.update(kind="motor", ctrlrange=(-effort, effort))
+        actuators.append(act)
+    return {"robot": robot, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "assets": sorted(assets.values(), key=lambda a: a["name"]),
             "materials": robot.materials, "world_geoms": world_geoms, "bodies": bodies,
             "equalities": equalities}
+
+
+def _touch_volume(link) -> tuple[tuple[float, ...], tuple[float, float, float]]:
+    """A box site around the link's collision primitives (or a 5 cm cube) for a touch sensor."""
+    pts = []
+    for g in link.collisions:
+        s = g.shape
+        half = (tuple(v / 2 for v in s.size) if s.kind == "box" else
+                (s.radius, s.radius, s.length / 2) if s.kind == "cylinder" else
+                (s.radius,) * 3 if s.kind == "sphere" else None)
+        if half is None:
+            continue
+        T = g.pose.matrix()
+        for corner in np.array(np.meshgrid(*[(-h, h) for h in half])).T.reshape(-1, 3):
+            pts.append(T[:3, :3] @ corner + T[:3, 3])
+    if not pts:
+        return (0.025, 0.025, 0.025), (0.0, 0.0, 0.0)
+    pts = np.array(pts)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    # slightly larger than the geometry, so contacts on its surface fall inside
+    return tuple(float(v) for v in (hi - lo) / 2 * 1.05 + 0.002), tuple(float(v) for v in (hi + lo) / 2)
 
 
 def render_mjcf(robot: Robot) -> str:

@@ -43,12 +43,33 @@ def context(robot: Robot) -> dict:
             "gazebo_material": gazebo_material,
             "contact": link.contact if link.collisions else None,
         })
+    from robotkit.emit.sensors import contexts
+
     return {
         "robot": robot,
+        "sensors": contexts(robot),
+        "actuators": actuator_contexts(robot),
         "materials": [materials[name] for name in used],
         "links": links,
         "joints": robot.joints,
     }
+
+
+def actuator_contexts(robot: Robot) -> list[dict]:
+    joints = {j.name: j for j in robot.joints}
+    out = []
+    for a in robot.actuators:
+        j = joints[a.joint]
+        lim = j.limit
+        lo = hi = None
+        if a.interface == "position" and j.type != "continuous":
+            lo, hi = lim.lower, lim.upper
+        elif a.interface == "velocity" and lim is not None and lim.velocity:
+            lo, hi = -lim.velocity, lim.velocity
+        elif a.interface == "effort" and lim is not None and lim.effort:
+            lo, hi = -lim.effort, lim.effort
+        out.append({"joint": a.joint, "interface": a.interface, "min": lo, "max": hi, "p": a.p, "i": a.i, "d": a.d})
+    return out
 
 
 def render_urdf(robot: Robot) -> str:

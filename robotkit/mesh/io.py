@@ -99,6 +99,8 @@ def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):
     if mesh.is_volume:
         return mesh, repairs, "mesh", warnings
     reason = _why_not_volume(mesh)
+    if policy == "visual-only":  # no inertial depends on it: facts for display only
+        return mesh.convex_hull, repairs, "hull", warnings
     if policy == "hull":
         warnings.append(f"mesh '{name}' is not a closed volume ({reason}); "
                         "its mass properties use its convex hull, which overestimates the volume")

@@ -21,7 +21,7 @@ import numpy as np
 from robotkit.errors import Problem, RecipeError
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
-    Metadata, Mimic, Pose, Robot, Shape, World, rpy_matrix,
+    Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, World, rpy_matrix,
 )
 from robotkit.recipe.load import LoadedRecipe
 from robotkit.recipe.schema import UNITS
@@ -80,6 +80,7 @@ def resolve(loaded: LoadedRecipe) -> Robot:
                 problems.append(marks.problem(path + ("mesh",),
                                               f"mesh file '{_show(g.mesh)}' has an unsupported format (use STL, OBJ or DAE)"))
                 return None
+            sources.setdefault(g.mesh, os.path.basename(g.mesh))
             if g.scale is not None:
                 s = g.scale if isinstance(g.scale, list) else [g.scale] * 3
                 scale = _t(s)
@@ -167,6 +168,33 @@ def resolve(loaded: LoadedRecipe) -> Robot:
         joints.append(Joint(name, j.type, j.parent, j.child, Pose(_t(j.origin.xyz), _t(j.origin.rpy)),
                             axis, limit, dyn, mimic))
 
+    extra_links, extra_joints, sensors = _sensors(r, marks, problems, make_geom, sources, base_dir)
+    known_links = set(link_names)
+    for link in extra_links:
+        if link.name in known_links:
+            problems.append(marks.problem(("sensors",), f"sensor frame '{link.name}' is also a link's name; "
+                                          "give the sensor another name or 'frame'"))
+        known_links.add(link.name)
+    links += extra_links
+    joints += extra_joints
+    link_names = [link.name for link in links]
+    actuators = []
+    joint_types = {j.name: j for j in joints}
+    for name, a in r.actuators.items():
+        j = joint_types.get(name)
+        if j is None:
+            problems.append(marks.problem(("actuators", name), _unknown("joint", name, list(r.joints))))
+        elif j.type not in ("revolute", "continuous", "prismatic"):
+            problems.append(marks.problem(("actuators", name), f"joint '{name}' is {j.type}: only revolute, "
+                                          "continuous and prismatic joints can be actuated"))
+        elif j.mimic is not None:
+            problems.append(marks.problem(("actuators", name), f"joint '{name}' mimics '{j.mimic.joint}'; "
+                                          "actuate the joint it follows"))
+        elif a.interface == "effort" and (j.limit is None or not j.limit.effort):
+            problems.append(marks.problem(("actuators", name), f"an effort actuator needs joint '{name}' "
+                                          "to have an effort limit"))
+        else:
+            actuators.append(Actuator(name, a.interface, float(a.p), float(a.i), float(a.d)))
     worlds = []
     for name, w in r.worlds.items():
         if not os.path.isfile(w.map):
@@ -180,7 +208,90 @@ def resolve(loaded: LoadedRecipe) -> Robot:
     md = r.metadata
     metadata = Metadata(md.version, md.description, tuple(Author(a.name, a.email) for a in md.authors), md.license)
     return Robot(r.robot, tuple(links), tuple(joints), materials, metadata, r.self_collide, tuple(r.urdf_extras),
-                 tuple(worlds))
+                 tuple(worlds), tuple(sensors), tuple(actuators), r.gazebo, r.ros_control, r.base)
+
+
+OPTICAL = (-math.pi / 2, 0.0, -math.pi / 2)
+
+
+def _sensors(r, marks, problems, make_geom, sources, base_dir):
+    """Sensor frames (links + fixed joints) and Sensor records; presets expanded."""
+    from robotkit import presets
+
+    links: list[Link] = []
+    joints: list[Joint] = []
+    sensors: list[Sensor] = []
+    for name, s in r.sensors.items():
+        sp = ("sensors", name)
+        if s.parent not in r.links:
+            problems.append(marks.problem(sp + ("parent",), _unknown("link", s.parent, list(r.links))))
+            continue
+        origin = Pose(_t(s.origin.xyz), _t(s.origin.rpy))
+        topic = s.topic or name
+        if s.type == "contact":
+            sensors.append(Sensor(name, "contact", s.parent, float(s.update_rate), topic, {}))
+            continue
+        if s.type == "d435":
+            frames, fjoints, fsensors = presets.d435_frames(name)
+            (mesh, vxyz, vrpy), (box, bxyz) = presets.d435_body()
+            screw = frames[0][0]
+            links.append(Link(screw))
+            joints.append(Joint(f"{name}_joint", "fixed", s.parent, screw, origin))
+            for lname, kind in frames[1:]:
+                if kind == "frame":
+                    links.append(Link(lname))
+                    continue
+                key = f"d435-{_h(mesh)}"
+                sources.setdefault(mesh, "d435.dae")
+                visual = Geom(Shape("mesh", mesh=MeshRef(mesh, (1.0, 1.0, 1.0), "d435.dae", key, "visual-only")),
+                              Pose(vxyz, vrpy))
+                collision = Geom(Shape("box", size=box), Pose(bxyz))
+                links.append(Link(lname, (visual,), (collision,),
+                                  InertialSpec("mass", mass=presets.D435["mass"], source="collision")))
+            for jname, parent, child, xyz, rpy in fjoints:
+                joints.append(Joint(jname, "fixed", parent, child, Pose(tuple(xyz), tuple(rpy))))
+            given = {k: getattr(s.camera, k) for k in s.camera.model_fields_set} if s.camera else {}
+            for sname, stype, link, optical, hfov in fsensors:
+                params = {**CameraDefaults(), "near": 0.1, "far": 10.0, "hfov": hfov, **given}
+                sensors.append(Sensor(sname, stype, link, float(s.update_rate), f"{topic}/{sname[len(name) + 1:]}",
+                                      params, optical))
+            continue
+        frame = s.frame or f"{name}_link"
+        visuals, collisions, spec = (), (), InertialSpec("none")
+        if s.body is not None:
+            geoms = []
+            for i, g in _indexed(s.body.visual):
+                geom = make_geom(g, sp + ("body", "visual") + i, frame, r.open_mesh)
+                if geom is not None:
+                    geoms.append(geom)
+            visuals = tuple(geoms)
+            collisions = tuple(replace(g, material=None) for g in geoms)
+            spec = InertialSpec("mass", mass=float(s.body.mass))
+        links.append(Link(frame, visuals, collisions, spec))
+        joints.append(Joint(f"{frame}_joint", "fixed", s.parent, frame, origin))
+        params = getattr(s, {"camera": "camera", "depth": "camera"}.get(s.type, s.type))
+        params = params.model_dump() if params is not None else \
+            {"camera": CameraDefaults, "depth": CameraDefaults}.get(s.type, lambda: None)() or _defaults(s.type)
+        optical = None
+        if s.type in ("camera", "depth"):
+            optical = f"{name}_optical_frame"
+            links.append(Link(optical))
+            joints.append(Joint(f"{optical}_joint", "fixed", frame, optical, Pose((0.0, 0.0, 0.0), OPTICAL)))
+        sensors.append(Sensor(name, s.type, frame, float(s.update_rate), topic, params, optical))
+    return links, joints, sensors
+
+
+def CameraDefaults():
+    from robotkit.recipe.schema import CameraParams
+
+    return CameraParams().model_dump()
+
+
+def _defaults(kind: str) -> dict:
+    from robotkit.recipe import schema
+
+    model = {"lidar": schema.LidarParams, "sonar": schema.SonarParams, "imu": schema.ImuParams}[kind]
+    return model().model_dump()
 
 
 def _indexed(value):

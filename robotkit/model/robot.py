@@ -211,6 +211,28 @@ class Metadata:
 
 
 @dataclass(frozen=True)
+class Sensor:
+    """A sensor sitting at the origin of frame link ``link`` (x forward, z up, as in Gazebo)."""
+
+    name: str
+    type: str  # camera | depth | lidar | sonar | imu | contact
+    link: str
+    update_rate: float
+    topic: str
+    params: dict = field(default_factory=dict)
+    optical_frame: str | None = None  # the ROS optical frame of a camera (z forward, y down)
+
+
+@dataclass(frozen=True)
+class Actuator:
+    joint: str
+    interface: str  # position | velocity | effort
+    p: float = 0.0
+    i: float = 0.0
+    d: float = 0.0
+
+
+@dataclass(frozen=True)
 class World:
     name: str
     map: str  # absolute path of the map_server YAML
@@ -228,6 +250,23 @@ class Robot:
     self_collide: bool = False
     urdf_extras: tuple[str, ...] = ()
     worlds: tuple[World, ...] = ()
+    sensors: tuple[Sensor, ...] = ()
+    actuators: tuple[Actuator, ...] = ()
+    gazebo: str = "sim"
+    ros_control: str = "ros2"
+    base: str = "fixed"
+
+    def frame_links(self) -> set[str]:
+        """Links that are only frames: no geometry, no inertial, fixed to a parent link.
+        SDF writes them as <frame> (an SDF link without an inertial would weigh 1 kg)."""
+        parent_joint = {j.child: j for j in self.joints}
+        out = set()
+        for link in self.links:
+            j = parent_joint.get(link.name)
+            if (j is not None and j.type == "fixed" and j.parent != "world" and not link.visuals
+                    and not link.collisions and link.inertial is None and link.inertial_spec.mode == "none"):
+                out.add(link.name)
+        return out
 
     def link(self, name: str) -> Link:
         for link in self.links:

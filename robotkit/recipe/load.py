@@ -226,19 +226,22 @@ def _absolute_meshes(data: dict, marks: Marks):
                 file, _ = marks.locate(("worlds", name, "map"))
                 base = Path(file).parent if file else Path.cwd()
                 w["map"] = os.path.normpath(str((base / w["map"]).absolute()))
-    links = data.get("links")
-    if not isinstance(links, dict):
-        return
-    for name, link in links.items():
+    holders = []
+    if isinstance(data.get("links"), dict):
+        holders += [(("links", name), link, ("visual", "collision")) for name, link in data["links"].items()]
+    if isinstance(data.get("sensors"), dict):
+        holders += [(("sensors", name, "body"), s.get("body"), ("visual",)) for name, s in data["sensors"].items()
+                    if isinstance(s, dict)]
+    for prefix, link, kinds in holders:
         if not isinstance(link, dict):
             continue
-        for kind in ("visual", "collision"):
+        for kind in kinds:
             geoms = link.get(kind)
             items = [(None, geoms)] if isinstance(geoms, dict) else (
                 list(enumerate(geoms)) if isinstance(geoms, list) else [])
             for i, g in items:
                 if isinstance(g, dict) and isinstance(g.get("mesh"), str):
-                    path = ("links", name, kind) + (() if i is None else (i,)) + ("mesh",)
+                    path = prefix + (kind,) + (() if i is None else (i,)) + ("mesh",)
                     file, _ = marks.locate(path)
                     base = Path(file).parent if file else Path.cwd()
                     g["mesh"] = os.path.normpath(str((base / g["mesh"]).absolute()))
@@ -416,16 +419,22 @@ def _salvage(data: dict, exc):
 
     data = dict(data)
     bad_links, bad_joints, bad_top = set(), set(), set()
+    bad_entries: dict[str, set] = {}
     for err in exc.errors(include_url=False):
         loc = err["loc"]
         if len(loc) >= 2 and loc[0] == "links":
             bad_links.add(loc[1])
         elif len(loc) >= 2 and loc[0] == "joints":
             bad_joints.add(loc[1])
+        elif len(loc) >= 2 and loc[0] in ("materials", "sensors", "actuators", "worlds") \
+                and isinstance(data.get(loc[0]), dict):
+            bad_entries.setdefault(loc[0], set()).add(loc[1])
         elif loc:
             bad_top.add(loc[0])
         else:
             return None, True
+    for section, names in bad_entries.items():
+        data[section] = {k: v for k, v in data[section].items() if k not in names}
     if "robot" in bad_top:
         data["robot"] = "robot"
         bad_top.discard("robot")

@@ -289,6 +289,111 @@ class Defaults(Strict):
     """Keys merged under every joint (same keys as a joint)."""
 
 
+class CameraParams(Strict):
+    width: Annotated[int, Field(gt=0)] = 640
+    """Image width in pixels."""
+    height: Annotated[int, Field(gt=0)] = 480
+    """Image height in pixels."""
+    hfov: Annotated[float, Field(gt=0, lt=3.1416)] = 1.047
+    """Horizontal field of view in radians."""
+    near: Positive = 0.05
+    """Near clip distance in metres."""
+    far: Positive = 50.0
+    """Far clip distance in metres."""
+    format: str = "R8G8B8"
+    """Image format (SDF names: R8G8B8, L8, ...)."""
+
+
+class LidarParams(Strict):
+    samples: Annotated[int, Field(gt=0)] = 360
+    """Horizontal rays per scan."""
+    min_angle: float = -3.141592653589793
+    """Start of the horizontal scan, radians."""
+    max_angle: float = 3.141592653589793
+    """End of the horizontal scan, radians."""
+    vertical_samples: Annotated[int, Field(gt=0)] = 1
+    """Vertical rays (1: a 2D lidar)."""
+    vertical_min_angle: float = 0.0
+    vertical_max_angle: float = 0.0
+    min_range: Positive = 0.1
+    """Minimum range in metres."""
+    max_range: Positive = 12.0
+    """Maximum range in metres."""
+    resolution: Positive = 0.01
+    """Range resolution in metres."""
+    noise: NonNegative = 0.0
+    """Standard deviation of Gaussian range noise, metres."""
+
+
+class SonarParams(Strict):
+    fov: Annotated[float, Field(gt=0, lt=3.1416)] = 0.26
+    """Cone opening angle in radians."""
+    min_range: Positive = 0.02
+    max_range: Positive = 4.0
+
+
+class ImuParams(Strict):
+    gyro_noise: NonNegative = 0.0
+    """Standard deviation of angular-rate noise, rad/s."""
+    accel_noise: NonNegative = 0.0
+    """Standard deviation of linear-acceleration noise, m/s^2."""
+
+
+class SensorBody(Strict):
+    """Geometry and mass a sensor brings to its frame link."""
+
+    visual: Shapes
+    """The sensor's shape (also its collision geometry)."""
+    mass: Positive
+    """Mass in kg; the inertia is computed from the shape at uniform density."""
+
+
+class Sensor(Strict):
+    """A sensor on a frame of its own (``frame``, fixed to ``parent`` at ``origin``)."""
+
+    type: Literal["camera", "depth", "lidar", "sonar", "imu", "contact", "d435"]
+    """``d435`` places an Intel RealSense D435 with its real frames (mounted by its bottom screw)."""
+    parent: str
+    """Link the sensor is mounted on (for ``contact``: the link whose collisions it reports)."""
+    origin: Origin = Origin()
+    """Pose of the sensor frame in the parent link (for ``d435``: of the bottom screw frame)."""
+    frame: str | None = None
+    """Name of the sensor's frame link. Default: ``<sensor>_link`` (``d435``: frames ``<sensor>_*`` as upstream)."""
+    update_rate: Positive = 30.0
+    """Updates per second."""
+    topic: str | None = None
+    """Topic name. Default: the sensor's name."""
+    camera: CameraParams | None = None
+    lidar: LidarParams | None = None
+    sonar: SonarParams | None = None
+    imu: ImuParams | None = None
+    body: SensorBody | None = None
+
+    @model_validator(mode="after")
+    def _params(self):
+        wanted = {"camera": "camera", "depth": "camera", "d435": "camera", "lidar": "lidar", "sonar": "sonar",
+                  "imu": "imu"}.get(self.type)
+        for key in ("camera", "lidar", "sonar", "imu"):
+            if getattr(self, key) is not None and key != wanted:
+                raise ValueError(f"'{key}' parameters do not apply to {self.type} sensors")
+        if self.type in ("contact", "d435") and self.body is not None:
+            raise ValueError(f"a {self.type} sensor takes no body")
+        return self
+
+
+class Actuator(Strict):
+    """A joint drive: ros_control interface, PID gains, and the matching MJCF actuator."""
+
+    interface: Literal["position", "velocity", "effort"] = "position"
+    """Command interface (MJCF: position servo, velocity servo, or motor)."""
+    p: NonNegative = 0.0
+    """Proportional gain (MJCF position: kp; velocity: kv)."""
+    i: NonNegative = 0.0
+    """Integral gain (ros_control only; MJCF actuators have none)."""
+    d: NonNegative = 0.0
+    """Derivative gain (MJCF position: kv)."""
+
+
 class World(Strict):
     """A world built from a ROS map_server occupancy map, written to ``OUT/<name>/``."""
 
@@ -324,6 +429,16 @@ class Recipe(Strict):
     defaults: Defaults = Defaults()
     links: dict[str, Link]
     joints: dict[str, Joint] = {}
+    sensors: dict[str, Sensor] = {}
+    """Sensors by name; each adds its frame link(s) and appears in every format."""
+    actuators: dict[str, Actuator] = {}
+    """Actuators by joint name: transmissions / ros2_control in the URDF, actuators in the MJCF, controllers YAML."""
+    base: Literal["fixed", "free"] = "fixed"
+    """How the root link sits in MuJoCo: ``fixed`` (welded to the world, as MuJoCo imports a URDF) or ``free`` (a free joint: a mobile robot). In Gazebo a model without a ``world`` link is always free."""
+    gazebo: Literal["sim", "classic"] = "sim"
+    """Which Gazebo the URDF's sensor blocks target: ``sim`` (Gazebo Sim, gz-sim systems) or ``classic`` (gazebo_ros plugins)."""
+    ros_control: Literal["ros2", "ros1"] = "ros2"
+    """Which ros_control the URDF declares: ``ros2`` (``<ros2_control>`` tags) or ``ros1`` (``<transmission>`` + gazebo_ros_control)."""
     worlds: dict[str, World] = {}
     """Worlds made from occupancy maps, by name (``robotkit world`` does the same from the command line)."""
 
@@ -344,7 +459,7 @@ class Recipe(Strict):
                 raise ValueError(f"urdf_extras[{i}] is not well-formed XML: {exc}") from None
         return v
 
-    @field_validator("materials", "links", "joints", "worlds")
+    @field_validator("materials", "links", "joints", "worlds", "sensors")
     @classmethod
     def _names(cls, v):
         for name in v:

@@ -59,7 +59,7 @@ class KModel:
         return {j.child: j for j in self.joints.values()}
 
     def root(self) -> str:
-        children = {j.child for j in self.joints.values()}
+        children = {j.child for j in self.joints.values() if j.parent in self.links}
         roots = [n for n in self.links if n not in children]
         return roots[0]
 
@@ -260,6 +260,14 @@ def read_sdf_text(text: str, source: str) -> KModel:
         R = T[:3, :3]
         links[name] = KLink(name, mass, T[:3, 3].copy(), R @ I @ R.T)
     joints = {}
+    for f in model.findall("frame"):  # a frame is a massless link fixed where it is attached
+        name = f.get("name")
+        attached = f.get("attached_to") or "__model__"
+        links[name] = KLink(name)
+        if attached != "__model__":
+            X_a, X_f = world(attached), world(name)
+            joints[f"(frame {name})"] = KJoint(f"(frame {name})", "fixed", attached, name,
+                                               np.linalg.inv(X_a) @ X_f, np.eye(4), np.array([1.0, 0, 0]))
     for name, j in joint_els.items():
         parent, child = j.find("parent").text.strip(), j.find("child").text.strip()
         if parent == WORLD:
