@@ -145,7 +145,8 @@ def test_first_build_runs_every_task_once_then_nothing(project):
         "turret_bot:copy:base.stl", "turret_bot:copy:slider.stl", "turret_bot:copy:rotor.stl",
         "turret_bot:inertial:base", "turret_bot:inertial:slider", "turret_bot:inertial:rotor",
         "turret_bot:urdf", "turret_bot:sdf", "turret_bot:mjcf", "turret_bot:mjcf-scene", "turret_bot:report",
-        "turret_bot:model.config", "turret_bot:package.xml", "turret_bot:CMakeLists.txt"])
+        "turret_bot:model.config", "turret_bot:package.xml", "turret_bot:CMakeLists.txt",
+        "turret_bot:controllers"])
     second = build([project / "turret_bot.yaml"], out)
     assert second.ran == []
     assert sorted(second.uptodate) == sorted(first.ran)
