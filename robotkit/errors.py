@@ -18,6 +18,9 @@ def display_path(path: str | os.PathLike | None) -> str:
     path = os.fspath(path)
     try:
         rel = os.path.relpath(path)
+        if rel.startswith(".."):  # the cwd may be the same folder reached through a symlink
+            real = os.path.relpath(os.path.realpath(path), os.path.realpath(os.getcwd()))
+            rel = real if not real.startswith("..") else rel
     except ValueError:  # other drive (Windows)
         return path
     return path if rel.startswith("..") else rel
