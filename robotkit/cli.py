@@ -53,6 +53,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="lowest severity that makes the exit status 1 (default: error)")
     c.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
 
+    from robotkit.importer.cli import add_parser as add_import
+
+    add_import(sub)
+
     s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
     s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
     return p
@@ -71,7 +75,8 @@ def main(argv: list[str] | None = None) -> int:
     from robotkit.errors import RobotkitError
 
     try:
-        return {"build": _build, "world": _world, "schema": _schema, "check": _check}[args.command](args)
+        return {"build": _build, "world": _world, "schema": _schema, "check": _check,
+                "import": _import}[args.command](args)
     except RobotkitError as exc:
         for line in exc.lines():
             print(line, file=sys.stderr)
@@ -133,6 +138,12 @@ def _check(args) -> int:
     sys.stdout.write(render(findings, args.format, args.path))
     levels = ("error",) if args.fail_on == "error" else ("error", "warning")
     return 1 if any(f.severity in levels for f in findings) else 0
+
+
+def _import(args) -> int:
+    from robotkit.importer.cli import run
+
+    return run(args)
 
 
 def _schema(args) -> int:

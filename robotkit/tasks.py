@@ -30,6 +30,7 @@ STATE = ".robotkit"  # below the output folder: doit's database and intermediate
 # emitter -> path below the robot folder
 OUTPUTS = {
     "urdf": lambda r: f"urdf/{r.name}.urdf",
+    "xacro": lambda r: f"urdf/{r.name}.urdf.xacro",
     "sdf": lambda r: "model.sdf",
     "mjcf": lambda r: f"mjcf/{r.name}.xml",
     "mjcf-scene": lambda r: "mjcf/scene.xml",

@@ -49,7 +49,7 @@ def built(tmp_path_factory) -> Path:
 
 def test_writes_the_promised_files(built):
     root = built / "turret_bot"
-    for rel in ("urdf/turret_bot.urdf", "model.sdf", "mjcf/turret_bot.xml", "mjcf/scene.xml", "report.json",
+    for rel in ("urdf/turret_bot.urdf", "urdf/turret_bot.urdf.xacro", "model.sdf", "mjcf/turret_bot.xml", "mjcf/scene.xml", "report.json",
                 "model.config", "package.xml", "meshes/visual/base.stl",
                 "meshes/visual/slider.stl", "meshes/visual/rotor.stl"):
         assert (root / rel).is_file(), rel
@@ -146,7 +146,7 @@ def test_first_build_runs_every_task_once_then_nothing(project):
         "turret_bot:inertial:base", "turret_bot:inertial:slider", "turret_bot:inertial:rotor",
         "turret_bot:urdf", "turret_bot:sdf", "turret_bot:mjcf", "turret_bot:mjcf-scene", "turret_bot:report",
         "turret_bot:model.config", "turret_bot:package.xml", "turret_bot:CMakeLists.txt",
-        "turret_bot:controllers"])
+        "turret_bot:controllers", "turret_bot:xacro"])
     second = build([project / "turret_bot.yaml"], out)
     assert second.ran == []
     assert sorted(second.uptodate) == sorted(first.ran)
@@ -167,7 +167,7 @@ def test_editing_one_links_density_reruns_that_inertial_and_the_urdf(project):
     again = build([recipe], out)
     # the outputs that contain inertials rerun; model.config, package.xml, the scene and the meshes do not
     assert sorted(again.ran) == ["turret_bot:inertial:rotor", "turret_bot:mjcf", "turret_bot:report",
-                                 "turret_bot:sdf", "turret_bot:urdf"]
+                                 "turret_bot:sdf", "turret_bot:urdf", "turret_bot:xacro"]
     mass = urdf_inertials(out / "turret_bot" / "urdf" / "turret_bot.urdf")["rotor"][0]
     assert mass == pytest.approx(2.1141772435614743 / 1250 * 2700, rel=1e-12)
 
@@ -183,7 +183,7 @@ def test_changing_one_mesh_file_reruns_only_what_depends_on_it(project):
     assert sorted(again.ran) == sorted([
         next(n for n in again.uptodate + again.ran if n.startswith("turret_bot:mesh:slider")),
         "turret_bot:copy:slider.stl", "turret_bot:inertial:slider", "turret_bot:urdf", "turret_bot:sdf",
-        "turret_bot:mjcf", "turret_bot:report"])
+        "turret_bot:mjcf", "turret_bot:report", "turret_bot:xacro"])
 
 
 def test_doit_in_a_project_root_runs_the_same_tasks(tmp_path):

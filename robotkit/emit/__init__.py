@@ -63,6 +63,12 @@ def _controllers(robot, raw=True, **_):
     return render_controllers(robot)
 
 
+def _xacro(robot, **_):
+    from robotkit.emit.xacro_macro import render_xacro_macro
+
+    return render_xacro_macro(robot)
+
+
 EMITTERS = {
     "urdf": _urdf,
     "sdf": _sdf,
@@ -73,6 +79,7 @@ EMITTERS = {
     "CMakeLists.txt": _cmakelists,
     "report": _report,
     "controllers": _controllers,
+    "xacro": _xacro,
 }
 
 # the templates each emitter renders (their edits must rebuild the output)
@@ -86,4 +93,5 @@ TEMPLATES = {
     "CMakeLists.txt": ["ros/CMakeLists.txt.j2"],
     "report": [],
     "controllers": [],
+    "xacro": ["urdf/robot.urdf.xacro.j2", "urdf/robot.urdf.j2", "sensors/sdf.j2", "sensors/classic.j2"],
 }

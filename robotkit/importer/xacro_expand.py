@@ -197,7 +197,9 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
         (sa, "_eval_find"): sa._eval_find,
     }
     saved_find_fn = sa._eval_dict.get("find")
-    saved_constructors = yaml.SafeLoader.__dict__.get("yaml_constructors")
+    # xacro.load_yaml registers its unit tags (!degrees...) on yaml.SafeLoader, in place
+    own = yaml.SafeLoader.__dict__.get("yaml_constructors")
+    saved_constructors = dict(own) if own is not None else None
     stderr = io.StringIO()
     with _LOCK:
         try:
@@ -207,13 +209,13 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
             sa._eval_find = find
             sa._eval_dict["find"] = find
             xacro.all_includes.clear()
-            xacro.verbosity = 1
             with contextlib.redirect_stderr(stderr):
                 try:
                     doc = xacro.process_file(str(path), mappings=args)
                 except (xacro.XacroException, sa.SubstitutionException, _MissingPackage, UnsafeExpression,
                         xml.parsers.expat.ExpatError, OSError, NameError, KeyError, TypeError, ValueError,
-                        SyntaxError, AttributeError, ZeroDivisionError, IndexError, yaml.YAMLError) as exc:
+                        SyntaxError, AttributeError, ZeroDivisionError, IndexError, yaml.YAMLError,
+                        RecursionError) as exc:
                     where = xacro.filestack[-1] if xacro.filestack and xacro.filestack[-1] else str(path)
                     raise RobotkitError(_problem(exc, state, where, path)) from None
             includes = sorted({os.path.abspath(f) for f in xacro.all_includes})
@@ -263,6 +265,8 @@ def _problem(exc: BaseException, state: _State, where: str, top: Path) -> Proble
         if os.path.abspath(str(missing)) == str(top):
             return Problem("file not found", file=str(top))
         return Problem(f"file not found: {_show(missing)}", file=where)
+    if isinstance(exc, RecursionError):
+        return Problem("xacro: expansion recurses without end (a macro that calls itself?)", file=where)
     inner = getattr(exc, "exc", None)
     import xacro.substitution_args as sa
 

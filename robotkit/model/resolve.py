@@ -95,7 +95,7 @@ def resolve(loaded: LoadedRecipe) -> Robot:
     for name, link in r.links.items():
         lp = ("links", name)
         ispec = link.inertial
-        policy = (ispec.open_mesh if ispec and ispec.open_mesh else None) or r.open_mesh
+        policy = (ispec.open_mesh if ispec and ispec != "none" and ispec.open_mesh else None) or r.open_mesh
         visuals = []
         for i, g in _indexed(link.visual):
             geom = make_geom(g, lp + ("visual",) + i, name, policy)
@@ -112,7 +112,7 @@ def resolve(loaded: LoadedRecipe) -> Robot:
                 geom = make_geom(g, lp + ("collision",) + i, name, policy)
                 if geom is not None:
                     collisions.append(geom)
-        spec = _inertial_spec(ispec, r.density)
+        spec = InertialSpec("none") if ispec == "none" else _inertial_spec(ispec, r.density)
         source = visuals if spec.source == "visual" else collisions
         if spec.mode in ("density", "mass") and not source:
             if ispec is None:
@@ -122,6 +122,10 @@ def resolve(loaded: LoadedRecipe) -> Robot:
                                               f"computing the inertial needs {spec.source} geometry, and the link has none"))
         if spec.mode == "explicit":
             problems.extend(_check_explicit(spec.explicit, marks, lp + ("inertial",)))
+        # meshes no inertial is computed from may be open: they are only drawn and collided
+        computed = spec.mode in ("density", "mass")
+        visuals = [g if computed and spec.source == "visual" else _display_only(g) for g in visuals]
+        collisions = [g if computed and spec.source == "collision" else _display_only(g) for g in collisions]
         contact = None
         if link.contact is not None:
             c = link.contact
@@ -292,6 +296,14 @@ def _defaults(kind: str) -> dict:
 
     model = {"lidar": schema.LidarParams, "sonar": schema.SonarParams, "imu": schema.ImuParams}[kind]
     return model().model_dump()
+
+
+def _display_only(geom: Geom) -> Geom:
+    m = geom.shape.mesh
+    if m is None or m.open_mesh == "visual-only":
+        return geom
+    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((m.source, m.scale, 'visual-only')))}"
+    return replace(geom, shape=replace(geom.shape, mesh=replace(m, open_mesh="visual-only", key=key)))
 
 
 def _indexed(value):
@@ -523,8 +535,15 @@ __all__ = ["resolve", "finalize", "compute_inertial", "rpy_matrix"]
 
 
 def finalize_link_inertial(link: Link, facts: dict) -> Inertial | None:
-    """One link's inertial, with recentering offsets applied to its geometry first."""
-    return compute_inertial(_with_offsets(link, facts), facts)
+    """One link's inertial, with recentering offsets applied to its source geometry first."""
+    def fix(geoms):
+        return tuple(replace(g, offset=recenter_offset(g, facts)) for g in geoms)
+
+    if link.inertial_spec.source == "collision":
+        link = replace(link, collisions=fix(link.collisions))
+    else:
+        link = replace(link, visuals=fix(link.visuals))
+    return compute_inertial(link, facts)
 
 
 def _with_offsets(link: Link, facts: dict) -> Link:

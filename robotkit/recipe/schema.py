@@ -196,8 +196,10 @@ class Link(Strict):
     """Visual geometry: one shape or a list of shapes."""
     collision: CollisionSpec = "visual"
     """Collision geometry: ``visual`` (the same shapes as the visual), ``none``, or shapes of its own."""
-    inertial: Inertial | None = None
-    """Mass properties. Default: computed from the geometry at the recipe's density; a link with no geometry gets none."""
+    inertial: Annotated[
+        Annotated[Inertial, Tag("shape")] | Annotated[Literal["none"], Tag("keyword")], Discriminator(_form)
+    ] | None = None
+    """Mass properties. Default: computed from the geometry at the recipe's density; a link with no geometry gets none. ``none``: the link has no inertial even though it has geometry (a frame with a marker shape)."""
     contact: Contact | None = None
     """Friction and contact parameters of the link's collision geometry."""
 
