@@ -84,17 +84,17 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
-    copies: dict[str, tuple[str, str]] = {}
+    copies: dict[str, tuple[str, list[str]]] = {}
     for key, mesh in robot.meshes().items():
-        copies.setdefault(mesh.file_name, (mesh.source, facts[key]))
+        copies.setdefault(mesh.file_name, (mesh.source, []))[1].append(facts[key])
     for file_name, (source, checked) in sorted(copies.items()):
         target = str(root / "meshes" / "visual" / file_name)
         tasks.append({
             "name": f"{robot.name}:copy:{file_name}",
             "doc": f"visual mesh {file_name}",
             "actions": [(actions.copy_file, [source, target])],
-            # after its mesh task: a file that cannot be read is never copied
-            "file_dep": [source, checked],
+            # after its mesh tasks: a file that cannot be used is never copied
+            "file_dep": [source, *checked],
             "targets": [target],
             "clean": True,
         })
@@ -103,12 +103,12 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
 
     for rel, source in sorted(converted_meshes(robot).items()):
         target = str(root / "meshes" / rel)
-        key = next(k for k, m in robot.meshes().items() if m.source == source)
+        checked = [facts[k] for k, m in robot.meshes().items() if m.source == source]
         tasks.append({
             "name": f"{robot.name}:convert:{rel}",
             "doc": f"meshes/{rel} for MuJoCo",
             "actions": [(actions.convert_mesh, [source, target])],
-            "file_dep": [source, facts[key]],
+            "file_dep": [source, *checked],
             "targets": [target],
             "uptodate": [config_changed({"version": actions.FACTS_VERSION})],
             "clean": True,

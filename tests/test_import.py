@@ -502,7 +502,8 @@ def test_link_without_inertial_but_with_geometry(tmp_path):
     otherwise says so in a warning."""
     urdf = _write(tmp_path / "r.urdf", """
         <robot name="r">
-          <link name="base"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial></link>
+          <link name="base"><inertial><mass value="1"/>
+            <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
           <joint name="j" type="fixed"><parent link="base"/><child link="cover"/></joint>
           <link name="cover"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
         </robot>

@@ -204,6 +204,7 @@ def resolve(loaded: LoadedRecipe) -> Robot:
         if not os.path.isfile(w.map):
             problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' does not exist"))
         worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall))
+    links = _share_mesh_tasks(links)
     if loaded.partial != "tree":  # joints dropped as invalid would show as false tree problems
         problems.extend(_check_tree(link_names, joints, marks))
     if problems:
@@ -296,6 +297,26 @@ def _defaults(kind: str) -> dict:
 
     model = {"lidar": schema.LidarParams, "sonar": schema.SonarParams, "imu": schema.ImuParams}[kind]
     return model().model_dump()
+
+
+def _share_mesh_tasks(links: list[Link]) -> list[Link]:
+    """A display-only mesh whose file and scale an inertial also uses shares that (stricter)
+    mesh task instead of a second one."""
+    strict = {}
+    for link in links:
+        for g in link.visuals + link.collisions:
+            m = g.shape.mesh
+            if m is not None and m.open_mesh != "visual-only":
+                strict.setdefault((m.source, m.scale), m)
+
+    def share(g: Geom) -> Geom:
+        m = g.shape.mesh
+        if m is None or m.open_mesh != "visual-only" or (m.source, m.scale) not in strict:
+            return g
+        return replace(g, shape=replace(g.shape, mesh=strict[(m.source, m.scale)]))
+
+    return [replace(link, visuals=tuple(map(share, link.visuals)), collisions=tuple(map(share, link.collisions)))
+            for link in links]
 
 
 def _display_only(geom: Geom) -> Geom:
