@@ -151,8 +151,8 @@ def _same_file(a: str, b: str) -> bool:
 
 
 @_user_errors_fail
-def world(map_yaml: str, out_dir: str, name: str, height: float, unknown_as_wall: bool):
-    """One world from an occupancy map (robotkit.world)."""
+def world(map_yaml: str, out_dir: str, name: str, height: float, unknown_as_wall: bool, robot: dict | None = None):
+    """One world from an occupancy map (robotkit.world), optionally with the robot placed in it."""
     from robotkit.world import build_world
 
-    build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall)
+    build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall, robot=robot)

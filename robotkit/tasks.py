@@ -177,14 +177,20 @@ def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
         root = out_dir / w.name
         targets = [root / "model.config", root / "model.sdf", root / "meshes" / f"{w.name}.stl",
                    root / f"{w.name}.world", root / "scene.xml"]
+        spawn = None
+        if w.spawn is not None:
+            from robotkit.emit.mjcf import quat
+
+            spawn = {"name": robot.name, "root": robot.root, "xyz": list(w.spawn.xyz), "rpy": list(w.spawn.rpy),
+                     "quat": list(quat(w.spawn.rpy))}
         tasks.append({
             "name": f"world:{w.name}",
             "doc": f"world {w.name} from {os.path.basename(w.map)}",
-            "actions": [(actions.world, [w.map, str(out_dir), w.name, w.height, w.unknown_as_wall])],
+            "actions": [(actions.world, [w.map, str(out_dir), w.name, w.height, w.unknown_as_wall, spawn])],
             "file_dep": [w.map] + _map_image(w.map),
             "targets": [str(t) for t in targets],
             "uptodate": [config_changed({"height": w.height, "unknown_as_wall": w.unknown_as_wall,
-                                         "templates": _world_templates()})],
+                                         "spawn": spawn, "templates": _world_templates()})],
             "clean": True,
         })
     return tasks

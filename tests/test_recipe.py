@@ -313,3 +313,32 @@ def test_recipe_world_with_a_missing_map(tmp_path):
         build([recipe], tmp_path / "out")
     assert [str(p).split(": ", 1)[1] for p in err.value.problems] == [
         "worlds.w.map: map file '" + str(tmp_path / "nowhere.yaml") + "' does not exist"]
+
+
+def test_recipe_world_with_the_robot_spawned(tmp_path, assets):
+    import os
+    import subprocess
+
+    from validators import mujoco, require
+
+    shutil.copytree(assets / "maps" / "turtlebot3_world", tmp_path / "maps" / "tb3")
+    text = (RECIPES / "rover.yaml").read_text()
+    recipe = tmp_path / "rover.yaml"
+    recipe.write_text(text + "\nworlds:\n  tb3: {map: maps/tb3/map.yaml, height: 0.5, "
+                             "spawn: {xyz: [-2.0, -0.5, 0.01], rpy: [0, 0, 1.5707963267948966]}}\n")
+    build([recipe], tmp_path / "out")
+    world = tmp_path / "out" / "tb3" / "tb3.world"
+    root = ET.parse(world).getroot()
+    assert root.findtext("world/include/uri") == "model://rover"
+    assert "gz-sim-sensors-system" in {p.get("filename") for p in root.iter("plugin")}
+    # libsdformat finds model://rover through SDF_PATH, as Gazebo does through its resource path
+    proc = subprocess.run([require("ign"), "sdf", "-k", str(world)], capture_output=True, text=True,
+                          env={**os.environ, "SDF_PATH": str(tmp_path / "out")})
+    assert "Valid" in proc.stdout, proc.stdout + proc.stderr
+    mj = mujoco()
+    model = mj.MjModel.from_xml_path(str(tmp_path / "out" / "tb3" / "scene.xml"))
+    data = mj.MjData(model)
+    for _ in range(300):
+        mj.mj_step(model, data)
+    np.testing.assert_allclose(data.qpos[:2], [-2.0, -0.5], atol=1e-3)  # standing where it was put
+    assert model.nsensor == 68

@@ -203,7 +203,8 @@ def resolve(loaded: LoadedRecipe) -> Robot:
     for name, w in r.worlds.items():
         if not os.path.isfile(w.map):
             problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' does not exist"))
-        worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall))
+        spawn = Pose(_t(w.spawn.xyz), _t(w.spawn.rpy)) if w.spawn is not None else None
+        worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall, spawn))
     links = _share_mesh_tasks(links)
     if loaded.partial != "tree":  # joints dropped as invalid would show as false tree problems
         problems.extend(_check_tree(link_names, joints, marks))

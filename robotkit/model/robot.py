@@ -238,6 +238,7 @@ class World:
     map: str  # absolute path of the map_server YAML
     height: float = 2.0
     unknown_as_wall: bool = False
+    spawn: Pose | None = None
 
 
 @dataclass(frozen=True)

@@ -405,6 +405,8 @@ class World(Strict):
     """Wall height in metres."""
     unknown_as_wall: bool = False
     """Treat unknown cells as walls (default: free space)."""
+    spawn: Origin | None = None
+    """Place this recipe's robot in the world (Gazebo world and MuJoCo scene) at this pose in the map frame."""
 
 
 class Recipe(Strict):

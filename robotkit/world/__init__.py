@@ -41,14 +41,15 @@ def wall_mesh(occupancy_map: "OccupancyMap", height: float = 2.0, *, unknown_as_
 
 
 def build_world(map_yaml: str | os.PathLike, out_dir: str | os.PathLike, name: str | None = None,
-                height: float = 2.0, unknown_as_wall: bool = False) -> list[Path]:
+                height: float = 2.0, unknown_as_wall: bool = False, robot: dict | None = None) -> list[Path]:
     """Write ``out_dir/<name>/`` (name: the YAML's stem by default); return the five file paths.
 
     Nothing is written when the map, the name or the height is unusable (MapError).
     """
     from robotkit.world.emit import build_world as _build_world
 
-    return _build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall)
+    return _build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall,
+                        robot=robot)
 
 
 def __getattr__(attr):

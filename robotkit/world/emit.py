@@ -103,8 +103,12 @@ def _num(x: float) -> str:
     return fmt(x)
 
 
-def render_world(name: str, occupancy_map, height: float = 2.0, unknown_as_wall: bool = False) -> dict[str, bytes]:
-    """Every output file of the world, by path relative to ``DIR/<name>/``, as bytes."""
+def render_world(name: str, occupancy_map, height: float = 2.0, unknown_as_wall: bool = False,
+                 robot: dict | None = None) -> dict[str, bytes]:
+    """Every output file of the world, by path relative to ``DIR/<name>/``, as bytes.
+
+    ``robot`` (name, root, xyz, rpy, quat) places a robot built into the same output folder
+    in the world and the scene."""
     from robotkit.emit.env import render
     from robotkit.world.walls import mask_mesh, rectangles, wall_cells
 
@@ -115,13 +119,13 @@ def render_world(name: str, occupancy_map, height: float = 2.0, unknown_as_wall:
         "model.config": render("world/model.config.j2", w=w).encode("utf-8"),
         "model.sdf": render("world/model.sdf.j2", w=w).encode("utf-8"),
         f"meshes/{name}.stl": mesh.export(file_type="stl"),
-        f"{name}.world": render("world/world.sdf.j2", w=w).encode("utf-8"),
-        "scene.xml": render("world/scene.xml.j2", w=w).encode("utf-8"),
+        f"{name}.world": render("world/world.sdf.j2", w=w, robot=robot).encode("utf-8"),
+        "scene.xml": render("world/scene.xml.j2", w=w, robot=robot).encode("utf-8"),
     }
 
 
 def build_world(map_yaml: str | os.PathLike, out_dir: str | os.PathLike, name: str | None = None,
-                height: float = 2.0, unknown_as_wall: bool = False) -> list[Path]:
+                height: float = 2.0, unknown_as_wall: bool = False, robot: dict | None = None) -> list[Path]:
     """Read ``map_yaml`` and write the world folder ``out_dir/<name>/``; return the five paths.
 
     ``name`` defaults to the YAML file's stem.  Raises MapError (nothing written) when the
@@ -145,7 +149,7 @@ def build_world(map_yaml: str | os.PathLike, out_dir: str | os.PathLike, name: s
         problems.extend(exc.problems)
     if problems:
         raise MapError(problems)
-    files = render_world(name, occupancy_map, float(height), unknown_as_wall)
+    files = render_world(name, occupancy_map, float(height), unknown_as_wall, robot)
     folder = Path(out_dir) / name
     paths = []
     for rel, data in files.items():
