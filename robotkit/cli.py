@@ -95,8 +95,12 @@ def _build(args) -> int:
     start = time.perf_counter()
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
     result = build(args.recipes, args.out, jobs=args.jobs, echo=echo)
-    for w in result.warnings:
-        print(f"warning: {w}", file=sys.stderr)
+    if result.ran or args.verbose:
+        for w in result.warnings:
+            print(f"warning: {w}", file=sys.stderr)
+    elif result.warnings:  # unchanged since they were shown; keep a no-op build quiet
+        print(f"{len(result.warnings)} warnings, unchanged since the last build (-v shows them; "
+              "report.json lists what each format could not express)", file=sys.stderr)
     if result.errors:
         for name, msg in result.errors:
             print(f"robotkit: internal error in task {name}:\n{msg}", file=sys.stderr)
