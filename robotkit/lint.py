@@ -414,20 +414,14 @@ def _box_check(link: LinkFacts, eig, points: np.ndarray, s: str) -> list[Finding
                                                        vals[0] + vals[1] - vals[2]])))
     local = (points - link.com) @ vecs
     extent = local.max(axis=0) - local.min(axis=0)
-    worst, axis = 1.0, 0
-    for k in range(3):
-        if extent[k] <= 1e-9 and dims[k] <= 1e-9:
-            continue
-        ratio = max(dims[k], 1e-12) / max(extent[k], 1e-12)
-        if ratio > worst:
-            worst, axis = ratio, k
+    worst = max([max(dims[k], 1e-12) / max(extent[k], 1e-12) for k in range(3)
+                 if extent[k] > 1e-9 or dims[k] > 1e-9] or [1.0])
     if worst <= math.sqrt(3) * BOX_WARNING:
         return []
     severity = "error" if worst > math.sqrt(3) * BOX_ERROR else "warning"
-    direction = "larger"
     return [Finding(severity, "inertia-box", s,
                     f"the equivalent inertia box ({' x '.join(f'{d:.3g}' for d in dims)} m) is {worst:.3g}x "
-                    f"{direction} than the geometry ({' x '.join(f'{e:.3g}' for e in extent)} m) along a principal axis",
+                    f"larger than the geometry ({' x '.join(f'{e:.3g}' for e in extent)} m) along a principal axis",
                     "the inertia does not fit the part: hand-typed or in the wrong units?")]
 
 

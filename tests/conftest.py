@@ -46,3 +46,14 @@ def tree_bytes(folder: Path) -> dict[str, bytes]:
     """Every output file below ``folder`` (state folder excluded), by relative path."""
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*"))
             if p.is_file() and ".robotkit" not in p.parts}
+
+
+def assert_golden(got_path: Path, golden: Path):
+    """Compare a generated file with its checked-in golden copy (ROBOTKIT_UPDATE_GOLDEN=1 rewrites it)."""
+    import os
+
+    got = got_path.read_text(encoding="utf-8")
+    if os.environ.get("ROBOTKIT_UPDATE_GOLDEN"):
+        golden.parent.mkdir(parents=True, exist_ok=True)
+        golden.write_text(got, encoding="utf-8")
+    assert got == golden.read_text(encoding="utf-8"), f"{got_path.name} differs from {golden}"

@@ -4,11 +4,8 @@ clean one; real cases from the assets; exit codes; report formats that parse."""
 from __future__ import annotations
 
 import json
-import shutil
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
-import numpy as np
 import pytest
 import trimesh
 

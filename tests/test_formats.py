@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import shutil
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -14,10 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import GOLDEN, RECIPES, run_cli, write_recipe
+from conftest import GOLDEN, assert_golden, RECIPES, run_cli, write_recipe
 from robotkit.build import build
 from robotkit.verify import equivalence, smoke_test
-from robotkit.verify import kinematics as k
 from validators import check_urdf, ign_sdf_check, mujoco, require
 
 EXAMPLES = sorted(p.stem for p in RECIPES.glob("*.yaml"))
@@ -70,12 +68,7 @@ def test_model_config_points_at_model_sdf(examples):
 
 @pytest.mark.parametrize("rel", ["model.sdf", "mjcf/turret_bot.xml", "mjcf/scene.xml"])
 def test_golden_files(examples, rel):
-    golden = GOLDEN / "turret_bot" / rel
-    got = (examples / "turret_bot" / rel).read_text(encoding="utf-8")
-    if os.environ.get("ROBOTKIT_UPDATE_GOLDEN"):
-        golden.parent.mkdir(parents=True, exist_ok=True)
-        golden.write_text(got, encoding="utf-8")
-    assert got == golden.read_text(encoding="utf-8"), f"{rel} differs from {golden}"
+    assert_golden(examples / "turret_bot" / rel, GOLDEN / "turret_bot" / rel)
 
 
 # ------------------------------------------------------------ the check can fail

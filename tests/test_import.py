@@ -516,7 +516,7 @@ def test_link_without_inertial_but_with_geometry(tmp_path):
         assert any("link 'cover' has no inertial" in w and "adds mass" in w for w in result.warnings)
     else:
         assert data["links"]["cover"]["inertial"] == form
-        built = build([result.recipe_path], tmp_path / "build")
+        build([result.recipe_path], tmp_path / "build")
         assert compare(read_urdf(urdf), read_urdf(tmp_path / "build/r/urdf/r.urdf"), TOL) == []
 
 

@@ -3,7 +3,6 @@ determinism, and incremental rebuilds asserted through doit's own record."""
 
 from __future__ import annotations
 
-import os
 import shutil
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -12,7 +11,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from conftest import GOLDEN, RECIPES, run_cli, tree_bytes
+from conftest import GOLDEN, assert_golden, RECIPES, run_cli, tree_bytes
 from robotkit.build import build
 from validators import check_urdf
 
@@ -103,12 +102,7 @@ def test_joints_match_the_original_urdf(built, assets):
 
 @pytest.mark.parametrize("rel", ["urdf/turret_bot.urdf", "model.config", "package.xml"])
 def test_golden_files(built, rel):
-    golden = GOLDEN / "turret_bot" / rel
-    got = (built / "turret_bot" / rel).read_text(encoding="utf-8")
-    if os.environ.get("ROBOTKIT_UPDATE_GOLDEN"):
-        golden.parent.mkdir(parents=True, exist_ok=True)
-        golden.write_text(got, encoding="utf-8")
-    assert got == golden.read_text(encoding="utf-8"), f"{rel} differs from {golden} (ROBOTKIT_UPDATE_GOLDEN=1 rewrites it)"
+    assert_golden(built / "turret_bot" / rel, GOLDEN / "turret_bot" / rel)
 
 
 def test_two_builds_are_byte_identical(built, tmp_path):

@@ -258,7 +258,7 @@ def _sensors(r, marks, problems, make_geom, sources, base_dir):
                 joints.append(Joint(jname, "fixed", parent, child, Pose(tuple(xyz), tuple(rpy))))
             given = {k: getattr(s.camera, k) for k in s.camera.model_fields_set} if s.camera else {}
             for sname, stype, link, optical, hfov in fsensors:
-                params = {**CameraDefaults(), "near": 0.1, "far": 10.0, "hfov": hfov, **given}
+                params = {**_defaults("camera"), "near": 0.1, "far": 10.0, "hfov": hfov, **given}
                 sensors.append(Sensor(sname, stype, link, float(s.update_rate), f"{topic}/{sname[len(name) + 1:]}",
                                       params, optical))
             continue
@@ -275,9 +275,8 @@ def _sensors(r, marks, problems, make_geom, sources, base_dir):
             spec = InertialSpec("mass", mass=float(s.body.mass))
         links.append(Link(frame, visuals, collisions, spec))
         joints.append(Joint(f"{frame}_joint", "fixed", s.parent, frame, origin))
-        params = getattr(s, {"camera": "camera", "depth": "camera"}.get(s.type, s.type))
-        params = params.model_dump() if params is not None else \
-            {"camera": CameraDefaults, "depth": CameraDefaults}.get(s.type, lambda: None)() or _defaults(s.type)
+        given = getattr(s, "camera" if s.type in ("camera", "depth") else s.type)
+        params = given.model_dump() if given is not None else _defaults(s.type)
         optical = None
         if s.type in ("camera", "depth"):
             optical = f"{name}_optical_frame"
@@ -287,16 +286,11 @@ def _sensors(r, marks, problems, make_geom, sources, base_dir):
     return links, joints, sensors
 
 
-def CameraDefaults():
-    from robotkit.recipe.schema import CameraParams
-
-    return CameraParams().model_dump()
-
-
 def _defaults(kind: str) -> dict:
     from robotkit.recipe import schema
 
-    model = {"lidar": schema.LidarParams, "sonar": schema.SonarParams, "imu": schema.ImuParams}[kind]
+    model = {"camera": schema.CameraParams, "depth": schema.CameraParams, "lidar": schema.LidarParams,
+             "sonar": schema.SonarParams, "imu": schema.ImuParams}[kind]
     return model().model_dump()
 
 
@@ -513,44 +507,6 @@ def inertial_from_json(data) -> Inertial | None:
     if data is None:
         return None
     return Inertial(data["mass"], tuple(data["com"]), tuple(data["inertia"]))
-
-
-def link_frame_poses(robot: Robot, q: dict[str, float] | None = None) -> dict[str, np.ndarray]:
-    """4x4 pose of every link frame relative to the root at joint positions ``q``."""
-    q = q or {}
-    T = {robot.root: np.eye(4)}
-    children: dict[str, list[Joint]] = {}
-    for j in robot.joints:
-        children.setdefault(j.parent, []).append(j)
-    stack = [robot.root]
-    while stack:
-        parent = stack.pop()
-        for j in children.get(parent, []):
-            M = T[parent] @ j.origin.matrix()
-            value = q.get(j.name, 0.0)
-            if j.mimic is not None:
-                value = j.mimic.multiplier * q.get(j.mimic.joint, 0.0) + j.mimic.offset
-            axis = np.asarray(j.axis)
-            if j.type in ("revolute", "continuous") and value:
-                M = M @ _axis_angle(axis, value)
-            elif j.type == "prismatic" and value:
-                D = np.eye(4)
-                D[:3, 3] = axis * value
-                M = M @ D
-            T[j.child] = M
-            stack.append(j.child)
-    return T
-
-
-def _axis_angle(axis, angle) -> np.ndarray:
-    x, y, z = axis
-    c, s = math.cos(angle), math.sin(angle)
-    C = 1 - c
-    M = np.eye(4)
-    M[:3, :3] = [[c + x * x * C, x * y * C - z * s, x * z * C + y * s],
-                 [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
-                 [z * x * C - y * s, z * y * C + x * s, c + z * z * C]]
-    return M
 
 
 __all__ = ["resolve", "finalize", "compute_inertial", "rpy_matrix"]
