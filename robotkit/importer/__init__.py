@@ -182,9 +182,8 @@ def mesh_is_closed(source: str, scale) -> bool:
 
 
 def _open_meshes(conv, recipe: dict, warnings: list[str], recompute: bool) -> None:
-    """robotkit's build loads every mesh as a closed volume, also meshes that only show (an
-    explicit inertial does not read them); a mesh that is not closed needs ``open_mesh: hull``
-    on its link's inertial, or on the recipe when the link has no inertial mapping."""
+    """A mesh that is not a closed volume needs ``open_mesh: hull`` only where an inertial is
+    computed from it (robotkit accepts open meshes that are only drawn and collided)."""
     open_by_link: dict[str, list[tuple[str, str]]] = {}
     for (link, kind, _i), use in conv.meshes.items():
         if not mesh_is_closed(use.source, use.scale):
@@ -194,23 +193,23 @@ def _open_meshes(conv, recipe: dict, warnings: list[str], recompute: bool) -> No
     top_level = []
     for link, found in open_by_link.items():
         spec = recipe["links"][link].get("inertial")
-        files = ", ".join(dict.fromkeys(name for _, name in found))
+        if spec == "none" or (isinstance(spec, dict) and "inertia" in spec):
+            continue  # no inertial is computed from the link's geometry
+        source = spec.get("source", "visual") if isinstance(spec, dict) else "visual"
+        read = [name for kind, name in found if kind == source]
+        if not read:
+            continue
+        files = ", ".join(dict.fromkeys(read))
         if isinstance(spec, dict):
             spec["open_mesh"] = "hull"
-            source = spec.get("source", "visual")
-            if "inertia" in spec or not any(kind == source for kind, _ in found):
-                warnings.append(f"link '{link}': mesh {files} is not a closed volume; the recipe sets "
-                                "open_mesh: hull so that it builds (the hull is not used: the inertial "
-                                f"{'is explicit' if 'inertia' in spec else 'comes from the ' + source + ' geometry'})")
-            else:
-                warnings.append(f"link '{link}': mesh {files} is not a closed volume; its recomputed inertial "
-                                "uses the convex hull (open_mesh: hull)")
+            warnings.append(f"link '{link}': mesh {files} is not a closed volume; its recomputed inertial "
+                            "uses the convex hull (open_mesh: hull)")
         else:
             top_level.append(f"{link} ({files})")
     if top_level:
         recipe["open_mesh"] = "hull"
-        warnings.append("meshes that are not closed volumes on links without an inertial: "
-                        f"{'; '.join(top_level)}; the recipe sets open_mesh: hull so that it builds")
+        warnings.append("meshes that are not closed volumes on links whose inertial is computed from them: "
+                        f"{'; '.join(top_level)}; the recipe sets open_mesh: hull")
 
 
 # ---------------------------------------------------------------- recomputed inertials
