@@ -156,3 +156,121 @@ def world(map_yaml: str, out_dir: str, name: str, height: float, unknown_as_wall
     from robotkit.world import build_world
 
     build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall, robot=robot)
+
+
+def _cache():
+    from robotkit.mesh.cache import Cache
+
+    return Cache()
+
+
+@_user_errors_fail
+def process_visual(source: str, scale, decimate, repair: bool, where: dict, target: str, report: str):
+    """A processed visual mesh: repaired and decimated, written as a binary STL in metres."""
+    from robotkit.mesh.decimate import decimate as run_decimate
+    from robotkit.mesh.export import stl_bytes
+    from robotkit.mesh.io import load_mesh
+    from robotkit.mesh.repair import repair as run_repair
+
+    loc = Problem("", **where)
+    mesh = load_mesh(source, scale, loc)
+    info: dict = {"source": _display(source)}
+    if repair:
+        mesh, info["repair"] = run_repair(mesh)
+    kind, value = decimate
+    faces = len(mesh.faces)
+    target_faces = int(value) if kind == "faces" else max(4, int(round(faces * float(value))))
+    if target_faces > faces:
+        raise RobotkitError(Problem(f"decimation target {target_faces} faces is above the mesh's {faces} "
+                                    f"faces ('{_display(source)}')", **where))
+
+    def compute():
+        out, rep = run_decimate(mesh, target_faces=target_faces)
+        return out, rep
+
+    out, rep = _cache().get_or_compute("decimate", {"faces": target_faces}, [mesh], compute)
+    info["decimate"] = rep
+    write_if_changed(target, stl_bytes(out))
+    write_if_changed(report, dump_json(_plain(info)))
+
+
+def _plain(value):
+    """JSON-able copy (numpy numbers and arrays to Python)."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+@_user_errors_fail
+def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: str, where: dict, target: str):
+    """Collision pieces for one mesh and strategy (cached), their files, and a fidelity report."""
+    import os
+
+    from robotkit.mesh.export import stl_bytes
+    from robotkit.mesh.fidelity import fidelity
+    from robotkit.mesh.io import load_mesh
+    from robotkit.mesh.repair import repair as run_repair
+
+    loc = Problem("", **where)
+    mesh = load_mesh(source, scale, loc)
+    info: dict = {"source": _display(source), "strategy": strategy}
+    if strategy["repair"]:
+        mesh, info["repair"] = run_repair(mesh)
+    kind = strategy["kind"]
+    params = {k: v for k, v in strategy.items() if k != "repair"}
+    try:
+        pieces = _proxy_pieces(mesh, kind, strategy, params)
+    except (ValueError, RuntimeError) as exc:
+        raise RobotkitError(Problem(f"collision '{kind}' of '{_display(source)}' failed: {exc}", **where)) from None
+    out_pieces = []
+    for i, piece in enumerate(pieces):
+        if hasattr(piece, "vertices"):
+            name = f"{stem}_{kind}_{i}.stl" if len(pieces) > 1 or kind != "mesh" else f"{stem}.stl"
+            write_if_changed(os.path.join(meshes_dir, name), stl_bytes(piece))
+            out_pieces.append({"kind": "mesh", "file": f"collision/{name}", "vertices": int(len(piece.vertices))})
+        else:
+            d = piece.to_dict()
+            out_pieces.append({"kind": d["kind"], **d["params"], "xyz": list(d["xyz"]), "rpy": list(d["rpy"])})
+    info["pieces"] = out_pieces
+    info["fidelity"] = fidelity(mesh, pieces)
+    write_if_changed(target, dump_json(_plain(info)))
+
+
+def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
+    cache = _cache()
+    if kind == "mesh":
+        if not strategy["decimate"]:
+            return [mesh]
+        how, value = strategy["decimate"]
+        faces = int(value) if how == "faces" else max(4, int(round(len(mesh.faces) * float(value))))
+        if faces > len(mesh.faces):
+            raise ValueError(f"decimation target {faces} faces is above the mesh's {len(mesh.faces)} faces")
+        from robotkit.mesh.decimate import decimate
+
+        return [cache.get_or_compute("decimate", {"faces": faces}, [mesh],
+                                     lambda: decimate(mesh, target_faces=faces, samples=0)[0])]
+    if kind == "hull":
+        from robotkit.mesh.hull import convex_hull
+
+        return [cache.get_or_compute("hull", {"max_vertices": strategy["max_vertices"]}, [mesh],
+                                     lambda: convex_hull(mesh, strategy["max_vertices"]))]
+    if kind == "decompose":
+        from robotkit.mesh.decompose import decompose
+
+        c = strategy["coacd"]
+        args = dict(threshold=c["threshold"], max_hulls=c["max_hulls"], resolution=c["resolution"],
+                    preprocess=c["preprocess"], preprocess_resolution=c["preprocess_resolution"], seed=c["seed"],
+                    max_hull_vertices=strategy["max_vertices"], mcts_iterations=c["mcts_iterations"])
+        value = cache.get_or_compute("coacd", args, [mesh], lambda: decompose(mesh, **args))
+        return value if isinstance(value, list) else [value]
+    from robotkit.mesh.primitives import fit
+
+    return [fit(mesh, kind)]

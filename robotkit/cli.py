@@ -105,6 +105,8 @@ def _build(args) -> int:
         for name, msg in result.errors:
             print(f"robotkit: internal error in task {name}:\n{msg}", file=sys.stderr)
         return 1
+    if result.ran:
+        _collision_summary(args.out, result.robots)
     elapsed = time.perf_counter() - start
     out = os.path.relpath(os.path.abspath(args.out))
     names = ", ".join(f"{out}/{r}" for r in result.robots)
@@ -113,6 +115,25 @@ def _build(args) -> int:
     else:
         print(f"{names}: up to date ({len(result.uptodate)} tasks, {elapsed:.2f} s)")
     return 0
+
+
+def _collision_summary(out: str, robots: list[str]) -> None:
+    """One line per collision proxy: strategy, pieces, volume against the visual, distance."""
+    import json
+
+    for name in robots:
+        try:
+            report = json.loads(open(os.path.join(out, name, "report.json"), encoding="utf-8").read())
+        except (OSError, ValueError):
+            continue
+        for entry in report.get("collision", {}).values():
+            f = entry["fidelity"]
+            ratio = f"{f['volume_ratio']:.3g}x the visual volume" if f.get("volume_ratio") else "visual not closed"
+            dist = f.get("distance") or {}
+            far = f", surface within {dist['max'] * 1000:.3g} mm" if dist.get("max") is not None else ""
+            largest = f", largest {f['largest_piece_vertices']} vertices" if f.get("largest_piece_vertices") else ""
+            print(f"collision {name}/{entry['source']}: {entry['strategy']}, {f['pieces']} piece"
+                  f"{'s' * (f['pieces'] != 1)}{largest}, {ratio}{far}", file=sys.stderr)
 
 
 def _world(args) -> int:

@@ -85,8 +85,45 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         })
 
     copies: dict[str, tuple[str, list[str]]] = {}
+    processed: dict[str, object] = {}
     for key, mesh in robot.meshes().items():
+        if mesh.processed:
+            processed.setdefault(mesh.path, mesh)
+            continue
         copies.setdefault(mesh.file_name, (mesh.source, []))[1].append(facts[key])
+    for rel, mesh in sorted(processed.items()):
+        target = str(root / "meshes" / rel)
+        report = str(state / "visual" / f"{mesh.key}.json")
+        tasks.append({
+            "name": f"{robot.name}:visual:{mesh.file_name}",
+            "doc": f"processed visual mesh {mesh.file_name}",
+            "actions": [(actions.process_visual, [mesh.source, list(mesh.scale), list(mesh.decimate), mesh.repair,
+                                                  where.get(mesh.key, {}), target, report])],
+            "file_dep": [mesh.source, facts[mesh.key]],
+            "targets": [target, report],
+            "uptodate": [config_changed({"scale": list(mesh.scale), "decimate": list(mesh.decimate),
+                                         "repair": mesh.repair, "version": actions.FACTS_VERSION})],
+            "clean": True,
+        })
+
+    proxies: dict[str, str] = {}
+    for key, shape in robot.proxies().items():
+        m = shape.mesh
+        target = str(state / "collision" / f"{key}.json")
+        proxies[key] = target
+        stem = os.path.splitext(m.file_name)[0]
+        tasks.append({
+            "name": f"{robot.name}:collision:{key[len('proxy-'):]}",
+            "doc": f"{shape.strategy.kind} collision of {os.path.basename(m.source)}",
+            "actions": [(actions.collision_proxy, [m.source, list(m.scale), shape.strategy.params(), stem,
+                                                   str(root / "meshes" / "collision"), where.get(m.key, {}),
+                                                   target])],
+            "file_dep": [m.source, facts[m.key]],
+            "targets": [target],
+            "uptodate": [config_changed({"scale": list(m.scale), "strategy": shape.strategy.params(),
+                                         "version": actions.FACTS_VERSION})],
+            "clean": True,
+        })
     for file_name, (source, checked) in sorted(copies.items()):
         target = str(root / "meshes" / "visual" / file_name)
         tasks.append({
@@ -133,9 +170,9 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         })
 
     # outputs need the facts of recentered meshes (their offsets) and every inertial
-    recentered = sorted({g.shape.mesh.key for link in robot.links for g in link.visuals + link.collisions
+    recentered = sorted({g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link)
                          if g.shape.mesh is not None and g.recenter != "none"})
-    out_facts = {k: facts[k] for k in recentered}
+    out_facts = {**{k: facts[k] for k in recentered}, **proxies}
     structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
     options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True}}
     for emitter, rel in OUTPUTS.items():
@@ -144,7 +181,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         target = str(root / rel(robot))
         opts = options.get(emitter, {})
         if emitter == "report":
-            subject, reads, facts_in, inertials_in = robot, structure, facts, inertials
+            subject, reads, facts_in, inertials_in = robot, structure, {**facts, **proxies}, inertials
         elif emitter in STRUCTURE_ONLY:
             subject, facts_in, inertials_in = robot, {}, {}
             reads = {"name": robot.name, "ros_control": robot.ros_control,
@@ -228,7 +265,7 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
     for name, link in loaded.recipe.links.items():
         for kind in ("visual", "collision"):
             value = getattr(link, kind)
-            if value is None or isinstance(value, str):
+            if value is None or isinstance(value, str) or hasattr(value, "strategy"):
                 continue
             items = [((i,), g) for i, g in enumerate(value)] if isinstance(value, list) else [((), value)]
             for idx, g in items:

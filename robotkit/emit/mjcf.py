@@ -34,7 +34,7 @@ def mesh_file(mesh) -> str:
     """The mesh file MJCF reads, relative to the robot's meshes/ folder (MuJoCo reads no DAE)."""
     stem, ext = os.path.splitext(mesh.file_name)
     if ext.lower() in MJCF_MESH_EXT:
-        return f"visual/{mesh.file_name}"
+        return mesh.path
     return f"mjcf/{stem}.stl"
 
 
@@ -42,6 +42,8 @@ def converted_meshes(robot: Robot) -> dict[str, str]:
     """Meshes that need converting for MJCF: output path below meshes/ -> source file."""
     out = {}
     for mesh in robot.meshes().values():
+        if mesh.processed:
+            continue
         rel = mesh_file(mesh)
         if rel.startswith("mjcf/"):
             out.setdefault(rel, mesh.source)
@@ -68,7 +70,7 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
         c = link.contact
         if c is not None and c.mu2 is not None and c.mu1 is not None and c.mu2 != c.mu1:
             out.append(f"link '{link.name}': MuJoCo friction is isotropic; mu2 {c.mu2:g} dropped, mu1 {c.mu1:g} used")
-        for g in link.collisions:
+        for g in link.collisions_for("mjcf"):
             if g.shape.mesh is not None and facts is not None:
                 f = facts.get(g.shape.mesh.key)
                 if f is not None and not f.get("convex", True):
@@ -86,11 +88,11 @@ def _geom(robot: Robot, geom: Geom, name: str, assets: dict) -> dict:
     ctx = {"name": name, "pos": pose.xyz, "quat": quat(pose.rpy), "type": s.kind,
            "material": geom.material}
     if s.kind == "mesh":
-        key = (mesh_file(s.mesh), s.mesh.scale)
+        key = (mesh_file(s.mesh), s.mesh.out_scale)
         ctx["mesh"] = assets[key]["name"]
     elif s.kind == "box":
         ctx["size"] = tuple(v / 2 for v in s.size)
-    elif s.kind == "cylinder":
+    elif s.kind in ("cylinder", "capsule"):
         ctx["size"] = (s.radius, s.length / 2)
     else:
         ctx["size"] = (s.radius,)
@@ -101,11 +103,11 @@ def _assets(robot: Robot) -> dict:
     assets: dict = {}
     used_names: set[str] = set()
     for link in robot.links:
-        for g in link.visuals + link.collisions:
+        for g in link.visuals + link.collisions_for("mjcf"):
             m = g.shape.mesh
             if m is None:
                 continue
-            key = (mesh_file(m), m.scale)
+            key = (mesh_file(m), m.out_scale)
             if key in assets:
                 continue
             base = os.path.splitext(m.file_name)[0]
@@ -114,7 +116,7 @@ def _assets(robot: Robot) -> dict:
                 n += 1
                 name = f"{base}_{n}"
             used_names.add(name)
-            assets[key] = {"name": name, "file": key[0], "scale": m.scale if any(v != 1 for v in m.scale) else None}
+            assets[key] = {"name": name, "file": key[0], "scale": key[1] if any(v != 1 for v in key[1]) else None}
     return assets
 
 
@@ -175,7 +177,7 @@ def context(robot: Robot) -> dict:
             "inertial": link.inertial,
             "visuals": [_geom(robot, g, f"{name}_visual_{i}", assets) for i, g in enumerate(link.visuals)],
             "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets), friction=friction, solref=solref)
-                           for i, g in enumerate(link.collisions)],
+                           for i, g in enumerate(link.collisions_for("mjcf"))],
             "children": [body(j.child, j) for j in by_parent.get(name, [])],
             "cameras": extras["cameras"],
             "sites": extras["sites"],

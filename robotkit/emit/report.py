@@ -32,4 +32,11 @@ def report(robot: Robot, facts: dict) -> dict:
         if link.inertial is not None:
             links[link.name] = {"mass": link.inertial.mass, "com": list(link.inertial.com),
                                 "inertia": list(link.inertial.inertia), "source": link.inertial_spec.mode}
-    return {"robot": robot.name, "losses": losses(robot, facts), "meshes": meshes, "inertials": links}
+    collision = {}
+    for key, f in sorted(facts.items()):
+        if "pieces" in f:
+            collision[key] = {"source": f["source"], "strategy": f["strategy"]["kind"], "pieces": f["pieces"],
+                              "fidelity": f["fidelity"], "repair": f.get("repair")}
+    meshes = {k: v for k, v in meshes.items() if k not in collision}
+    return {"robot": robot.name, "losses": losses(robot, facts), "meshes": meshes, "inertials": links,
+            "collision": collision}

@@ -68,7 +68,7 @@ def context(robot: Robot) -> dict:
             "sensors": [s for s in sensors if s["host"] == link.name],
             "visuals": [dict(geom_context(robot, g), uri=_uri(robot, g),
                              material=materials.get(g.material)) for g in link.visuals],
-            "collisions": [dict(geom_context(robot, g), uri=_uri(robot, g)) for g in link.collisions],
+            "collisions": [dict(geom_context(robot, g), uri=_uri(robot, g)) for g in link.collisions_for("sdf")],
             "inertial": link.inertial,
             "contact": link.contact,
         })
@@ -82,7 +82,7 @@ def context(robot: Robot) -> dict:
 def _uri(robot: Robot, geom) -> str | None:
     if geom.shape.mesh is None:
         return None
-    return f"model://{robot.name}/meshes/visual/{geom.shape.mesh.file_name}"
+    return f"model://{robot.name}/meshes/{geom.shape.mesh.path}"
 
 
 def render_sdf(robot: Robot) -> str:

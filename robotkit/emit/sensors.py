@@ -52,7 +52,7 @@ def sensor_context(robot: Robot, s: Sensor) -> dict:
     if s.type in ("lidar", "sonar"):
         ctx["scan"] = scan(s)
     if s.type == "contact":
-        n = len(robot.link(s.link).collisions)
+        n = len(robot.link(s.link).collisions_for("sdf"))
         ctx["collisions"] = [f"collision_{i}" for i in range(n)]
         # names libsdformat gives URDF collisions when it converts the URDF for Gazebo classic
         ctx["classic_collisions"] = [f"{s.link}_collision" + (f"_{i}" if i else "") for i in range(n)]

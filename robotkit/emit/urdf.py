@@ -7,7 +7,25 @@ from robotkit.model.robot import Geom, Robot
 
 
 def mesh_uri(robot: Robot, geom: Geom) -> str:
-    return f"package://{robot.name}/meshes/visual/{geom.shape.mesh.file_name}"
+    return f"package://{robot.name}/meshes/{geom.shape.mesh.path}"
+
+
+def urdf_geoms(geoms) -> list[Geom]:
+    """URDF has no capsule: a cylinder and two spheres make the same shape."""
+    from dataclasses import replace
+
+    from robotkit.model.robot import Shape
+
+    out = []
+    for g in geoms:
+        s = g.shape
+        if s.kind != "capsule":
+            out.append(g)
+            continue
+        out.append(replace(g, shape=Shape("cylinder", radius=s.radius, length=s.length)))
+        for z in (-s.length / 2, s.length / 2):
+            out.append(replace(g, shape=Shape("sphere", radius=s.radius), offset=(0.0, 0.0, z)))
+    return out
 
 
 def geom_context(robot: Robot, geom: Geom) -> dict:
@@ -16,7 +34,7 @@ def geom_context(robot: Robot, geom: Geom) -> dict:
     ctx = {"xyz": pose.xyz, "rpy": pose.rpy, "kind": s.kind, "material": geom.material}
     if s.kind == "mesh":
         ctx["uri"] = mesh_uri(robot, geom)
-        ctx["scale"] = s.mesh.scale if any(v != 1.0 for v in s.mesh.scale) else None
+        ctx["scale"] = s.mesh.out_scale if any(v != 1.0 for v in s.mesh.out_scale) else None
     elif s.kind == "box":
         ctx["size"] = s.size
     else:
@@ -38,7 +56,7 @@ def context(robot: Robot) -> dict:
         links.append({
             "name": link.name,
             "visuals": [geom_context(robot, g) for g in link.visuals],
-            "collisions": [geom_context(robot, g) for g in link.collisions],
+            "collisions": [geom_context(robot, g) for g in urdf_geoms(link.collisions_for("urdf"))],
             "inertial": link.inertial,
             "gazebo_material": gazebo_material,
             "contact": link.contact if link.collisions else None,

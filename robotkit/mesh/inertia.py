@@ -4,10 +4,10 @@ For a closed, consistently outward-wound mesh, the volume integrals are sums
 over the signed tetrahedra (reference point, a, b, c): one vectorised pass
 over the faces.  trimesh's ``mass_properties`` computes the same integrals;
 this version exists because it is a single pass over contiguous coordinate
-rows (about 10x faster than trimesh and 15-20x faster than pymeshlab on a
-500k-face mesh, see benchmarks/bench_mesh.py and docs/performance.md) and
-works about a reference point near the mesh to keep cancellation error small
-for meshes far from their origin.
+rows in cache-sized blocks of faces (on a 500k-face mesh about 30x faster
+than trimesh and 60x faster than pymeshlab, see benchmarks/bench_mesh.py and
+docs/performance.md) and works about a reference point near the mesh to keep
+cancellation error small for meshes far from their origin.
 Results are at unit density: multiply mass and inertia by the density.
 """
 
@@ -28,29 +28,40 @@ class MassProps:
         return self.volume * density, self.com, self.inertia * density
 
 
-def mesh_mass_properties(vertices: np.ndarray, faces: np.ndarray) -> MassProps:
+def mesh_mass_properties(vertices: np.ndarray, faces: np.ndarray, block: int = 1 << 15) -> MassProps:
     V = np.asarray(vertices, dtype=np.float64)
     F = np.asarray(faces)
     if F.dtype != np.intp:
         F = F.astype(np.intp)
-    # one coordinate per contiguous row: np.take on 1-D rows is several times faster than V[F]
+    # one coordinate per contiguous row (np.take on 1-D rows is several times faster than V[F]),
+    # and blocks of faces whose temporaries stay in cache (3.7x faster than whole arrays at 500k faces)
     Vt = np.ascontiguousarray(V.T).reshape(3, -1)
     Ft = np.ascontiguousarray(F.T).reshape(3, -1)
     ref = 0.5 * (Vt.min(axis=1) + Vt.max(axis=1))
     Vt = Vt - ref[:, None]
-    (ax, ay, az), (bx, by, bz), (cx, cy, cz) = ([np.take(Vt[k], Ft[j]) for k in range(3)] for j in range(3))
-    d = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)  # 6 x signed volume
-    volume = float(d.sum()) / 6.0
-    sx, sy, sz = ax + bx + cx, ay + by + cy, az + bz + cz
-    com_rel = np.array([d @ sx, d @ sy, d @ sz]) / 24.0 / volume
-    # integral of x x^T over the tetrahedra: d/120 (a a^T + b b^T + c c^T + s s^T), as one weighted product
-    P = np.stack([ax, ay, az, bx, by, bz, cx, cy, cz, sx, sy, sz])
-    G = (P * d) @ P.T
-    C = (G[0:3, 0:3] + G[3:6, 3:6] + G[6:9, 6:9] + G[9:12, 9:12]) / 120.0
+    six, first, C = 0.0, np.zeros(3), np.zeros((3, 3))
+    for lo in range(0, Ft.shape[1], block):
+        f = Ft[:, lo:lo + block]
+        A, B, Cc = ([np.take(Vt[k], f[j]) for k in range(3)] for j in range(3))
+        (ax, ay, az), (bx, by, bz), (cx, cy, cz) = A, B, Cc
+        d = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)  # 6 x signed volume
+        six += float(d.sum())
+        S = (ax + bx + cx, ay + by + cy, az + bz + cz)
+        # integral of x x^T over the tetrahedra: d/120 (a a^T + b b^T + c c^T + s s^T).  Element-wise
+        # products and numpy's pairwise sums, not a BLAS product: OpenBLAS threads made that 15x slower
+        # (20 ms instead of 1.4 ms on 34k faces) on a busy 2-core machine.
+        for j in range(3):
+            dj = (d * A[j], d * B[j], d * Cc[j], d * S[j])
+            first[j] += dj[3].sum()
+            for k in range(j, 3):
+                C[j, k] += (dj[0] * A[k] + dj[1] * B[k] + dj[2] * Cc[k] + dj[3] * S[k]).sum()
+    volume = six / 6.0
+    com_rel = first / 24.0 / volume
+    C = (np.triu(C) + np.triu(C, 1).T) / 120.0
     C_com = C - volume * np.outer(com_rel, com_rel)
     inertia = np.trace(C_com) * np.eye(3) - C_com
     inertia = 0.5 * (inertia + inertia.T)
-    return MassProps(volume, ref + com_rel, inertia)
+    return MassProps(float(volume), ref + com_rel, inertia)
 
 
 def box_props(size) -> MassProps:

@@ -24,8 +24,8 @@ Library parts and hand-written parts:
   makes every closed body's volume positive, which turns the inner shell of a
   hollow part (a cavity, correctly inward) outward and adds the cavity's volume
   instead of subtracting it.  Here a closed body lying entirely inside another
-  closed body (winding-number test) keeps the orientation most of its faces had
-  in the input, and every other closed body is made outward.
+  closed body (winding-number test), and every open body, keeps the orientation
+  most of its faces had in the input; every other closed body is made outward.
 """
 
 from __future__ import annotations
@@ -44,7 +44,9 @@ def repair(mesh, fill_holes: bool = True, *,
     ``nonfinite_faces_removed``, ``vertices_merged``, ``duplicate_faces_removed``,
     ``degenerate_faces_removed``, ``unreferenced_vertices_removed``,
     ``faces_flipped`` (input faces whose orientation changed),
-    ``bodies_inverted`` (closed bodies turned inside out as a whole),
+    ``bodies_inverted`` (connected bodies turned around as a whole, after the
+    winding fix: closed bodies made outward, other bodies back to the orientation
+    most of their input faces had),
     ``nested_bodies`` (closed bodies inside another: cavities or embedded parts),
     ``holes_found``, ``holes_filled``, ``faces_added``, ``vertices_added``,
     ``holes_left`` (open loops too large or ambiguous to fill),
@@ -210,28 +212,24 @@ def _orient_bodies(m, before: np.ndarray) -> tuple[int, int]:
     vol = np.bincount(labels, weights=six, minlength=nb) / 6.0
     scale = float(np.abs(six).sum()) / 6.0 or 1.0
     closed = np.nonzero(~body_bad & (np.abs(vol) > 1e-12 * scale))[0]
-    if len(closed) == 0:
-        return 0, 0
-    # input majority orientation of each body (before winding fixes)
+    # input majority orientation of each body (before winding fixes): +1 kept, -1 flipped
     flipped = _flipped(before, F[:len(before)])
     votes = np.bincount(labels[:len(before)], weights=np.where(flipped, -1.0, 1.0), minlength=nb)
     nested = _nested(V, F, labels, closed, vol)
     flip_body = np.zeros(nb, dtype=bool)
-    inverted = 0
+    # open bodies, and closed bodies nested in another (cavities or embedded parts): keep what
+    # most of their input faces said (the winding fix may have turned a whole body around)
+    flip_body[votes < 0] = True
     for b in closed:
-        if nested[b]:
-            want_positive = (vol[b] > 0) == (votes[b] >= 0)  # keep what most input faces said
-        else:
-            want_positive = True
-        if (vol[b] > 0) != want_positive:
-            flip_body[b] = True
-            inverted += 1
+        if not nested[int(b)]:  # a free closed body: outward
+            flip_body[b] = vol[b] < 0
+    inverted = int(flip_body.sum())
     if inverted:
         fl = flip_body[labels]
         F2 = F.copy()
         F2[fl] = F2[fl][:, ::-1]
         m.faces = F2
-    return inverted, int(sum(bool(nested[b]) for b in closed))
+    return inverted, int(sum(bool(nested[int(b)]) for b in closed))
 
 
 def _nested(V, F, labels, closed, vol) -> dict:

@@ -21,10 +21,10 @@ import numpy as np
 from robotkit.errors import Problem, RecipeError
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
-    Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, World, rpy_matrix,
+    Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World, matrix_rpy, rpy_matrix,
 )
 from robotkit.recipe.load import LoadedRecipe
-from robotkit.recipe.schema import UNITS
+from robotkit.recipe.schema import UNITS, Collision
 
 
 def _h(text: str, n: int = 8) -> str:
@@ -62,7 +62,7 @@ def resolve(loaded: LoadedRecipe) -> Robot:
             name = f"{stem}-{_h(os.path.relpath(src, base_dir))}{ext}"
         sources[src] = name
 
-    def make_geom(g, path, link_name, policy) -> Geom | None:
+    def make_geom(g, path, link_name, policy, role="visual") -> Geom | None:
         if g.material is not None and g.material not in material_names:
             problems.append(marks.problem(path + ("material",), _unknown("material", g.material, material_names)))
         origin = Pose(_t(g.origin.xyz), _t(g.origin.rpy))
@@ -87,8 +87,12 @@ def resolve(loaded: LoadedRecipe) -> Robot:
             else:
                 f = UNITS[g.units or r.units]
                 scale = (f, f, f)
-            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((g.mesh, scale, policy)))}"
-            shape = Shape("mesh", mesh=MeshRef(g.mesh, scale, sources[g.mesh], key, policy))
+            dec = (g.decimate or r.meshes.decimate) if role == "visual" else g.decimate
+            dec = (("faces", dec.faces) if dec.faces is not None else ("ratio", dec.ratio)) if dec else None
+            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((g.mesh, scale, policy, dec)))}"
+            file_name = sources[g.mesh] if dec is None else os.path.splitext(sources[g.mesh])[0] + ".stl"
+            shape = Shape("mesh", mesh=MeshRef(g.mesh, scale, file_name, key, policy, decimate=dec,
+                                               repair=dec is not None and r.meshes.repair))
         return Geom(shape, origin, (0.0, 0.0, 0.0), g.material, g.recenter)
 
     links: list[Link] = []
@@ -102,14 +106,23 @@ def resolve(loaded: LoadedRecipe) -> Robot:
             if geom is not None:
                 visuals.append(geom)
         collisions = []
-        if link.collision == "visual":
+        format_collisions = []
+        strategy = link.collision if isinstance(link.collision, Collision) else (
+            r.meshes.collision if link.collision == "visual" else None)
+        if strategy is not None:
+            collisions = _proxies(visuals, strategy, r.meshes.repair)
+            for fmt in ("urdf", "sdf", "mjcf"):
+                if getattr(strategy, fmt) is not None:
+                    format_collisions.append((fmt, tuple(_proxies(visuals, getattr(strategy, fmt),
+                                                                  r.meshes.repair))))
+        elif link.collision == "visual":
             collisions = [replace(v, material=None) for v in visuals]
         elif link.collision != "none":
             for i, g in _indexed(link.collision):
                 if g.material is not None:
                     problems.append(marks.problem(lp + ("collision",) + i + ("material",),
                                                   "collision geometry has no material"))
-                geom = make_geom(g, lp + ("collision",) + i, name, policy)
+                geom = make_geom(g, lp + ("collision",) + i, name, policy, "collision")
                 if geom is not None:
                     collisions.append(geom)
         spec = InertialSpec("none") if ispec == "none" else _inertial_spec(ispec, r.density)
@@ -124,14 +137,25 @@ def resolve(loaded: LoadedRecipe) -> Robot:
             problems.extend(_check_explicit(spec.explicit, marks, lp + ("inertial",)))
         # meshes no inertial is computed from may be open: they are only drawn and collided
         computed = spec.mode in ("density", "mass")
+        old = [g.shape.mesh for g in visuals]
         visuals = [g if computed and spec.source == "visual" else _display_only(g) for g in visuals]
         collisions = [g if computed and spec.source == "collision" else _display_only(g) for g in collisions]
+        # proxies read their visual mesh's facts (recentering): follow its new key
+        renamed = {m.key: g.shape.mesh for m, g in zip(old, visuals) if m is not None}
+
+        def follow(g: Geom) -> Geom:
+            if g.shape.kind != "proxy":
+                return g
+            return replace(g, shape=replace(g.shape, mesh=renamed.get(g.shape.mesh.key, g.shape.mesh)))
+
+        collisions = [follow(g) for g in collisions]
+        format_collisions = [(f, tuple(follow(g) for g in gs)) for f, gs in format_collisions]
         contact = None
         if link.contact is not None:
             c = link.contact
             contact = Contact(c.mu1, c.mu2 if c.mu2 is not None else c.mu1, c.kp, c.kd)
         links.append(Link(name, tuple(visuals), tuple(collisions), spec,
-                          spec.explicit if spec.mode == "explicit" else None, contact))
+                          spec.explicit if spec.mode == "explicit" else None, contact, tuple(format_collisions)))
 
     link_names = [link.name for link in links]
     joints: list[Joint] = []
@@ -294,6 +318,29 @@ def _defaults(kind: str) -> dict:
     return model().model_dump()
 
 
+def _strategy(model, repair: bool) -> Strategy:
+    dec = model.decimate
+    dec = (("faces", dec.faces) if dec.faces is not None else ("ratio", dec.ratio)) if dec else None
+    return Strategy(model.strategy, model.max_vertices, dec, tuple(sorted(model.coacd.model_dump().items())), repair)
+
+
+def _proxies(visuals: list[Geom], model, repair: bool) -> list[Geom]:
+    """Collision geometry made from the visual geometry by a strategy (mesh parts become proxies
+    that the collision tasks turn into pieces; primitives stay as they are)."""
+    if model.strategy == "none":
+        return []
+    strategy = _strategy(model, repair)
+    out = []
+    for g in visuals:
+        m = g.shape.mesh
+        if m is None:
+            out.append(replace(g, material=None))
+            continue
+        key = f"proxy-{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((m.source, m.scale, strategy)))}"
+        out.append(replace(g, material=None, shape=Shape("proxy", mesh=m, strategy=strategy, proxy_key=key)))
+    return out
+
+
 def _share_mesh_tasks(links: list[Link]) -> list[Link]:
     """A display-only mesh whose file and scale an inertial also uses shares that (stricter)
     mesh task instead of a second one."""
@@ -301,24 +348,25 @@ def _share_mesh_tasks(links: list[Link]) -> list[Link]:
     for link in links:
         for g in link.visuals + link.collisions:
             m = g.shape.mesh
-            if m is not None and m.open_mesh != "visual-only":
+            if m is not None and m.open_mesh != "visual-only" and not m.processed:
                 strict.setdefault((m.source, m.scale), m)
 
     def share(g: Geom) -> Geom:
         m = g.shape.mesh
-        if m is None or m.open_mesh != "visual-only" or (m.source, m.scale) not in strict:
+        if m is None or m.open_mesh != "visual-only" or (m.source, m.scale) not in strict or m.processed:
             return g
         return replace(g, shape=replace(g.shape, mesh=strict[(m.source, m.scale)]))
 
-    return [replace(link, visuals=tuple(map(share, link.visuals)), collisions=tuple(map(share, link.collisions)))
+    return [replace(link, visuals=tuple(map(share, link.visuals)), collisions=tuple(map(share, link.collisions)),
+                    format_collisions=tuple((f, tuple(map(share, gs))) for f, gs in link.format_collisions))
             for link in links]
 
 
 def _display_only(geom: Geom) -> Geom:
     m = geom.shape.mesh
-    if m is None or m.open_mesh == "visual-only":
+    if m is None or m.open_mesh == "visual-only" or geom.shape.kind == "proxy":
         return geom
-    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((m.source, m.scale, 'visual-only')))}"
+    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((m.source, m.scale, 'visual-only', m.decimate)))}"
     return replace(geom, shape=replace(geom.shape, mesh=replace(m, open_mesh="visual-only", key=key)))
 
 
@@ -331,7 +379,7 @@ def _indexed(value):
 
 
 def _geoms(value):
-    if value is None or isinstance(value, str):
+    if value is None or isinstance(value, (str, Collision)):
         return []
     return value if isinstance(value, list) else [value]
 
@@ -528,4 +576,34 @@ def _with_offsets(link: Link, facts: dict) -> Link:
     def fix(geoms):
         return tuple(replace(g, offset=recenter_offset(g, facts)) for g in geoms)
 
-    return replace(link, visuals=fix(link.visuals), collisions=fix(link.collisions))
+    def expand(geoms):
+        return tuple(piece for g in fix(geoms) for piece in _pieces(g, facts))
+
+    return replace(link, visuals=fix(link.visuals), collisions=expand(link.collisions),
+                   format_collisions=tuple((f, expand(gs)) for f, gs in link.format_collisions))
+
+
+def _pieces(geom: Geom, facts: dict) -> list[Geom]:
+    """A collision proxy as the pieces its collision task made (meshes or fitted primitives)."""
+    if geom.shape.kind != "proxy":
+        return [geom]
+    if geom.shape.proxy_key not in facts:  # a task that reads no collision facts
+        return [geom]
+    pose = geom.pose
+    out = []
+    for p in facts[geom.shape.proxy_key]["pieces"]:
+        if p["kind"] == "mesh":
+            folder, name = p["file"].split("/", 1)
+            ref = MeshRef(geom.shape.mesh.source, (1.0, 1.0, 1.0), name, geom.shape.proxy_key, "visual-only", folder)
+            out.append(Geom(Shape("mesh", mesh=ref), pose))
+            continue
+        T = pose.matrix() @ Pose(tuple(p["xyz"]), tuple(p["rpy"])).matrix()
+        piece_pose = Pose(tuple(float(v) for v in T[:3, 3]), matrix_rpy(T[:3, :3]))
+        if p["kind"] == "box":
+            shape = Shape("box", size=tuple(p["size"]))
+        elif p["kind"] == "sphere":
+            shape = Shape("sphere", radius=p["radius"])
+        else:  # cylinder, capsule
+            shape = Shape(p["kind"], radius=p["radius"], length=p["length"])
+        out.append(Geom(shape, piece_pose))
+    return out

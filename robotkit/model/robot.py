@@ -67,27 +67,64 @@ class Pose:
 
 
 @dataclass(frozen=True)
+class Strategy:
+    """How collision geometry is made from a visual mesh (see the recipe's ``collision``)."""
+
+    kind: str  # mesh | hull | decompose | box | cylinder | sphere | capsule | none
+    max_vertices: int | None = None
+    decimate: tuple | None = None  # ("faces", n) or ("ratio", r)
+    coacd: tuple = ()  # sorted (name, value) pairs
+    repair: bool = True
+
+    def params(self) -> dict:
+        return {"kind": self.kind, "max_vertices": self.max_vertices,
+                "decimate": list(self.decimate) if self.decimate else None,
+                "coacd": dict(self.coacd), "repair": self.repair}
+
+
+@dataclass(frozen=True)
 class MeshRef:
     """A mesh file and how its coordinates map to metres."""
 
     source: str
     """Absolute path of the source file."""
     scale: Vec3
-    """Per-axis factor from file units to metres."""
+    """Per-axis factor from file units to metres (of the file the outputs reference)."""
     file_name: str
-    """Output name under ``meshes/visual/``."""
+    """Output name under ``meshes/<folder>/``."""
     key: str
     """Unit-of-work key: one mesh task per (file, scale, open-mesh policy)."""
     open_mesh: str = "error"
+    folder: str = "visual"
+    """``visual``, ``collision``; the output is ``meshes/<folder>/<file_name>``."""
+    decimate: tuple | None = None
+    """A processed visual: ("faces", n) or ("ratio", r); written as a binary STL in metres."""
+    repair: bool = False
+
+    @property
+    def path(self) -> str:
+        """Path below the robot's ``meshes/`` folder."""
+        return f"{self.folder}/{self.file_name}"
+
+    @property
+    def processed(self) -> bool:
+        return self.decimate is not None
+
+    @property
+    def out_scale(self) -> Vec3:
+        """The scale an output file needs: processed meshes and collision pieces are in metres."""
+        return (1.0, 1.0, 1.0) if self.processed or self.folder != "visual" else self.scale
 
 
 @dataclass(frozen=True)
 class Shape:
-    kind: str  # mesh | box | cylinder | sphere
+    kind: str  # mesh | box | cylinder | sphere | capsule | proxy (expanded into pieces by finalize)
     size: Vec3 | None = None  # box
-    radius: float | None = None  # cylinder, sphere
-    length: float | None = None  # cylinder
+    radius: float | None = None  # cylinder, sphere, capsule
+    length: float | None = None  # cylinder, capsule
     mesh: MeshRef | None = None
+    strategy: Strategy | None = None  # proxy: made from ``mesh`` by a collision task
+    proxy_key: str | None = None
 
 
 @dataclass(frozen=True)
@@ -149,6 +186,10 @@ class Link:
     inertial_spec: InertialSpec = InertialSpec("none")
     inertial: Inertial | None = None
     contact: Contact | None = None
+    format_collisions: tuple = ()  # (("mjcf", (Geom, ...)), ...): per-format collision geometry
+
+    def collisions_for(self, fmt: str) -> tuple[Geom, ...]:
+        return dict(self.format_collisions).get(fmt, self.collisions)
 
     def source_geoms(self) -> tuple[Geom, ...]:
         return self.collisions if self.inertial_spec.source == "collision" else self.visuals
@@ -286,13 +327,25 @@ class Robot:
         children = {j.child for j in self.joints}
         return next(link.name for link in self.links if link.name not in children)
 
+    def all_geoms(self, link: Link) -> tuple[Geom, ...]:
+        return link.visuals + link.collisions + tuple(g for _, geoms in link.format_collisions for g in geoms)
+
     def meshes(self) -> dict[str, MeshRef]:
-        """Every distinct mesh unit of work, by key, in a stable order."""
+        """Every distinct mesh unit of work, by key, in a stable order (proxies excluded)."""
         out: dict[str, MeshRef] = {}
         for link in self.links:
-            for geom in link.visuals + link.collisions:
-                if geom.shape.mesh is not None:
+            for geom in self.all_geoms(link):
+                if geom.shape.mesh is not None and geom.shape.kind == "mesh":
                     out.setdefault(geom.shape.mesh.key, geom.shape.mesh)
+        return dict(sorted(out.items()))
+
+    def proxies(self) -> dict[str, Shape]:
+        """Every distinct collision-proxy unit of work, by key."""
+        out: dict[str, Shape] = {}
+        for link in self.links:
+            for geom in self.all_geoms(link):
+                if geom.shape.kind == "proxy":
+                    out.setdefault(geom.shape.proxy_key, geom.shape)
         return dict(sorted(out.items()))
 
     def to_dict(self) -> dict:

@@ -249,7 +249,7 @@ def _absolute_meshes(data: dict, marks: Marks):
 
 # ---------------------------------------------------------------- schema errors
 
-_TAGS = {"keyword", "shape", "shapes", "number", "vector"}
+_TAGS = {"keyword", "shape", "shapes", "number", "vector", "strategy"}
 
 
 def _fields_at(model, loc):

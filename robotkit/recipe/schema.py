@@ -82,6 +82,75 @@ class Sphere(Strict):
     """Radius in metres."""
 
 
+class Decimate(Strict):
+    """Quadric decimation to a face count or a fraction of the faces (exactly one)."""
+
+    faces: Annotated[int, Field(gt=3)] | None = None
+    """Target number of triangles."""
+    ratio: Annotated[float, Field(gt=0, le=1)] | None = None
+    """Fraction of the triangles to keep."""
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.faces is None) == (self.ratio is None):
+            raise ValueError("give exactly one of 'faces' or 'ratio'")
+        return self
+
+
+class Coacd(Strict):
+    """CoACD's main parameters (approximate convex decomposition)."""
+
+    threshold: Annotated[float, Field(ge=0.01, le=1)] = 0.05
+    """Concavity threshold: smaller gives more, finer pieces."""
+    max_hulls: int = -1
+    """Upper bound on the number of pieces (-1: none)."""
+    resolution: Annotated[int, Field(gt=0)] = 2000
+    """Surface sampling resolution."""
+    preprocess: Literal["auto", "on", "off"] = "auto"
+    """Remesh the input into a manifold first (auto: only when it is not one)."""
+    preprocess_resolution: Annotated[int, Field(gt=0)] = 50
+    """Voxel resolution of that remeshing."""
+    seed: int = 0
+    """Random seed (the same seed gives the same pieces)."""
+    mcts_iterations: Annotated[int, Field(gt=0)] = 150
+    """Cutting-plane search iterations (fewer: faster and coarser)."""
+
+
+class Proxy(Strict):
+    """How a link's collision geometry is made from its visual meshes."""
+
+    strategy: Literal["mesh", "hull", "decompose", "box", "cylinder", "sphere", "capsule", "none"]
+    """``mesh``: the visual mesh (optionally decimated); ``hull``: one convex hull; ``decompose``: convex pieces by CoACD; ``box`` (oriented bounding box), ``cylinder``, ``sphere``, ``capsule``: a fitted primitive; ``none``: no collision."""
+    max_vertices: Annotated[int, Field(ge=4)] | None = None
+    """Vertex budget of a hull or of each decomposed piece (MuJoCo recommends at most 64)."""
+    decimate: Decimate | None = None
+    """For ``mesh``: decimate the collision mesh."""
+    coacd: Coacd = Coacd()
+    """For ``decompose``: CoACD's parameters."""
+
+
+class Collision(Proxy):
+    """A collision strategy, with optional overrides for single output formats."""
+
+    urdf: Proxy | None = None
+    """Strategy for the URDF only."""
+    sdf: Proxy | None = None
+    """Strategy for the SDF only."""
+    mjcf: Proxy | None = None
+    """Strategy for the MJCF only (e.g. primitives for MuJoCo, a mesh for Gazebo)."""
+
+
+class MeshDefaults(Strict):
+    """Project defaults for mesh processing."""
+
+    repair: bool = True
+    """Repair meshes that are processed (merge vertices, remove duplicate and degenerate faces, fix winding, fill small holes)."""
+    decimate: Decimate | None = None
+    """Decimate every visual mesh."""
+    collision: Collision | None = None
+    """Default collision strategy for links whose collision is ``visual`` (the default)."""
+
+
 class Geometry(Strict):
     """One shape: exactly one of ``mesh``, ``box``, ``cylinder``, ``sphere``."""
 
@@ -102,6 +171,8 @@ class Geometry(Strict):
     """Pose of the geometry in the link frame."""
     material: str | None = None
     """Name of a material from ``materials`` (visual geometry only)."""
+    decimate: Decimate | None = None
+    """Decimate this mesh (the output is a binary STL in metres). Default: the recipe's ``meshes.decimate``."""
 
     @model_validator(mode="after")
     def _one_shape(self):
@@ -115,6 +186,8 @@ class Geometry(Strict):
                     raise ValueError(f"'{key}' applies to mesh geometry only")
             if self.recenter != "none":
                 raise ValueError("'recenter' applies to mesh geometry only")
+            if self.decimate is not None:
+                raise ValueError("'decimate' applies to mesh geometry only")
         elif self.units is not None and self.scale is not None:
             raise ValueError("give either 'units' or 'scale', not both")
         if isinstance(self.scale, list) and any(s == 0 for s in self.scale) or self.scale == 0:
@@ -170,11 +243,18 @@ class Inertial(Strict):
 Shapes = Annotated[
     Annotated[Geometry, Tag("shape")] | Annotated[list[Geometry], Tag("shapes")], Discriminator(_form)
 ]
+def _collision_form(value) -> str | None:
+    if isinstance(value, dict) and "strategy" in value or isinstance(value, Collision):
+        return "strategy"
+    return _form(value)
+
+
 CollisionSpec = Annotated[
     Annotated[Literal["visual", "none"], Tag("keyword")]
     | Annotated[Geometry, Tag("shape")]
-    | Annotated[list[Geometry], Tag("shapes")],
-    Discriminator(_form),
+    | Annotated[list[Geometry], Tag("shapes")]
+    | Annotated[Collision, Tag("strategy")],
+    Discriminator(_collision_form),
 ]
 
 
@@ -195,7 +275,7 @@ class Link(Strict):
     visual: Shapes | None = None
     """Visual geometry: one shape or a list of shapes."""
     collision: CollisionSpec = "visual"
-    """Collision geometry: ``visual`` (the same shapes as the visual), ``none``, or shapes of its own."""
+    """Collision geometry: ``visual`` (the visual shapes, or the recipe's ``meshes.collision`` strategy applied to them), ``none``, shapes of its own, or a strategy mapping (``strategy: hull``...)."""
     inertial: Annotated[
         Annotated[Inertial, Tag("shape")] | Annotated[Literal["none"], Tag("keyword")], Discriminator(_form)
     ] | None = None
@@ -422,6 +502,8 @@ class Recipe(Strict):
     """Default density in kg/m^3 for inertials computed from geometry."""
     open_mesh: Literal["error", "hull"] = "error"
     """Default policy for meshes that are not closed volumes after safe repair."""
+    meshes: MeshDefaults = MeshDefaults()
+    """Mesh processing defaults: repair, visual decimation, collision strategy."""
     measured_mass: Positive | None = None
     """The robot's total mass as weighed, in kg; `robotkit check` compares it with the sum of the links' masses."""
     self_collide: bool = False

@@ -1,0 +1,326 @@
+"""A content-addressed disk cache for expensive mesh results (CoACD, hulls, decimation).
+
+**Key.**  sha256 over canonical JSON of: the cache format version, the
+operation name, the effective parameters, the versions of the libraries that
+can change a result (trimesh, coacd, fast-simplification, manifold3d, numpy,
+scipy) and robotkit's version, followed by the digest of every input (raw
+bytes, or :func:`mesh_digest` of a mesh).  Changing any of them is a miss.
+
+**Location.**  ``Cache(root)``; by default ``$ROBOTKIT_CACHE``, else
+``$XDG_CACHE_HOME/robotkit``, else ``~/.cache/robotkit``.  Entries live in
+``<root>/v1/<key[:2]>/``:
+
+- ``<key>.<payload sha256[:16]>.bin``: the meshes, as little-endian float64
+  vertices and int32/int64 faces back to back (exact: binary STL would round
+  to float32; ``.npz`` embeds zip timestamps);
+- ``<key>.json``: the manifest: key, operation, parameters, versions, mesh
+  shapes, the payload's file name, size and sha256, and an optional JSON
+  ``info`` dict (a report stored with the meshes).
+
+**Writes are atomic**: each file is written to a temporary file in the same
+folder and moved into place with ``os.replace``; the payload first, the
+manifest last, so a manifest only ever names a complete payload, and the
+payload's name carries its checksum, so two writers never replace each
+other's payload with different bytes.  **Reads verify**: an entry whose
+manifest is unreadable or names another key, whose payload is missing, of the
+wrong size or checksum, or does not parse into valid meshes is removed and
+recomputed, never used.  **Concurrency**: ``get_or_compute`` holds an
+exclusive ``fcntl`` lock on ``<key>.lock`` while it looks up, computes and
+stores, so two processes asking for the same key compute it once (the second
+waits, then hits).  Where ``fcntl`` is missing (Windows) both compute, and
+the atomic writes still keep the entry whole.
+
+Values are a ``trimesh.Trimesh``, a list of them, or a ``(mesh or list,
+info dict)`` tuple.  A miss returns the value rebuilt from the stored arrays
+(``process=False``), so a miss and a later hit return identical arrays.
+Meshes are stored as geometry only (no visual data).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+CACHE_FORMAT = 1
+LIBRARIES = ("trimesh", "coacd", "fast-simplification", "manifold3d", "numpy", "scipy")
+
+
+def default_root() -> Path:
+    """``$ROBOTKIT_CACHE``, else ``$XDG_CACHE_HOME/robotkit``, else ``~/.cache/robotkit``."""
+    env = os.environ.get("ROBOTKIT_CACHE")
+    if env:
+        return Path(env).expanduser()
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    base = Path(xdg).expanduser() if xdg and os.path.isabs(os.path.expanduser(xdg)) else Path.home() / ".cache"
+    return base / "robotkit"
+
+
+def library_versions() -> dict:
+    """Installed versions of the libraries that shape cached results, plus robotkit's."""
+    from importlib import metadata
+
+    import robotkit
+
+    out = {}
+    for name in LIBRARIES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = "not installed"
+    out["robotkit"] = robotkit.__version__
+    return out
+
+
+def mesh_digest(mesh) -> str:
+    """sha256 (hex) of a mesh's geometry: float64 vertices and int64 faces, little-endian, with shapes."""
+    V = np.ascontiguousarray(np.asarray(mesh.vertices, dtype="<f8") + 0.0)  # -0.0 -> 0.0
+    F = np.ascontiguousarray(np.asarray(mesh.faces, dtype="<i8"))
+    h = hashlib.sha256()
+    h.update(f"mesh {V.shape[0]} {F.shape[0]}\n".encode())
+    h.update(V.tobytes())
+    h.update(F.tobytes())
+    return h.hexdigest()
+
+
+def canonical_json(value) -> str:
+    """Deterministic JSON: sorted keys, no spaces, numpy values and tuples as plain JSON, no NaN."""
+    return json.dumps(_plain(value), sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+def _plain(value):
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return [_plain(v) for v in value.tolist()]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) + 0.0
+    if value is None or isinstance(value, str):
+        return value
+    raise TypeError(f"cannot put a {type(value).__name__} into a cache key or manifest")
+
+
+class CacheCorrupt(Exception):
+    """An entry failed verification (internal: the entry is removed and recomputed)."""
+
+
+class Cache:
+    """See the module docstring.  ``versions`` overrides :func:`library_versions` (tests)."""
+
+    def __init__(self, root: str | os.PathLike | None = None, versions: dict | None = None):
+        self.root = Path(root).expanduser() if root is not None else default_root()
+        self.versions = dict(versions) if versions is not None else library_versions()
+        self.stats = {"hits": 0, "misses": 0, "corrupt": 0, "stored": 0}
+
+    # --- keys and paths ----------------------------------------------------------------------
+
+    def key(self, op: str, params: dict, inputs) -> str:
+        """The entry key for ``op`` with ``params`` on ``inputs`` (bytes, str, mesh, or a list of those)."""
+        head = canonical_json({"format": CACHE_FORMAT, "op": op, "params": params, "versions": self.versions})
+        h = hashlib.sha256(head.encode())
+        for item in (inputs if isinstance(inputs, (list, tuple)) else [inputs]):
+            h.update(b"\0" + _input_digest(item).encode())
+        return h.hexdigest()
+
+    def folder(self, key: str) -> Path:
+        return self.root / f"v{CACHE_FORMAT}" / key[:2]
+
+    def manifest_path(self, key: str) -> Path:
+        return self.folder(key) / f"{key}.json"
+
+    # --- public API ---------------------------------------------------------------------------
+
+    def get_or_compute(self, op: str, params: dict, inputs, compute: Callable[[], object], *,
+                       lock: bool = True):
+        """The cached value for (op, params, inputs), computing and storing it on a miss."""
+        key = self.key(op, params, inputs)
+        with (self._locked(key) if lock else contextlib.nullcontext()):
+            value = self.get(key)
+            if value is not None:
+                return value
+            self.stats["misses"] += 1
+            return self.put(key, compute(), op=op, params=params)
+
+    def get(self, key: str):
+        """The verified value stored under ``key``, or None (a corrupt entry is removed)."""
+        path = self.manifest_path(key)
+        if not path.exists():
+            return None
+        try:
+            value = self._read(key, path)
+        except CacheCorrupt:
+            self.stats["corrupt"] += 1
+            self._remove(key)
+            return None
+        self.stats["hits"] += 1
+        return value
+
+    def put(self, key: str, value, *, op: str = "", params: dict | None = None):
+        """Store ``value`` under ``key``; return it rebuilt from the stored arrays."""
+        meshes, kind, info = _unpack(value)
+        blobs, shapes = [], []
+        for m in meshes:
+            V = np.ascontiguousarray(np.asarray(m.vertices, dtype="<f8").reshape(-1, 3))
+            F = np.asarray(m.faces, dtype=np.int64).reshape(-1, 3)
+            ftype = "<i4" if F.size == 0 or F.max() < 2 ** 31 - 1 else "<i8"
+            F = np.ascontiguousarray(F.astype(ftype))
+            blobs += [V.tobytes(), F.tobytes()]
+            shapes.append({"vertices": int(V.shape[0]), "faces": int(F.shape[0]), "faces_dtype": ftype})
+        payload = b"".join(blobs)
+        digest = hashlib.sha256(payload).hexdigest()
+        manifest = {
+            "format": CACHE_FORMAT, "key": key, "op": op, "params": _plain(params or {}),
+            "versions": self.versions, "kind": kind, "meshes": shapes, "info": _plain(info),
+            "payload": {"file": f"{key}.{digest[:16]}.bin", "size": len(payload), "sha256": digest},
+        }
+        rebuilt = _build(kind, _parse(payload, shapes), manifest["info"])
+        try:
+            folder = self.folder(key)
+            folder.mkdir(parents=True, exist_ok=True)
+            _atomic_write(folder / manifest["payload"]["file"], payload)
+            _atomic_write(self.manifest_path(key),
+                          (json.dumps(manifest, sort_keys=True, indent=1) + "\n").encode())
+            self.stats["stored"] += 1
+        except OSError:
+            pass  # a read-only or full cache folder costs time, never correctness
+        return rebuilt
+
+    def clear(self) -> None:
+        """Remove every entry of this cache format."""
+        import shutil
+
+        shutil.rmtree(self.root / f"v{CACHE_FORMAT}", ignore_errors=True)
+
+    # --- internals ----------------------------------------------------------------------------
+
+    def _read(self, key: str, path: Path):
+        try:
+            manifest = json.loads(path.read_text(encoding="utf-8"))
+            if manifest.get("format") != CACHE_FORMAT or manifest.get("key") != key:
+                raise CacheCorrupt("manifest of another key or format")
+            pay = manifest["payload"]
+            if os.path.basename(pay["file"]) != pay["file"]:
+                raise CacheCorrupt("payload name with a folder")
+            data = (self.folder(key) / pay["file"]).read_bytes()
+            if len(data) != pay["size"] or hashlib.sha256(data).hexdigest() != pay["sha256"]:
+                raise CacheCorrupt("payload size or checksum mismatch")
+            return _build(manifest["kind"], _parse(data, manifest["meshes"]), manifest.get("info"))
+        except CacheCorrupt:
+            raise
+        except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+            raise CacheCorrupt(str(exc)) from exc
+
+    def _remove(self, key: str) -> None:
+        folder = self.folder(key)
+        with contextlib.suppress(OSError):
+            self.manifest_path(key).unlink()
+        with contextlib.suppress(OSError):
+            for p in folder.glob(f"{key}.*.bin"):
+                p.unlink()
+
+    @contextlib.contextmanager
+    def _locked(self, key: str):
+        try:
+            import fcntl
+        except ImportError:  # Windows: no lock, atomic writes only
+            yield
+            return
+        try:
+            folder = self.folder(key)
+            folder.mkdir(parents=True, exist_ok=True)
+            fd = os.open(folder / f"{key}.lock", os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError:
+            yield
+            return
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            yield
+        finally:
+            with contextlib.suppress(OSError):
+                fcntl.flock(fd, fcntl.LOCK_UN)
+            os.close(fd)
+
+
+def _input_digest(item) -> str:
+    if isinstance(item, (bytes, bytearray, memoryview)):
+        return "bytes:" + hashlib.sha256(bytes(item)).hexdigest()
+    if isinstance(item, str):
+        return "str:" + hashlib.sha256(item.encode()).hexdigest()
+    if hasattr(item, "vertices") and hasattr(item, "faces"):
+        return "mesh:" + mesh_digest(item)
+    raise TypeError(f"cache inputs must be bytes, str or meshes, not {type(item).__name__}")
+
+
+def _unpack(value):
+    import trimesh
+
+    info = None
+    if isinstance(value, tuple):
+        if len(value) != 2 or not isinstance(value[1], dict):
+            raise TypeError("a cached tuple must be (mesh or list of meshes, info dict)")
+        value, info = value
+    if isinstance(value, trimesh.Trimesh):
+        return [value], "mesh", info
+    if isinstance(value, list) and all(isinstance(m, trimesh.Trimesh) for m in value):
+        return value, "meshes", info
+    raise TypeError("a cached value must be a trimesh.Trimesh, a list of them, or (that, info dict)")
+
+
+def _parse(data: bytes, shapes: list) -> list:
+    import trimesh
+
+    out, at = [], 0
+    for s in shapes:
+        nv, nf, ftype = int(s["vertices"]), int(s["faces"]), s["faces_dtype"]
+        if ftype not in ("<i4", "<i8") or nv < 0 or nf < 0:
+            raise CacheCorrupt("bad mesh shape")
+        vb, fb = nv * 24, nf * 3 * np.dtype(ftype).itemsize
+        if at + vb + fb > len(data):
+            raise CacheCorrupt("payload shorter than its manifest")
+        V = np.frombuffer(data, dtype="<f8", count=nv * 3, offset=at).reshape(nv, 3).astype(np.float64)
+        F = np.frombuffer(data, dtype=ftype, count=nf * 3, offset=at + vb).reshape(nf, 3).astype(np.int64)
+        at += vb + fb
+        if nf and (F.min() < 0 or F.max() >= nv):
+            raise CacheCorrupt("face index out of range")
+        out.append(trimesh.Trimesh(V, F, process=False))
+    if at != len(data):
+        raise CacheCorrupt("payload longer than its manifest")
+    return out
+
+
+def _build(kind: str, meshes: list, info):
+    if kind == "mesh":
+        if len(meshes) != 1:
+            raise CacheCorrupt("a single-mesh entry holds several meshes")
+        value = meshes[0]
+    elif kind == "meshes":
+        value = meshes
+    else:
+        raise CacheCorrupt(f"unknown kind {kind!r}")
+    return (value, info) if info is not None else value
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise

@@ -1,0 +1,100 @@
+"""How far a collision proxy is from the visual mesh: volume, pieces, size, surface distance.
+
+The proxy is a list of pieces, each a closed ``trimesh.Trimesh`` (hulls,
+decomposition pieces, repaired meshes) or a fitted
+:class:`robotkit.mesh.primitives.Primitive`.
+
+- **Volume**: the volume of the *union* of the pieces, with manifold3d's
+  boolean union (``Manifold.batch_boolean``, exact on the tessellations), so
+  overlapping pieces are not counted twice; the plain sum and the overlap
+  (sum minus union) are reported too.  A single primitive uses its analytic
+  volume.  Primitives enter the union and the distances as tessellations
+  (``Primitive.to_mesh``: 128-section cylinders and capsules, 5-times
+  subdivided icospheres), whose volume error is below 1e-3 relative.
+- **Surface distance**: between the surface of the union and the visual
+  surface, both directions, with
+  :func:`robotkit.mesh.decimate.surface_distance` (exact distances from
+  area-uniform samples, fixed seed).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from robotkit.mesh.decimate import DEFAULT_SAMPLES, surface_distance
+
+
+def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed: int = 0) -> dict:
+    """Compare a collision proxy (``pieces``) with ``visual_mesh``.
+
+    Returns ``pieces`` (count), ``mesh_pieces``, ``primitive_pieces``,
+    ``largest_piece_vertices`` (mesh pieces only; None when every piece is a
+    primitive), ``total_vertices``, ``visual_volume`` (None unless the visual
+    mesh is a closed volume), ``proxy_volume`` (union), ``proxy_volume_sum``,
+    ``overlap_volume``, ``volume_method`` (``union``, ``analytic`` or ``sum``:
+    ``sum`` when the union could not be computed, e.g. a piece is not closed),
+    ``volume_ratio`` (proxy / visual, None without a visual volume),
+    ``distance`` (see :func:`robotkit.mesh.decimate.surface_distance`; max and
+    mean in metres) and ``distance_relative`` (max distance over the visual
+    bounding-box diagonal).
+    """
+    from robotkit.mesh.primitives import Primitive
+
+    if not pieces:
+        raise ValueError("the collision proxy has no pieces")
+    meshes, n_prim, vertex_counts, analytic = [], 0, [], []
+    for p in pieces:
+        if isinstance(p, Primitive):
+            n_prim += 1
+            analytic.append(p.volume)
+            meshes.append(p.to_mesh())
+        elif isinstance(p, trimesh.Trimesh):
+            vertex_counts.append(int(len(p.vertices)))
+            meshes.append(p)
+        else:
+            raise TypeError(f"a proxy piece must be a trimesh.Trimesh or a Primitive, not {type(p).__name__}")
+    volume_sum = float(sum(p.volume if isinstance(p, Primitive) else m.volume for p, m in zip(pieces, meshes)))
+    surface, union_volume, method = _union(meshes)
+    if len(pieces) == 1 and n_prim == 1:
+        union_volume, method = float(analytic[0]), "analytic"
+    if union_volume is None:
+        union_volume, method = volume_sum, "sum"
+    visual_volume = float(visual_mesh.volume) if visual_mesh.is_volume else None
+    dist = surface_distance(surface, visual_mesh, samples, seed)
+    diag = float(np.linalg.norm(np.ptp(np.asarray(visual_mesh.vertices), axis=0)))
+    return {
+        "pieces": len(pieces),
+        "mesh_pieces": len(pieces) - n_prim,
+        "primitive_pieces": n_prim,
+        "largest_piece_vertices": max(vertex_counts) if vertex_counts else None,
+        "total_vertices": int(sum(vertex_counts)),
+        "visual_volume": visual_volume,
+        "proxy_volume": float(union_volume),
+        "proxy_volume_sum": volume_sum,
+        "overlap_volume": float(volume_sum - union_volume),
+        "volume_method": method,
+        "volume_ratio": float(union_volume / visual_volume) if visual_volume else None,
+        "distance": dist,
+        "distance_relative": float(dist["max"] / diag) if diag > 0 else None,
+    }
+
+
+def _union(meshes: list) -> tuple[trimesh.Trimesh, float | None, str]:
+    """(surface of the union, its volume or None, method); falls back to all pieces together."""
+    from robotkit.mesh.hull import from_manifold, to_manifold
+
+    if len(meshes) == 1:
+        m = meshes[0]
+        return m, (float(m.volume) if m.is_volume else None), "union"
+    try:
+        import manifold3d as m3
+
+        parts = [to_manifold(m) for m in meshes]
+        if any(p.status() != m3.Error.NoError or p.is_empty() for p in parts):
+            raise ValueError("a piece is not a closed manifold")
+        union = m3.Manifold.batch_boolean(parts, m3.OpType.Add)
+        return from_manifold(union), float(union.volume()), "union"
+    except ValueError:
+        together = trimesh.util.concatenate(meshes)
+        return together, None, "sum"

@@ -1,0 +1,628 @@
+"""The mesh-processing library against known answers: repair, transform, decimation, hulls,
+CoACD decomposition, primitive fits, proxy fidelity, the result cache, reproducible export."""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import math
+import multiprocessing
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from robotkit.mesh.cache import Cache, default_root, mesh_digest
+from robotkit.mesh.decimate import closed_volume, decimate, point_surface_distance, surface_distance
+from robotkit.mesh.decompose import decompose
+from robotkit.mesh.export import obj_bytes, stl_bytes
+from robotkit.mesh.fidelity import fidelity
+from robotkit.mesh.hull import canonical, convex_hull, convex_hull_report, from_manifold, to_manifold
+from robotkit.mesh.inertia import box_props, mesh_mass_properties
+from robotkit.mesh.primitives import Primitive, fit_box, fit_capsule, fit_cylinder, fit_sphere
+from robotkit.mesh.repair import repair
+from robotkit.mesh.transform import transform
+from robotkit.model.robot import rpy_matrix
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def pose(rpy=(0.3, -0.7, 1.2), xyz=(0.1, -0.2, 0.3)) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = rpy_matrix(rpy)
+    T[:3, 3] = xyz
+    return T
+
+
+def moved(mesh, T):
+    m = mesh.copy()
+    m.apply_transform(T)
+    return m
+
+
+def props(mesh):
+    return mesh_mass_properties(mesh.vertices, mesh.faces)
+
+
+def l_shape(subdivisions: int = 2) -> trimesh.Trimesh:
+    """Two 0.2 x 0.05 x 0.05 m bars joined at one end (a closed L), subdivided."""
+    import manifold3d as m3
+
+    a = trimesh.creation.box([0.2, 0.05, 0.05])
+    a.apply_translation([0.1, 0.025, 0.025])
+    b = trimesh.creation.box([0.05, 0.2, 0.05])
+    b.apply_translation([0.025, 0.1, 0.025])
+    mesh = from_manifold(m3.Manifold.batch_boolean([to_manifold(a), to_manifold(b)], m3.OpType.Add))
+    for _ in range(subdivisions):
+        mesh = mesh.subdivide()
+    return mesh
+
+
+def shell(mesh) -> tuple[float, float]:
+    """(rho, R) for a surface around the origin: every point of it has rho <= |p| <= R, and
+    every ray from the origin meets it once (all face planes have the origin behind them)."""
+    n = mesh.face_normals
+    offsets = np.einsum("ij,ij->i", n, mesh.triangles[:, 0])
+    assert (offsets > 0).all(), "not star-shaped about the origin"
+    tri = np.asarray(mesh.triangles)
+    nearest = trimesh.triangles.closest_point(tri, np.zeros((len(tri), 3)))
+    return float(np.linalg.norm(nearest, axis=1).min()), float(np.linalg.norm(mesh.vertices, axis=1).max())
+
+
+# --- repair ----------------------------------------------------------------------------------
+
+def broken_box():
+    """A unit box with faces 3 and 7 flipped, face 0 missing, faces 4 and 5 duplicated."""
+    box = trimesh.creation.box([1.0, 1.0, 1.0])
+    F = np.array(box.faces)
+    F[[0, 3, 7]] = F[[0, 3, 7]][:, ::-1]
+    F = np.vstack([F[1:], F[[4, 5]]])
+    return trimesh.Trimesh(np.array(box.vertices), F, process=False)
+
+
+def test_repair_reports_duplicates_flips_and_the_filled_hole():
+    mesh = broken_box()
+    V0, F0 = np.array(mesh.vertices), np.array(mesh.faces)
+    fixed, report = repair(mesh)
+    np.testing.assert_array_equal(mesh.vertices, V0)  # the input is untouched
+    np.testing.assert_array_equal(mesh.faces, F0)
+    assert report["faces_in"] == 13
+    assert report["duplicate_faces_removed"] == 2
+    assert report["faces_flipped"] == 2  # faces 3 and 7 (face 0 was the missing one)
+    assert report["holes_found"] == report["holes_filled"] == 1
+    assert report["faces_added"] == 1 and report["vertices_added"] == 0 and report["holes_left"] == 0
+    assert report["degenerate_faces_removed"] == report["vertices_merged"] == 0
+    assert report["is_volume"] and report["watertight"] and report["changed"]
+    assert report["faces_out"] == 12 and report["open_edges"] == 0
+    assert report["volume"] == pytest.approx(1.0, abs=1e-15)
+    np.testing.assert_allclose(props(fixed).inertia, box_props([1, 1, 1]).inertia, atol=1e-15)
+
+
+def test_repair_of_a_clean_mesh_changes_nothing():
+    box = trimesh.creation.box([0.1, 0.2, 0.3])
+    fixed, report = repair(box)
+    assert not report["changed"] and report["is_volume"]
+    np.testing.assert_array_equal(fixed.faces, box.faces)
+    np.testing.assert_array_equal(fixed.vertices, box.vertices)
+
+
+def test_repair_inverted_box_and_triangle_soup():
+    box = trimesh.creation.box([1.0, 2.0, 3.0])
+    inverted = trimesh.Trimesh(np.array(box.vertices), np.array(box.faces)[:, ::-1], process=False)
+    fixed, report = repair(inverted)
+    assert report["faces_flipped"] == 12 and report["bodies_inverted"] == 1
+    assert fixed.volume == pytest.approx(6.0, rel=1e-14)
+    soup = trimesh.Trimesh(box.triangles.reshape(-1, 3), np.arange(36).reshape(-1, 3), process=False)
+    fixed, report = repair(soup)
+    assert report["vertices_merged"] == 28 and report["is_volume"]
+    assert fixed.volume == pytest.approx(6.0, rel=1e-14)
+
+
+def test_repair_keeps_a_cavity_inward():
+    """A hollow box: the inner shell is inward on purpose; trimesh's multibody fix would flip it."""
+    outer, inner = trimesh.creation.box([1.0, 1.0, 1.0]), trimesh.creation.box([0.5, 0.5, 0.5])
+    V = np.vstack([outer.vertices, inner.vertices])
+    F = np.vstack([outer.faces, np.array(inner.faces)[:, ::-1] + 8])
+    fixed, report = repair(trimesh.Trimesh(V, F, process=False))
+    assert report["nested_bodies"] == 1 and report["faces_flipped"] == 0
+    assert fixed.volume == pytest.approx(0.875, rel=1e-14)
+    F2 = F.copy()
+    F2[[13, 20]] = F2[[13, 20]][:, ::-1]  # two cavity faces wound the wrong way: the majority wins
+    fixed, report = repair(trimesh.Trimesh(V, F2, process=False))
+    assert report["faces_flipped"] == 2 and report["is_volume"]
+    assert fixed.volume == pytest.approx(0.875, rel=1e-14)
+
+
+def test_repair_leaves_large_holes_open():
+    box = trimesh.creation.box([1.0, 1.0, 1.0])
+    open_box = trimesh.Trimesh(np.array(box.vertices), np.array(box.faces)[2:], process=False)  # a square hole
+    _, report = repair(open_box, max_hole_edges=3)
+    assert report["holes_found"] == 1 and report["holes_left"] == 1 and not report["is_volume"]
+    assert report["open_edges"] == 4 and report["volume"] is None
+    _, report = repair(open_box, fill_holes=False)
+    assert report["holes_filled"] == 0 and not report["watertight"]
+    for k in range(10):  # one face wound against the rest: only it turns, wherever the winding fix starts
+        F = np.array(open_box.faces)
+        F[k] = F[k][::-1]
+        fixed, report = repair(trimesh.Trimesh(open_box.vertices, F, process=False), fill_holes=False)
+        assert report["faces_flipped"] == 1 and report["winding_consistent"]
+        np.testing.assert_array_equal(fixed.faces, open_box.faces)
+    fixed, report = repair(open_box)
+    assert report["holes_filled"] == 1 and report["faces_added"] == 2 and report["is_volume"]
+    assert fixed.volume == pytest.approx(1.0, abs=1e-15)
+
+
+# --- transform -------------------------------------------------------------------------------
+
+def test_transform_mm_to_m_is_exact():
+    box_mm = trimesh.creation.box([100.0, 200.0, 300.0])
+    box_mm.apply_translation([1000.0, -20.0, 5.0])
+    out, M = transform(box_mm, scale=0.001)
+    np.testing.assert_array_equal(out.vertices, np.asarray(box_mm.vertices) * 0.001)
+    np.testing.assert_array_equal(M, np.diag([0.001, 0.001, 0.001, 1.0]))
+    a, b = props(box_mm), props(out)
+    assert b.volume == pytest.approx(a.volume * 1e-9, rel=1e-12)
+    np.testing.assert_allclose(b.com, a.com * 0.001, rtol=1e-12)
+    np.testing.assert_allclose(b.inertia, a.inertia * 1e-15, rtol=1e-12, atol=1e-20)
+    np.testing.assert_allclose(b.inertia, box_props([0.1, 0.2, 0.3]).inertia, rtol=1e-10, atol=1e-18)
+
+
+def test_transform_rotation_translation_carry_mass_properties():
+    mesh = trimesh.creation.annulus(r_min=0.02, r_max=0.05, height=0.03, sections=48)
+    mesh.apply_translation([0.01, 0.02, 0.03])
+    before = props(mesh)
+    out, M = transform(mesh, translate=(0.5, -0.25, 1.0), rpy=(0.3, -1.1, 2.5))
+    R = rpy_matrix((0.3, -1.1, 2.5))
+    np.testing.assert_allclose(M[:3, :3], R, atol=0)
+    np.testing.assert_allclose(out.vertices, trimesh.transform_points(mesh.vertices, M), atol=1e-15)
+    after = props(out)
+    assert after.volume == pytest.approx(before.volume, rel=1e-12)
+    np.testing.assert_allclose(after.com, R @ before.com + [0.5, -0.25, 1.0], atol=1e-15)
+    np.testing.assert_allclose(after.inertia, R @ before.inertia @ R.T, atol=1e-17)
+
+
+@pytest.mark.parametrize("recenter", ["bbox", "com"])
+def test_transform_recenter(recenter):
+    mesh = trimesh.creation.cone(radius=30.0, height=80.0, sections=64)  # mm, COM off the bbox centre
+    mesh.apply_translation([5.0, 7.0, 11.0])
+    out, M = transform(mesh, scale=0.001, translate=(0.1, 0.2, 0.3), rpy=(0.0, math.pi / 2, 0.0),
+                       recenter=recenter)
+    scaled = np.asarray(mesh.vertices) * 0.001
+    c = (0.5 * (scaled.min(axis=0) + scaled.max(axis=0)) if recenter == "bbox"
+         else mesh_mass_properties(scaled, mesh.faces).com)
+    np.testing.assert_allclose(M[:3, :3] @ (c / 0.001) + M[:3, 3], [0.1, 0.2, 0.3], atol=1e-15)  # on translate
+    if recenter == "com":
+        np.testing.assert_allclose(props(out).com, [0.1, 0.2, 0.3], atol=1e-15)
+        assert out.volume == pytest.approx(mesh.volume * 1e-9, rel=1e-12)
+
+
+def test_transform_mirror_keeps_the_winding_outward():
+    mesh = trimesh.creation.cone(radius=0.03, height=0.08, sections=32)
+    mesh.apply_translation([0.01, 0.0, 0.0])
+    out, M = transform(mesh, scale=(-1.0, 1.0, 1.0))
+    assert np.linalg.det(M[:3, :3]) < 0
+    assert out.is_volume and out.volume == pytest.approx(mesh.volume, rel=1e-12)
+    np.testing.assert_allclose(props(out).com, props(mesh).com * [-1, 1, 1], atol=1e-15)
+    assert mesh.is_volume  # input untouched
+
+
+def test_transform_errors():
+    box = trimesh.creation.box([1, 1, 1])
+    with pytest.raises(ValueError, match="non-zero"):
+        transform(box, scale=(1.0, 0.0, 1.0))
+    with pytest.raises(ValueError, match="recenter"):
+        transform(box, recenter="centre")
+    open_box = trimesh.Trimesh(box.vertices, box.faces[1:], process=False)
+    with pytest.raises(ValueError, match="closed"):
+        transform(open_box, recenter="com")
+
+
+# --- decimation and surface distance ---------------------------------------------------------
+
+def test_surface_distance_is_exact():
+    """Concentric spheres r=1 and 1.1: every distance lies in an interval set by the tessellations,
+    and the k-d tree search equals brute force over every triangle."""
+    a = trimesh.creation.icosphere(subdivisions=4, radius=1.0)
+    b = trimesh.creation.icosphere(subdivisions=4, radius=1.1)
+    (rho_a, big_a), (rho_b, big_b) = shell(a), shell(b)
+    d = surface_distance(a, b, samples=2000)
+    lo, hi = rho_b - big_a, big_b - rho_a
+    for k in ("a_to_b_max", "a_to_b_mean", "b_to_a_max", "b_to_a_mean"):
+        assert lo - 1e-12 <= d[k] <= hi + 1e-12, (k, d[k], lo, hi)
+    pts = trimesh.sample.sample_surface(a, 300, seed=3)[0] * 1.03 + 0.01
+    tri = np.asarray(b.triangles)
+    brute = np.array([np.linalg.norm(trimesh.triangles.closest_point(tri, np.tile(p, (len(tri), 1))) - p,
+                                     axis=1).min() for p in pts])
+    np.testing.assert_allclose(point_surface_distance(pts, b), brute, rtol=0, atol=1e-15)
+
+
+def test_decimate_sphere_volume_and_distance_against_the_sphere():
+    sphere = trimesh.creation.icosphere(subdivisions=6, radius=1.0)  # 81,920 faces
+    out, report = decimate(sphere, target_faces=5000)
+    assert 4900 <= report["faces_after"] <= 5000 and report["faces_before"] == 81920
+    assert report["is_volume_after"] and abs(report["volume_change"]) < 0.01
+    assert report["volume_change"] == pytest.approx(out.volume / sphere.volume - 1, rel=1e-12)
+    # both surfaces lie between spheres: no sampled distance can exceed the shell bound
+    (rho_s, big_s), (rho_d, big_d) = shell(sphere), shell(out)
+    bound = max(big_d - rho_s, big_s - rho_d)
+    dist = report["distance"]
+    assert 0 < dist["mean"] < dist["max"] <= bound
+    assert dist["max"] > 0.5 * bound  # and close to it: the bound is tight for a fine sphere
+
+
+def test_decimate_torus_ratio_is_deterministic():
+    torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=128, minor_sections=64)
+    a, ra = decimate(torus, ratio=0.1)
+    b, rb = decimate(torus, ratio=0.1)
+    assert ra["target_faces"] == round(0.1 * len(torus.faces))
+    assert abs(ra["volume_change"]) < 0.01 and ra["is_volume_after"]
+    np.testing.assert_array_equal(a.vertices, b.vertices)
+    np.testing.assert_array_equal(a.faces, b.faces)
+    assert ra == rb
+    assert ra["distance"]["max"] < 0.01 * 0.5  # well under 1 % of the torus size
+
+
+def test_decimate_does_not_depend_on_units():
+    """fast-simplification's thresholds are absolute: robotkit normalises the size first."""
+    torus_m = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=96, minor_sections=48)
+    torus_mm = trimesh.Trimesh(np.asarray(torus_m.vertices) * 1000.0, torus_m.faces, process=False)
+    a, ra = decimate(torus_m, target_faces=900, samples=500)
+    b, rb = decimate(torus_mm, target_faces=900, samples=500)
+    np.testing.assert_array_equal(a.faces, b.faces)
+    np.testing.assert_allclose(np.asarray(b.vertices) / 1000.0, a.vertices, rtol=0, atol=1e-12)  # 5e-11 of the size
+    assert ra["distance"]["max"] == pytest.approx(rb["distance"]["max"] / 1000.0, rel=1e-6)
+
+
+def test_closed_volume_agrees_with_trimesh():
+    box = trimesh.creation.box([1.0, 2.0, 3.0])
+    F = np.asarray(box.faces)
+    one_flipped = F.copy()
+    one_flipped[3] = one_flipped[3][::-1]
+    cases = [F, F[:, ::-1], F[1:], F[2:], one_flipped, np.vstack([F, F]), np.vstack([F, F[:, ::-1]])]
+    for faces in cases:
+        m = trimesh.Trimesh(box.vertices, faces, process=False)
+        v = closed_volume(m)
+        assert (v is not None) == m.is_volume
+        if v is not None:
+            assert v == pytest.approx(m.volume, rel=1e-14)
+    torus = trimesh.creation.torus(0.2, 0.05, major_sections=64, minor_sections=32)
+    assert closed_volume(torus) == pytest.approx(torus.volume, rel=1e-13)
+
+
+def test_decimate_errors():
+    box = trimesh.creation.box([1, 1, 1])
+    with pytest.raises(ValueError, match="only 12 faces"):
+        decimate(box, target_faces=100)
+    with pytest.raises(ValueError, match="exactly one"):
+        decimate(box, target_faces=10, ratio=0.5)
+    with pytest.raises(ValueError, match="fraction of faces to keep"):
+        decimate(box, ratio=1.5)
+    same, report = decimate(box, target_faces=12)
+    assert report["faces_after"] == 12 and report["distance"]["max"] < 1e-15
+
+
+# --- convex hull -----------------------------------------------------------------------------
+
+def test_exact_hull_of_a_box_and_determinism():
+    box = trimesh.creation.box([1.0, 2.0, 3.0]).subdivide()
+    hull, report = convex_hull_report(box)
+    assert len(hull.vertices) == 8 and hull.is_volume and hull.is_convex
+    assert hull.volume == pytest.approx(6.0, rel=1e-14) and report["method"] == "exact"
+    again = convex_hull(box)
+    np.testing.assert_array_equal(hull.vertices, again.vertices)
+    np.testing.assert_array_equal(hull.faces, again.faces)
+
+
+@pytest.mark.parametrize("budget", [16, 32, 64])
+def test_hull_budget_and_error(budget):
+    mesh = trimesh.creation.capsule(height=0.3, radius=0.1, count=[32, 32])
+    hull, report = convex_hull_report(mesh, max_vertices=budget)
+    assert len(hull.vertices) <= budget and report["vertices"] == len(hull.vertices)
+    assert hull.is_volume and hull.is_convex
+    # every hull vertex is a mesh vertex, so the hull is inside the exact hull
+    assert set(map(tuple, np.asarray(hull.vertices))) <= set(map(tuple, np.asarray(mesh.vertices)))
+    assert report["volume_ratio"] == pytest.approx(hull.volume / mesh.convex_hull.volume, rel=1e-12)
+    assert report["volume_ratio"] > {16: 0.65, 32: 0.8, 64: 0.9}[budget]
+    # the reported largest outside distance is the true one
+    signed = np.asarray(mesh.vertices) @ hull.face_normals.T - np.einsum(
+        "ij,ij->i", hull.face_normals, hull.triangles[:, 0])
+    assert signed.max(axis=1).max() == pytest.approx(report["max_outside"], rel=1e-9)
+    assert report["max_outside"] < {16: 0.07, 32: 0.035, 64: 0.02}[budget] * np.linalg.norm(mesh.extents)
+    contained, rc = convex_hull_report(mesh, max_vertices=budget, contain=True)
+    assert len(contained.vertices) <= budget and rc["scale"] > 1 and rc["volume_ratio"] > 1
+    inside = np.asarray(mesh.vertices) @ contained.face_normals.T - np.einsum(
+        "ij,ij->i", contained.face_normals, contained.triangles[:, 0])
+    assert inside.max() <= 1e-12  # contains every vertex
+
+
+def test_hull_errors():
+    with pytest.raises(ValueError, match="at least 4"):
+        convex_hull(trimesh.creation.box([1, 1, 1]), max_vertices=3)
+    flat = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2], [1, 3, 2]])
+    with pytest.raises(ValueError, match="flat"):
+        convex_hull(flat)
+
+
+# --- CoACD -----------------------------------------------------------------------------------
+
+def test_decompose_l_shape(capfd):
+    mesh = l_shape()
+    t0 = time.perf_counter()
+    pieces = decompose(mesh, max_hull_vertices=16)
+    elapsed = time.perf_counter() - t0
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""  # CoACD's console output is silenced at the file-descriptor level
+    assert len(pieces) >= 2
+    for p in pieces:
+        assert p.is_volume and p.is_convex and len(p.vertices) <= 16
+    report = fidelity(mesh, pieces)
+    assert report["volume_ratio"] == pytest.approx(1.0, abs=0.02)
+    assert report["largest_piece_vertices"] <= 16 and report["pieces"] == len(pieces)
+    assert elapsed < 10
+    again = decompose(mesh, max_hull_vertices=16)
+    assert [p.vertices.tolist() for p in again] == [p.vertices.tolist() for p in pieces]
+    tight = decompose(mesh, max_hull_vertices=8)
+    assert max(len(p.vertices) for p in tight) <= 8
+
+
+def test_decompose_rejects_bad_parameters():
+    box = trimesh.creation.box([1, 1, 1])
+    with pytest.raises(ValueError, match="threshold"):
+        decompose(box, threshold=0)
+    with pytest.raises(ValueError, match="preprocess"):
+        decompose(box, preprocess="maybe")
+    with pytest.raises(ValueError, match="max_hull_vertices"):
+        decompose(box, max_hull_vertices=3)
+
+
+# --- primitives ------------------------------------------------------------------------------
+
+def inside_primitive(p: Primitive, points: np.ndarray, tol: float) -> bool:
+    T = np.linalg.inv(p.pose)
+    q = points @ T[:3, :3].T + T[:3, 3]
+    if p.kind == "box":
+        return bool((np.abs(q) <= np.asarray(p.params["size"]) / 2 + tol).all())
+    if p.kind == "sphere":
+        return bool((np.linalg.norm(q, axis=1) <= p.params["radius"] + tol).all())
+    rho = np.linalg.norm(q[:, :2], axis=1)
+    half = p.params["length"] / 2
+    if p.kind == "cylinder":
+        return bool(((rho <= p.params["radius"] + tol) & (np.abs(q[:, 2]) <= half + tol)).all())
+    dz = np.maximum(np.abs(q[:, 2]) - half, 0)
+    return bool((np.hypot(rho, dz) <= p.params["radius"] + tol).all())
+
+
+def test_fit_box_is_the_box():
+    box = trimesh.creation.box([0.1, 0.2, 0.3])
+    fit = fit_box(box)
+    np.testing.assert_allclose(fit.params["size"], [0.1, 0.2, 0.3], rtol=1e-12)
+    np.testing.assert_allclose(fit.pose, np.eye(4), atol=1e-12)
+    assert fit.volume == pytest.approx(0.006, rel=1e-12)
+    T = pose()
+    fit = fit_box(moved(box, T))
+    assert sorted(fit.params["size"]) == pytest.approx([0.1, 0.2, 0.3], rel=1e-9)
+    np.testing.assert_allclose(fit.pose[:3, 3], T[:3, 3], atol=1e-12)
+    json.dumps(fit.to_dict())
+
+
+def test_fit_cylinder_sphere_capsule_give_the_analytic_parameters():
+    T = pose()
+    cyl = fit_cylinder(moved(trimesh.creation.cylinder(radius=0.05, height=0.4, sections=256), T))
+    assert cyl.params["radius"] == pytest.approx(0.05, rel=1e-9)
+    assert cyl.params["length"] == pytest.approx(0.4, rel=1e-9)
+    assert abs(cyl.pose[:3, 2] @ T[:3, 2]) == pytest.approx(1.0, abs=1e-9)
+    np.testing.assert_allclose(cyl.pose[:3, 3], T[:3, 3], atol=1e-9)
+    assert cyl.volume == pytest.approx(math.pi * 0.05 ** 2 * 0.4, rel=1e-9)
+
+    sph = fit_sphere(moved(trimesh.creation.icosphere(subdivisions=3, radius=0.2), T))
+    assert sph.params["radius"] == pytest.approx(0.2, rel=1e-9)
+    np.testing.assert_allclose(sph.pose[:3, 3], T[:3, 3], atol=1e-9)
+
+    cap = fit_capsule(moved(trimesh.creation.capsule(height=0.4, radius=0.1, count=[32, 32]), T))
+    assert cap.params["radius"] == pytest.approx(0.1, rel=1e-6)
+    assert cap.params["length"] == pytest.approx(0.4, rel=1e-6)
+    assert abs(cap.pose[:3, 2] @ T[:3, 2]) == pytest.approx(1.0, abs=1e-6)
+    assert cap.volume == pytest.approx(math.pi * 0.01 * 0.4 + 4 / 3 * math.pi * 0.001, rel=1e-5)
+
+
+def test_every_fit_contains_the_mesh():
+    mesh = moved(l_shape(0), pose())
+    V = np.asarray(mesh.vertices)
+    for fit in (fit_box, fit_cylinder, fit_sphere, fit_capsule):
+        p = fit(mesh)
+        assert inside_primitive(p, V, 1e-9), p.kind
+        assert p.volume >= mesh.volume
+        assert p.to_mesh().is_volume
+
+
+# --- fidelity --------------------------------------------------------------------------------
+
+def test_fidelity_of_a_box_hull_is_perfect():
+    box = trimesh.creation.box([0.1, 0.2, 0.3]).subdivide()
+    f = fidelity(box, [convex_hull(box)])
+    assert f["volume_ratio"] == pytest.approx(1.0, abs=1e-12)
+    assert f["distance"]["max"] < 1e-15 and f["pieces"] == 1 and f["largest_piece_vertices"] == 8
+
+
+def test_fidelity_of_a_sphere_proxied_by_its_bounding_box():
+    r = 0.5
+    sphere = trimesh.creation.icosphere(subdivisions=5, radius=r)
+    rho, _ = shell(sphere)
+    box = Primitive("box", {"size": (2 * r, 2 * r, 2 * r)}, np.eye(4), 8 * r ** 3)
+    f = fidelity(sphere, [box])
+    assert f["volume_method"] == "analytic" and f["largest_piece_vertices"] is None
+    assert f["volume_ratio"] == pytest.approx(8 * r ** 3 / sphere.volume, rel=1e-12)
+    assert f["volume_ratio"] == pytest.approx(6 / math.pi, rel=1e-3)
+    d = f["distance"]
+    # farthest box point from the sphere: a corner, sqrt(3) r - r; farthest sphere point: r (1 - 1/sqrt(3))
+    assert 0.9 * (math.sqrt(3) - 1) * r <= d["a_to_b_max"] <= math.sqrt(3) * r - rho
+    assert 0.9 * (1 - 1 / math.sqrt(3)) * r <= d["b_to_a_max"] <= (1 - 1 / math.sqrt(3)) * r + 1e-12
+
+
+def test_fidelity_unions_overlapping_pieces():
+    a = trimesh.creation.box([1.0, 1.0, 1.0])
+    b = moved(a, pose((0, 0, 0), (0.5, 0, 0)))
+    whole = moved(trimesh.creation.box([1.5, 1.0, 1.0]), pose((0, 0, 0), (0.25, 0, 0)))
+    f = fidelity(whole, [a, b])
+    assert f["volume_method"] == "union"
+    assert f["proxy_volume"] == pytest.approx(1.5, rel=1e-12) and f["overlap_volume"] == pytest.approx(0.5)
+    assert f["volume_ratio"] == pytest.approx(1.0, rel=1e-12) and f["distance"]["max"] < 1e-12
+    with pytest.raises(ValueError):
+        fidelity(whole, [])
+
+
+# --- cache -----------------------------------------------------------------------------------
+
+class Counter:
+    def __init__(self, value):
+        self.calls, self.value = 0, value
+
+    def __call__(self):
+        self.calls += 1
+        return self.value
+
+
+def test_cache_hit_and_misses(tmp_path):
+    torus = trimesh.creation.torus(0.2, 0.05, major_sections=32, minor_sections=16)
+    cache = Cache(tmp_path)
+    compute = Counter(([torus, convex_hull(torus)], {"note": "two meshes", "n": 2}))
+    first = cache.get_or_compute("hull", {"max_vertices": 32}, torus, compute)
+    second = cache.get_or_compute("hull", {"max_vertices": 32}, torus, compute)
+    assert compute.calls == 1 and cache.stats["hits"] == 1 and cache.stats["misses"] == 1
+    (m1, info1), (m2, info2) = first, second
+    assert info1 == info2 == {"note": "two meshes", "n": 2}
+    for x, y in zip(m1, m2):
+        np.testing.assert_array_equal(x.vertices, y.vertices)
+        np.testing.assert_array_equal(x.faces, y.faces)
+    np.testing.assert_array_equal(m1[0].vertices, torus.vertices)  # exact float64
+    cache.get_or_compute("hull", {"max_vertices": 16}, torus, compute)  # other parameters
+    assert compute.calls == 2
+    cache.get_or_compute("hull", {"max_vertices": 32}, torus.copy().apply_scale(2.0), compute)  # other input
+    assert compute.calls == 3
+    other_versions = dict(cache.versions, coacd="0.0.1")
+    Cache(tmp_path, versions=other_versions).get_or_compute("hull", {"max_vertices": 32}, torus, compute)
+    assert compute.calls == 4
+    assert cache.get_or_compute("hull", {"max_vertices": 32}, torus, compute)[1]["n"] == 2
+    assert compute.calls == 4
+
+
+def test_cache_keys_are_canonical(tmp_path):
+    cache = Cache(tmp_path, versions={"x": "1"})
+    box = trimesh.creation.box([1, 1, 1])
+    assert cache.key("op", {"a": 1, "b": (1.0, 2.0)}, box) == cache.key("op", {"b": [1.0, 2.0], "a": 1}, box)
+    assert cache.key("op", {"a": 1}, box) != cache.key("op2", {"a": 1}, box)
+    assert cache.key("op", {"a": 1}, b"abc") != cache.key("op", {"a": 1}, b"abd")
+    assert mesh_digest(box) == mesh_digest(box.copy())
+
+
+@pytest.mark.parametrize("damage", ["flip_byte", "truncate", "drop_payload", "garble_manifest",
+                                    "manifest_of_other_key"])
+def test_cache_corrupt_entry_is_recomputed(tmp_path, damage):
+    box = trimesh.creation.box([1, 2, 3])
+    cache = Cache(tmp_path)
+    compute = Counter(box)
+    cache.get_or_compute("op", {}, b"input", compute)
+    key = cache.key("op", {}, b"input")
+    manifest = cache.manifest_path(key)
+    payload = manifest.parent / json.loads(manifest.read_text())["payload"]["file"]
+    if damage == "flip_byte":
+        data = bytearray(payload.read_bytes())
+        data[30] ^= 0xFF
+        payload.write_bytes(bytes(data))
+    elif damage == "truncate":
+        payload.write_bytes(payload.read_bytes()[:-7])
+    elif damage == "drop_payload":
+        payload.unlink()
+    elif damage == "garble_manifest":
+        manifest.write_text(manifest.read_text()[:40])
+    else:
+        doc = json.loads(manifest.read_text())
+        doc["key"] = "0" * 64
+        manifest.write_text(json.dumps(doc))
+    again = cache.get_or_compute("op", {}, b"input", compute)
+    assert compute.calls == 2 and cache.stats["corrupt"] == 1
+    np.testing.assert_array_equal(again.vertices, box.vertices)
+    assert cache.get(key) is not None  # the recomputed entry is whole again
+    assert len(list(manifest.parent.glob("*.bin"))) == 1
+
+
+def test_cache_location(monkeypatch, tmp_path):
+    monkeypatch.setenv("ROBOTKIT_CACHE", str(tmp_path / "mine"))
+    assert default_root() == tmp_path / "mine"
+    cache = Cache()
+    cache.get_or_compute("op", {}, b"x", Counter(trimesh.creation.box([1, 1, 1])))
+    assert list((tmp_path / "mine").rglob("*.json"))
+    monkeypatch.delenv("ROBOTKIT_CACHE")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert default_root() == tmp_path / "xdg" / "robotkit"
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    assert default_root() == Path.home() / ".cache" / "robotkit"
+
+
+def _slow_compute_in_process(root: str, log: str, out: str):
+    def compute():
+        with open(log, "a") as f:
+            f.write(f"{os.getpid()}\n")
+        time.sleep(0.3)
+        return trimesh.creation.icosphere(2)
+
+    mesh = Cache(root, versions={"v": "1"}).get_or_compute("slow", {}, b"same", compute)
+    Path(out).write_text(hashlib.sha256(stl_bytes(mesh)).hexdigest())
+
+
+def test_cache_two_processes_compute_the_same_key_once(tmp_path):
+    ctx = multiprocessing.get_context("fork")
+    log = tmp_path / "calls.log"
+    procs = [ctx.Process(target=_slow_compute_in_process, args=(str(tmp_path / "c"), str(log), str(tmp_path / f"o{i}")))
+             for i in range(2)]
+    for p in procs:
+        p.start()
+    for p in procs:
+        p.join(30)
+        assert p.exitcode == 0
+    assert len(log.read_text().split()) == 1
+    assert (tmp_path / "o0").read_text() == (tmp_path / "o1").read_text()
+
+
+# --- export ----------------------------------------------------------------------------------
+
+def test_stl_bytes_are_reproducible_across_processes():
+    mesh = moved(trimesh.creation.icosphere(subdivisions=3, radius=0.1), pose())
+    data = stl_bytes(mesh)
+    assert data == stl_bytes(mesh.copy())
+    assert len(data) == 84 + 50 * len(mesh.faces)
+    code = ("import hashlib, numpy as np, trimesh, sys; sys.path.insert(0, %r);"
+            "from robotkit.mesh.export import stl_bytes; from robotkit.model.robot import rpy_matrix;"
+            "m = trimesh.creation.icosphere(subdivisions=3, radius=0.1); T = np.eye(4);"
+            "T[:3, :3] = rpy_matrix((0.3, -0.7, 1.2)); T[:3, 3] = (0.1, -0.2, 0.3); m.apply_transform(T);"
+            "print(hashlib.sha256(stl_bytes(m)).hexdigest())") % str(REPO)
+    other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert other.stdout.strip() == hashlib.sha256(data).hexdigest()
+    back = trimesh.load(io.BytesIO(data), file_type="stl")
+    assert back.is_volume and back.volume == pytest.approx(mesh.volume, rel=1e-6)
+
+
+def test_obj_bytes_are_exact_and_reproducible():
+    mesh = moved(trimesh.creation.icosphere(subdivisions=2, radius=0.1), pose())
+    data = obj_bytes(mesh)
+    assert data == obj_bytes(mesh.copy())
+    back = trimesh.load(io.BytesIO(data), file_type="obj", process=False)
+    np.testing.assert_array_equal(back.vertices, mesh.vertices)
+    np.testing.assert_array_equal(back.faces, mesh.faces)
+
+
+def test_canonical_order_ignores_the_input_order():
+    box = trimesh.creation.box([1, 2, 3])
+    rng = np.random.default_rng(0)
+    perm = rng.permutation(len(box.vertices))
+    inv = np.argsort(perm)
+    shuffled = trimesh.Trimesh(np.asarray(box.vertices)[perm], np.roll(inv[box.faces][rng.permutation(12)], 1, axis=1),
+                               process=False)
+    a, b = canonical(box.vertices, box.faces), canonical(shuffled.vertices, shuffled.faces)
+    assert stl_bytes(a) == stl_bytes(b)
