@@ -89,8 +89,10 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
         findings += [Finding("warning", "equivalence", f"robot '{name}'", n) for n in notes]
     except (RuntimeError, ValueError) as exc:
         findings.append(Finding("warning", "equivalence", f"robot '{name}'", str(exc)))
+    sim_notes: list[str] = []
     findings += [Finding("error", "simulation", f"robot '{name}'", p,
-                         "MuJoCo scene mjcf/scene.xml") for p in smoke_test(scene)]
+                         "MuJoCo scene mjcf/scene.xml") for p in smoke_test(scene, notes=sim_notes)]
+    findings += [Finding("warning", "simulation", f"robot '{name}'", n) for n in sim_notes]
     return findings
 
 

@@ -86,7 +86,10 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
 
     copies: dict[str, tuple[str, list[str]]] = {}
     processed: dict[str, object] = {}
+    shown = {g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link) if g.shape.kind == "mesh"}
     for key, mesh in robot.meshes().items():
+        if key not in shown:  # only the source of collision pieces
+            continue
         if mesh.processed:
             processed.setdefault(mesh.path, mesh)
             continue
@@ -261,22 +264,27 @@ def _world_templates() -> list[str]:
 def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
     """Recipe location (file, line, key) of the first geometry naming each mesh key."""
     marks = loaded.marks
-    out: dict[str, dict] = {}
+    where_source: dict[tuple[str, str], dict] = {}  # (link, source file) -> location
     for name, link in loaded.recipe.links.items():
-        for kind in ("visual", "collision"):
-            value = getattr(link, kind)
-            if value is None or isinstance(value, str) or hasattr(value, "strategy"):
+        places = [("visual",), ("collision",)]
+        if hasattr(link.collision, "strategy"):
+            places = [("visual",), ("collision", "source")]
+        for place in places:
+            value = link.visual if place == ("visual",) else (
+                link.collision.source if len(place) == 2 else link.collision)
+            if value is None or isinstance(value, str):
                 continue
             items = [((i,), g) for i, g in enumerate(value)] if isinstance(value, list) else [((), value)]
             for idx, g in items:
-                if g.mesh is None:
-                    continue
-                path = ("links", name, kind) + idx + ("mesh",)
-                for geom in robot.link(name).visuals + robot.link(name).collisions:
-                    m = geom.shape.mesh
-                    if m is not None and m.source == g.mesh and m.key not in out:
-                        p = marks.problem(path, "")
-                        out[m.key] = {"file": p.file, "line": p.line, "key": p.key}
+                if g.mesh is not None and (name, g.mesh) not in where_source:
+                    p = marks.problem(("links", name) + place + idx + ("mesh",), "")
+                    where_source[(name, g.mesh)] = {"file": p.file, "line": p.line, "key": p.key}
+    out: dict[str, dict] = {}
+    for link in robot.links:
+        for geom in robot.all_geoms(link):
+            m = geom.shape.mesh
+            if m is not None and m.key not in out and (link.name, m.source) in where_source:
+                out[m.key] = where_source[(link.name, m.source)]
     return out
 
 

@@ -14,6 +14,22 @@ RECIPES = REPO / "recipes"
 GOLDEN = Path(__file__).resolve().parent / "golden"
 
 
+@pytest.fixture(scope="session", autouse=True)
+def mesh_cache(tmp_path_factory):
+    """One mesh cache for the test session (builds in subprocesses inherit it): CoACD and
+    friends run once per session, and the user's own cache is never touched."""
+    import os
+
+    folder = tmp_path_factory.mktemp("robotkit-cache")
+    old = os.environ.get("ROBOTKIT_CACHE")
+    os.environ["ROBOTKIT_CACHE"] = str(folder)
+    yield folder
+    if old is None:
+        os.environ.pop("ROBOTKIT_CACHE", None)
+    else:
+        os.environ["ROBOTKIT_CACHE"] = old
+
+
 @pytest.fixture
 def assets() -> Path:
     if not ASSETS.is_dir():

@@ -204,7 +204,7 @@ CASES = {
         links:
           a: {visual: {mesh: open.stl}}
         """,
-        ["robot.yaml:3: links.a.visual.mesh: mesh 'open.stl' is not a closed volume (4 open edges), so its "
+        ["robot.yaml:3: links.a.visual.mesh: mesh 'open.stl' is not a closed volume (32 open edges), so its "
          "mass properties would be wrong; repair the mesh, give an explicit inertial, or set 'open_mesh: hull'"],
     ),
     "every_problem_at_once": (
@@ -243,8 +243,9 @@ def folder(tmp_path):
     shutil.copyfile(BASE_STL, tmp_path / "base.stl")
     (tmp_path / "trunc.stl").write_bytes(BASE_STL.read_bytes()[:300])
     (tmp_path / "garbage.obj").write_text("this is not a mesh\n")
-    box = trimesh.creation.box([0.1, 0.1, 0.1])
-    trimesh.Trimesh(box.vertices, box.faces[:-2]).export(tmp_path / "open.stl")
+    tube = trimesh.creation.cylinder(radius=0.05, height=0.1, sections=32)
+    up = tube.face_normals[:, 2] < 0.99  # no top cap: a 32-edge hole, too large to fill
+    trimesh.Trimesh(tube.vertices, tube.faces[up]).export(tmp_path / "open.stl")
     return tmp_path
 
 

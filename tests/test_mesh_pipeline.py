@@ -475,6 +475,10 @@ def test_fidelity_unions_overlapping_pieces():
     assert f["volume_ratio"] == pytest.approx(1.0, rel=1e-12) and f["distance"]["max"] < 1e-12
     with pytest.raises(ValueError):
         fidelity(whole, [])
+    open_box = trimesh.Trimesh(whole.vertices, whole.faces[2:], process=False)
+    f = fidelity(whole, [open_box])  # an open piece has no volume: none is made up
+    assert f["volume_method"] == "unavailable" and f["proxy_volume"] is None and f["volume_ratio"] is None
+    assert f["distance"]["a_to_b_max"] < 1e-12  # every proxy point lies on the visual surface
 
 
 # --- cache -----------------------------------------------------------------------------------

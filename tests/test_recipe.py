@@ -181,19 +181,20 @@ def test_defaults_and_includes(tmp_path):
 
 def test_open_mesh_with_hull_policy_warns_and_uses_the_hull(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    box = trimesh.creation.box([0.1, 0.1, 0.1])
+    tube = trimesh.creation.cylinder(radius=0.05, height=0.1, sections=32)
+    box = trimesh.Trimesh(tube.vertices, tube.faces[tube.face_normals[:, 2] < 0.99])  # a 32-edge hole
     recipe = write_recipe(tmp_path, """
         robot: op
         open_mesh: hull
         links:
           a: {visual: {mesh: open.stl}}
-        """, meshes={"open.stl": trimesh.Trimesh(box.vertices, box.faces[:-2])})
+        """, meshes={"open.stl": box})
     result = build([recipe], tmp_path / "out")
     assert result.warnings == [
-        "robot.yaml:4: links.a.visual.mesh: mesh 'open.stl' is not a closed volume (4 open edges); "
+        "robot.yaml:4: links.a.visual.mesh: mesh 'open.stl' is not a closed volume (32 open edges); "
         "its mass properties use its convex hull, which overestimates the volume"]
     mass, _, _ = urdf_inertials(tmp_path / "out" / "op" / "urdf" / "op.urdf")["a"]
-    assert mass == pytest.approx(1000 * stored(box).volume, rel=1e-12)
+    assert mass == pytest.approx(1000 * stored(box).convex_hull.volume, rel=1e-9)
 
 
 def test_safe_repairs_fix_duplicate_faces_and_inverted_winding(tmp_path):

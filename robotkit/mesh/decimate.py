@@ -15,15 +15,15 @@ in metres and in millimetres, and badly when small: at metre scale the
 threshold passes centimetres within a few rounds.  The mesh is therefore
 moved to its bounding-box centre and scaled to a 1000-unit diagonal for the
 call, and mapped back after.  On the real meshes in shared/assets (to 10 %
-of their faces) this made the largest surface deviation 2-7 times smaller
-than calling it on metres; the 500k-face torus is unchanged (4.5e-4 of its
-diagonal).
+of their faces) this made the largest surface deviation 1.1-7 times smaller
+than calling it on metres (UR5 shoulder 0.22 -> 0.034 of the diagonal); the
+500k-face torus is unchanged (4.7e-4 of its diagonal).
 
-**Limits** (measured, see docs/performance.md): on large smooth meshes it is
-10-20 times faster than MeshLab's quadric edge collapse at the same quality;
-on CAD tessellations (UR5, TurtleBot3) it can stop above the target (it
-refuses collapses that flip faces) and deviates several times more than
-MeshLab at the same target.  The report's ``faces_after`` and ``distance``
+**Limits** (measured, see docs/performance.md): on a large smooth mesh it is
+about 10 times faster than MeshLab's quadric edge collapse at the same
+quality; on CAD tessellations (UR5, TurtleBot3) it is only 0.9-6 times faster,
+can stop above the target (it refuses collapses that fold long thin
+triangles) and deviates up to 20 times more than MeshLab.  The report's ``faces_after`` and ``distance``
 say what was achieved; callers should check them against their budget.
 
 :func:`surface_distance` is hand-written.  ``trimesh.proximity.closest_point``

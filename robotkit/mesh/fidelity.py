@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from robotkit.mesh.decimate import DEFAULT_SAMPLES, surface_distance
+from robotkit.mesh.decimate import DEFAULT_SAMPLES, closed_volume, surface_distance
 
 
 def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed: int = 0) -> dict:
@@ -32,9 +32,10 @@ def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed:
     ``largest_piece_vertices`` (mesh pieces only; None when every piece is a
     primitive), ``total_vertices``, ``visual_volume`` (None unless the visual
     mesh is a closed volume), ``proxy_volume`` (union), ``proxy_volume_sum``,
-    ``overlap_volume``, ``volume_method`` (``union``, ``analytic`` or ``sum``:
-    ``sum`` when the union could not be computed, e.g. a piece is not closed),
-    ``volume_ratio`` (proxy / visual, None without a visual volume),
+    ``overlap_volume``, ``volume_method`` (``union``, ``analytic`` for one
+    primitive, ``sum`` when manifold3d could not build the union, or
+    ``unavailable`` when a mesh piece is not a closed volume: the proxy volumes
+    are then None), ``volume_ratio`` (proxy / visual, None without both volumes),
     ``distance`` (see :func:`robotkit.mesh.decimate.surface_distance`; max and
     mean in metres) and ``distance_relative`` (max distance over the visual
     bounding-box diagonal).
@@ -54,13 +55,15 @@ def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed:
             meshes.append(p)
         else:
             raise TypeError(f"a proxy piece must be a trimesh.Trimesh or a Primitive, not {type(p).__name__}")
-    volume_sum = float(sum(p.volume if isinstance(p, Primitive) else m.volume for p, m in zip(pieces, meshes)))
-    surface, union_volume, method = _union(meshes)
+    piece_volumes = [p.volume if isinstance(p, Primitive) else closed_volume(m) for p, m in zip(pieces, meshes)]
+    closed = all(v is not None for v in piece_volumes)
+    volume_sum = float(sum(piece_volumes)) if closed else None
+    surface, union_volume, method = _union(meshes) if closed else (trimesh.util.concatenate(meshes), None, "")
     if len(pieces) == 1 and n_prim == 1:
         union_volume, method = float(analytic[0]), "analytic"
-    if union_volume is None:
-        union_volume, method = volume_sum, "sum"
-    visual_volume = float(visual_mesh.volume) if visual_mesh.is_volume else None
+    elif union_volume is None:
+        union_volume, method = (volume_sum, "sum") if closed else (None, "unavailable")
+    visual_volume = closed_volume(visual_mesh)
     dist = surface_distance(surface, visual_mesh, samples, seed)
     diag = float(np.linalg.norm(np.ptp(np.asarray(visual_mesh.vertices), axis=0)))
     return {
@@ -70,11 +73,11 @@ def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed:
         "largest_piece_vertices": max(vertex_counts) if vertex_counts else None,
         "total_vertices": int(sum(vertex_counts)),
         "visual_volume": visual_volume,
-        "proxy_volume": float(union_volume),
+        "proxy_volume": union_volume,
         "proxy_volume_sum": volume_sum,
-        "overlap_volume": float(volume_sum - union_volume),
+        "overlap_volume": volume_sum - union_volume if volume_sum is not None and union_volume is not None else None,
         "volume_method": method,
-        "volume_ratio": float(union_volume / visual_volume) if visual_volume else None,
+        "volume_ratio": union_volume / visual_volume if visual_volume and union_volume is not None else None,
         "distance": dist,
         "distance_relative": float(dist["max"] / diag) if diag > 0 else None,
     }
@@ -86,7 +89,7 @@ def _union(meshes: list) -> tuple[trimesh.Trimesh, float | None, str]:
 
     if len(meshes) == 1:
         m = meshes[0]
-        return m, (float(m.volume) if m.is_volume else None), "union"
+        return m, closed_volume(m), "union"
     try:
         import manifold3d as m3
 

@@ -39,7 +39,7 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
         if problem:
             raise fail(f"mesh file '{name}' {problem}")
     try:
-        loaded = trimesh.load(path, force="mesh", process=True)
+        loaded = trimesh.load(path, force="mesh", process=False)  # process would drop NaN faces unseen
     except Exception as exc:  # trimesh raises many kinds on corrupt input
         raise fail(f"cannot read mesh file '{name}': {type(exc).__name__}: {exc}".rstrip(": ")) from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
@@ -82,20 +82,16 @@ def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):
     repairs: list[str] = []
     warnings: list[str] = []
     if not mesh.is_volume:
-        n = len(mesh.faces)
-        mesh.update_faces(mesh.unique_faces())
-        if len(mesh.faces) < n:
-            repairs.append(f"removed {n - len(mesh.faces)} duplicate faces")
-        n = len(mesh.faces)
-        mesh.update_faces(mesh.nondegenerate_faces())
-        if len(mesh.faces) < n:
-            repairs.append(f"removed {n - len(mesh.faces)} degenerate faces")
-        mesh.remove_unreferenced_vertices()
-        if mesh.is_watertight and not (mesh.is_winding_consistent and mesh.volume > 0):
-            import trimesh
+        from robotkit.mesh.repair import repair
 
-            trimesh.repair.fix_normals(mesh, multibody=True)
-            repairs.append("fixed face winding and orientation")
+        mesh, report = repair(mesh)
+        for key, text in (("vertices_merged", "merged {} vertices"),
+                          ("duplicate_faces_removed", "removed {} duplicate faces"),
+                          ("degenerate_faces_removed", "removed {} degenerate faces"),
+                          ("faces_flipped", "flipped {} faces"), ("bodies_inverted", "turned {} bodies outward"),
+                          ("holes_filled", "filled {} holes")):
+            if report.get(key):
+                repairs.append(text.format(report[key]))
     if mesh.is_volume:
         return mesh, repairs, "mesh", warnings
     reason = _why_not_volume(mesh)

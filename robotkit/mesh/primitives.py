@@ -37,7 +37,7 @@ import numpy as np
 import trimesh
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Primitive:
     """A fitted primitive: ``kind`` is ``box``, ``cylinder``, ``sphere`` or ``capsule``.
 

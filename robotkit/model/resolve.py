@@ -109,11 +109,22 @@ def resolve(loaded: LoadedRecipe) -> Robot:
         format_collisions = []
         strategy = link.collision if isinstance(link.collision, Collision) else (
             r.meshes.collision if link.collision == "visual" else None)
+        if isinstance(link.collision, Collision) and r.meshes.collision is not None:
+            # what the link does not say comes from the project default
+            strategy = r.meshes.collision.model_copy(
+                update={k: getattr(link.collision, k) for k in link.collision.model_fields_set})
         if strategy is not None:
-            collisions = _proxies(visuals, strategy, r.meshes.repair)
+            made_from = visuals
+            if isinstance(link.collision, Collision) and link.collision.source is not None:
+                made_from = []
+                for i, g in _indexed(link.collision.source):
+                    geom = make_geom(g, lp + ("collision", "source") + i, name, "error", "collision")
+                    if geom is not None:
+                        made_from.append(_display_only(geom))
+            collisions = _proxies(made_from, strategy, r.meshes.repair)
             for fmt in ("urdf", "sdf", "mjcf"):
                 if getattr(strategy, fmt) is not None:
-                    format_collisions.append((fmt, tuple(_proxies(visuals, getattr(strategy, fmt),
+                    format_collisions.append((fmt, tuple(_proxies(made_from, getattr(strategy, fmt),
                                                                   r.meshes.repair))))
         elif link.collision == "visual":
             collisions = [replace(v, material=None) for v in visuals]

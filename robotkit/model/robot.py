@@ -331,11 +331,11 @@ class Robot:
         return link.visuals + link.collisions + tuple(g for _, geoms in link.format_collisions for g in geoms)
 
     def meshes(self) -> dict[str, MeshRef]:
-        """Every distinct mesh unit of work, by key, in a stable order (proxies excluded)."""
+        """Every distinct mesh file unit of work (incl. the sources of collision proxies), by key."""
         out: dict[str, MeshRef] = {}
         for link in self.links:
             for geom in self.all_geoms(link):
-                if geom.shape.mesh is not None and geom.shape.kind == "mesh":
+                if geom.shape.mesh is not None:
                     out.setdefault(geom.shape.mesh.key, geom.shape.mesh)
         return dict(sorted(out.items()))
 

@@ -229,6 +229,9 @@ def _absolute_meshes(data: dict, marks: Marks):
     holders = []
     if isinstance(data.get("links"), dict):
         holders += [(("links", name), link, ("visual", "collision")) for name, link in data["links"].items()]
+    for name, link in (data.get("links") or {}).items() if isinstance(data.get("links"), dict) else []:
+        if isinstance(link, dict) and isinstance(link.get("collision"), dict) and "source" in link["collision"]:
+            holders.append((("links", name, "collision"), link["collision"], ("source",)))
     if isinstance(data.get("sensors"), dict):
         holders += [(("sensors", name, "body"), s.get("body"), ("visual",)) for name, s in data["sensors"].items()
                     if isinstance(s, dict)]

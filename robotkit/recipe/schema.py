@@ -132,6 +132,8 @@ class Proxy(Strict):
 class Collision(Proxy):
     """A collision strategy, with optional overrides for single output formats."""
 
+    source: "Shapes | None" = None
+    """The shapes the strategy is applied to (e.g. a closed low-poly CAD export). Default: the link's visual geometry."""
     urdf: Proxy | None = None
     """Strategy for the URDF only."""
     sdf: Proxy | None = None
@@ -248,6 +250,8 @@ def _collision_form(value) -> str | None:
         return "strategy"
     return _form(value)
 
+
+Collision.model_rebuild()
 
 CollisionSpec = Annotated[
     Annotated[Literal["visual", "none"], Tag("keyword")]
