@@ -188,7 +188,8 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
         out, rep = run_decimate(mesh, target_faces=target_faces)
         return out, rep
 
-    out, rep = _cache().get_or_compute("decimate", {"faces": target_faces}, [mesh], compute)
+    out, rep = _cache().get_or_compute("decimate/1", {"faces": target_faces, "aggression": 7, "samples": 4000,
+                                                      "seed": 0, "report": True}, [mesh], compute)
     info["decimate"] = rep
     write_if_changed(target, stl_bytes(out))
     write_if_changed(report, dump_json(_plain(info)))
@@ -255,12 +256,13 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
             raise ValueError(f"decimation target {faces} faces is above the mesh's {len(mesh.faces)} faces")
         from robotkit.mesh.decimate import decimate
 
-        return [cache.get_or_compute("decimate", {"faces": faces}, [mesh],
+        return [cache.get_or_compute("decimate/1", {"faces": faces, "aggression": 7, "samples": 0, "seed": 0},
+                                     [mesh],
                                      lambda: decimate(mesh, target_faces=faces, samples=0)[0])]
     if kind == "hull":
         from robotkit.mesh.hull import convex_hull
 
-        return [cache.get_or_compute("hull", {"max_vertices": strategy["max_vertices"]}, [mesh],
+        return [cache.get_or_compute("hull/1", {"max_vertices": strategy["max_vertices"], "contain": False}, [mesh],
                                      lambda: convex_hull(mesh, strategy["max_vertices"]))]
     if kind == "decompose":
         from robotkit.mesh.decompose import decompose
@@ -269,7 +271,7 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
         args = dict(threshold=c["threshold"], max_hulls=c["max_hulls"], resolution=c["resolution"],
                     preprocess=c["preprocess"], preprocess_resolution=c["preprocess_resolution"], seed=c["seed"],
                     max_hull_vertices=strategy["max_vertices"], mcts_iterations=c["mcts_iterations"])
-        value = cache.get_or_compute("coacd", args, [mesh], lambda: decompose(mesh, **args))
+        value = cache.get_or_compute("coacd/1", args, [mesh], lambda: decompose(mesh, **args))
         return value if isinstance(value, list) else [value]
     from robotkit.mesh.primitives import fit
 
