@@ -30,12 +30,17 @@ class BuildResult:
     robots: list[str] = field(default_factory=list)
 
 
+SLOW = 1.0  # seconds: tasks at least this long are reported with their time
+
+
 class _Recorder:
     """A doit reporter that records instead of printing."""
 
-    def __init__(self, result: BuildResult, echo=None):
+    def __init__(self, result: BuildResult, echo=None, progress=None):
         self.result = result
         self.echo = echo
+        self.progress = progress  # a stream for progress of long tasks (None: quiet)
+        self.started: dict[str, float] = {}
         self.failures = []
         self.runtime_errors: list[str] = []
 
@@ -46,10 +51,16 @@ class _Recorder:
         pass
 
     def execute_task(self, task):
+        import time
+
         if task.actions:
             self.result.ran.append(task.name)
+            self.started[task.name] = time.perf_counter()
             if self.echo:
                 self.echo(f"  {task.name}")
+            elif self.progress is not None and self.progress.isatty():
+                self.progress.write(f"\r\033[K  running {task.name}")
+                self.progress.flush()
 
     def add_failure(self, task, fail):
         from doit.exceptions import TaskFailed, UnmetDependency
@@ -62,7 +73,16 @@ class _Recorder:
             self.result.errors.append((task.name, fail.get_msg()))
 
     def add_success(self, task):
-        pass
+        import time
+
+        start = self.started.pop(task.name, None)
+        if start is None or self.progress is None:
+            return
+        elapsed = time.perf_counter() - start
+        if elapsed >= SLOW:  # long tasks (CoACD, decimation) are named with their time
+            clear = "\r\033[K" if self.progress.isatty() else ""
+            self.progress.write(f"{clear}  {task.name}: {elapsed:.1f} s\n")
+            self.progress.flush()
 
     def skip_uptodate(self, task):
         self.result.uptodate.append(task.name)
@@ -80,7 +100,9 @@ class _Recorder:
         pass
 
     def complete_run(self):
-        pass
+        if self.progress is not None and self.progress.isatty():
+            self.progress.write("\r\033[K")
+            self.progress.flush()
 
 
 def state_db(out_dir: Path) -> str:
@@ -110,7 +132,7 @@ def to_doit(task: dict) -> dict:
 
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
-          echo=None) -> BuildResult:
+          echo=None, progress=None) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem."""
     from doit.cmd_base import TaskLoader2
     from doit.doit_cmd import DoitMain
@@ -125,7 +147,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     for loaded, robot in robots:
         tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot)))
     (out / ".robotkit").mkdir(parents=True, exist_ok=True)
-    recorder = _Recorder(result, echo)
+    recorder = _Recorder(result, echo, progress)
 
     class Loader(TaskLoader2):
         def setup(self, opt_values):

@@ -94,7 +94,7 @@ def _build(args) -> int:
         return 2
     start = time.perf_counter()
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
-    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo)
+    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr)
     if result.ran or args.verbose:
         for w in result.warnings:
             print(f"warning: {w}", file=sys.stderr)
