@@ -216,7 +216,6 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
     import os
 
     from robotkit.mesh.export import stl_bytes
-    from robotkit.mesh.fidelity import fidelity
     from robotkit.mesh.io import load_mesh
     from robotkit.mesh.repair import repair as run_repair
 
@@ -228,7 +227,7 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
     kind = strategy["kind"]
     params = {k: v for k, v in strategy.items() if k != "repair"}
     try:
-        pieces = _proxy_pieces(mesh, kind, strategy, params)
+        pieces, fid = _proxy_pieces(mesh, kind, strategy, params)
     except (ValueError, RuntimeError) as exc:
         raise RobotkitError(Problem(f"collision '{kind}' of '{_display(source)}' failed: {exc}", **where)) from None
     out_pieces = []
@@ -241,38 +240,51 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
             d = piece.to_dict()
             out_pieces.append({"kind": d["kind"], **d["params"], "xyz": list(d["xyz"]), "rpy": list(d["rpy"])})
     info["pieces"] = out_pieces
-    info["fidelity"] = fidelity(mesh, pieces)
+    info["fidelity"] = fid
     write_if_changed(target, dump_json(_plain(info)))
 
 
 def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
+    """(pieces, fidelity report).  Mesh results and their report come from the cache: the
+    report's surface sampling costs as much as a hull."""
+    from robotkit.mesh.fidelity import fidelity
+
     cache = _cache()
+
+    def with_report(make):
+        def compute():
+            pieces = make()
+            return pieces, {"fidelity": fidelity(mesh, pieces)}
+        return compute
+
+    if kind == "primitive" or kind in ("box", "cylinder", "sphere", "capsule"):
+        from robotkit.mesh.primitives import fit
+
+        pieces = [fit(mesh, kind)]
+        return pieces, fidelity(mesh, pieces)
     if kind == "mesh":
         if not strategy["decimate"]:
-            return [mesh]
+            return [mesh], fidelity(mesh, [mesh])
         how, value = strategy["decimate"]
         faces = int(value) if how == "faces" else max(4, int(round(len(mesh.faces) * float(value))))
         if faces > len(mesh.faces):
             raise ValueError(f"decimation target {faces} faces is above the mesh's {len(mesh.faces)} faces")
         from robotkit.mesh.decimate import decimate
 
-        return [cache.get_or_compute("decimate/1", {"faces": faces, "aggression": 7, "samples": 0, "seed": 0},
-                                     [mesh],
-                                     lambda: decimate(mesh, target_faces=faces, samples=0)[0])]
-    if kind == "hull":
+        op, args, make = "collision-decimate/1", {"faces": faces, "aggression": 7, "seed": 0}, \
+            (lambda: [decimate(mesh, target_faces=faces, samples=0)[0]])
+    elif kind == "hull":
         from robotkit.mesh.hull import convex_hull
 
-        return [cache.get_or_compute("hull/1", {"max_vertices": strategy["max_vertices"], "contain": False}, [mesh],
-                                     lambda: convex_hull(mesh, strategy["max_vertices"]))]
-    if kind == "decompose":
+        op, args, make = "collision-hull/1", {"max_vertices": strategy["max_vertices"], "contain": False}, \
+            (lambda: [convex_hull(mesh, strategy["max_vertices"])])
+    else:
         from robotkit.mesh.decompose import decompose
 
         c = strategy["coacd"]
         args = dict(threshold=c["threshold"], max_hulls=c["max_hulls"], resolution=c["resolution"],
                     preprocess=c["preprocess"], preprocess_resolution=c["preprocess_resolution"], seed=c["seed"],
                     max_hull_vertices=strategy["max_vertices"], mcts_iterations=c["mcts_iterations"])
-        value = cache.get_or_compute("coacd/1", args, [mesh], lambda: decompose(mesh, **args))
-        return value if isinstance(value, list) else [value]
-    from robotkit.mesh.primitives import fit
-
-    return [fit(mesh, kind)]
+        op, make = "collision-coacd/1", (lambda: decompose(mesh, **args))
+    pieces, info = cache.get_or_compute(op, {**args, "fidelity_samples": 4000}, [mesh], with_report(make))
+    return list(pieces) if isinstance(pieces, (list, tuple)) else [pieces], info["fidelity"]
