@@ -196,18 +196,9 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
 
 
 def _plain(value):
-    """JSON-able copy (numpy numbers and arrays to Python)."""
-    import numpy as np
+    from robotkit.mesh.cache import plain
 
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
+    return plain(value)
 
 
 @_user_errors_fail

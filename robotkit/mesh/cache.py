@@ -91,16 +91,17 @@ def mesh_digest(mesh) -> str:
 
 def canonical_json(value) -> str:
     """Deterministic JSON: sorted keys, no spaces, numpy values and tuples as plain JSON, no NaN."""
-    return json.dumps(_plain(value), sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return json.dumps(plain(value), sort_keys=True, separators=(",", ":"), allow_nan=False)
 
 
-def _plain(value):
+def plain(value):
+    """A JSON-able copy: numpy numbers and arrays, tuples to plain Python (no -0.0)."""
     if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
+        return {str(k): plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [plain(v) for v in value]
     if isinstance(value, np.ndarray):
-        return [_plain(v) for v in value.tolist()]
+        return [plain(v) for v in value.tolist()]
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
     if isinstance(value, (int, np.integer)):
@@ -181,8 +182,8 @@ class Cache:
         payload = b"".join(blobs)
         digest = hashlib.sha256(payload).hexdigest()
         manifest = {
-            "format": CACHE_FORMAT, "key": key, "op": op, "params": _plain(params or {}),
-            "versions": self.versions, "kind": kind, "meshes": shapes, "info": _plain(info),
+            "format": CACHE_FORMAT, "key": key, "op": op, "params": plain(params or {}),
+            "versions": self.versions, "kind": kind, "meshes": shapes, "info": plain(info),
             "payload": {"file": f"{key}.{digest[:16]}.bin", "size": len(payload), "sha256": digest},
         }
         rebuilt = _build(kind, _parse(payload, shapes), manifest["info"])
