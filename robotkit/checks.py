@@ -171,9 +171,11 @@ def render(findings: list[Finding], fmt: str, source: str) -> str:
     if fmt == "junit":
         return _junit(findings, source)
     if fmt == "github":
+        from robotkit.errors import display_path
+
         lines = []
-        for f in findings:
-            where = f"file={f.file}" + (f",line={f.line}" if f.line else "") if f.file else ""
+        for f in findings:  # GitHub wants paths relative to the repository (the working directory)
+            where = f"file={display_path(f.file)}" + (f",line={f.line}" if f.line else "") if f.file else ""
             text = f"{f.subject}: {f.message}" + (f" (hint: {f.hint})" if f.hint else "")
             text = text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
             lines.append(f"::{f.severity} {where}{',' if where else ''}title=robotkit {f.check}::{text}"
