@@ -56,7 +56,6 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
         out.append(f"mesh '{os.path.basename(src)}': MuJoCo reads no {os.path.splitext(src)[1].upper()[1:]}; "
                    f"converted to meshes/{rel} (the file's own colours and textures are dropped, "
                    "the recipe's material is used)")
-    children = {j.child: j for j in robot.joints}
     for j in robot.joints:
         if j.type == "planar":
             out.append(f"joint '{j.name}': MJCF has no planar joint; written as slides "
@@ -76,7 +75,6 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
                 if f is not None and not f.get("convex", True):
                     out.append(f"link '{link.name}': collision mesh '{g.shape.mesh.file_name}' is not convex; "
                                "MuJoCo collides with its convex hull")
-    del children
     from robotkit.emit.sensors import losses as sensor_losses
 
     return out + sensor_losses(robot)["mjcf"]
@@ -135,7 +133,6 @@ def context(robot: Robot) -> dict:
     for j in robot.joints:
         by_parent.setdefault(j.parent, []).append(j)
     links = {link.name: link for link in robot.links}
-    contacts = {}
 
     def joints_of(j) -> list[dict]:
         if j.type in ("revolute", "continuous", "prismatic"):
@@ -196,7 +193,6 @@ def context(robot: Robot) -> dict:
     equalities = [{"name": f"{j.name}_mimic", "joint1": j.name, "joint2": j.mimic.joint,
                    "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
                   for j in robot.joints if j.mimic is not None]
-    del contacts
     excludes = [(j.parent, j.child) for j in robot.joints if j.parent != WORLD]
     joint_by_name = {j.name: j for j in robot.joints}
     actuators = []
