@@ -150,7 +150,7 @@ def _world(args) -> int:
 
 
 def _check(args) -> int:
-    from robotkit.checks import check, render
+    from robotkit.check import check, render
 
     packages = {}
     for item in args.package_path:
