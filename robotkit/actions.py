@@ -26,7 +26,9 @@ def _user_errors_fail(fn):
         try:
             fn(*args, **kwargs)
         except RobotkitError as exc:
-            return TaskFailed("\n".join(exc.lines()))
+            failed = TaskFailed("\n".join(exc.lines()))
+            failed.exit_status = exc.exit_status  # survives pickling to -j workers
+            return failed
         return None
 
     return run
@@ -112,11 +114,21 @@ def _finalized(robot, fact_paths: dict[str, str], inertial_paths: dict[str, str]
 
 @_user_errors_fail
 def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[str, str], target: str,
-         options: dict):
-    """Render one output file of a finalized robot through a registered emitter."""
-    from robotkit.emit import EMITTERS
+         options: dict, where: dict | None = None):
+    """Render one output file of a finalized robot through a registered emitter.
+
+    The robot descriptions (URDF, SDF, MJCF) are not written for a robot that their consumers
+    would refuse (a moving link without mass...): ConsumerError, naming the link (``where``:
+    link -> recipe location)."""
+    from robotkit.emit import CONSUMED, EMITTERS
 
     full = robot if options.get("raw") else _finalized(robot, fact_paths, inertial_paths)
+    if emitter in CONSUMED:
+        from robotkit.errors import ConsumerError
+
+        problems = [Problem(msg, **(where or {}).get(link, {})) for link, msg in full.consumer_problems()]
+        if problems:
+            raise ConsumerError(problems)
     if options.get("facts"):
         options = dict(options, facts=read_facts(fact_paths))
     write_if_changed(target, EMITTERS[emitter](full, **options))

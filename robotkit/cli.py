@@ -80,7 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     except RobotkitError as exc:
         for line in exc.lines():
             print(line, file=sys.stderr)
-        return 2
+        return exc.exit_status
     except KeyboardInterrupt:
         print("robotkit: interrupted", file=sys.stderr)
         return 130

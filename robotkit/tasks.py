@@ -60,8 +60,9 @@ def _template_files(emitter: str) -> list[str]:
 def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None) -> list[dict]:
     """The task dicts that build ``robot`` into ``out_dir/<robot>/``.
 
-    ``where`` maps a mesh key to the recipe location naming it (for messages).
+    ``where`` maps a mesh key, and ``link:<name>``, to the recipe location naming it (for messages).
     """
+    where = where or {}
     out_dir = Path(out_dir).absolute()
     root = out_dir / robot.name
     state = out_dir / STATE / robot.name
@@ -198,7 +199,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         tasks.append({
             "name": f"{robot.name}:{emitter}",
             "doc": f"{rel(robot)}",
-            "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts])],
+            "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts,
+                                        {k[5:]: v for k, v in where.items() if k.startswith("link:")}])],
             "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter),
             "targets": [target],
             "uptodate": [config_changed({"robot": reads, "options": opts})],
@@ -262,7 +264,8 @@ def _world_templates() -> list[str]:
 
 
 def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
-    """Recipe location (file, line, key) of the first geometry naming each mesh key."""
+    """Recipe location (file, line, key) of the first geometry naming each mesh key, and of
+    each link (``link:<name>``)."""
     marks = loaded.marks
     where_source: dict[tuple[str, str], dict] = {}  # (link, source file) -> location
     for name, link in loaded.recipe.links.items():
@@ -281,6 +284,9 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
                     where_source[(name, g.mesh)] = {"file": p.file, "line": p.line, "key": p.key}
     out: dict[str, dict] = {}
     for link in robot.links:
+        if link.name in loaded.recipe.links:
+            p = marks.problem(("links", link.name), "")
+            out[f"link:{link.name}"] = {"file": p.file, "line": p.line, "key": p.key}
         for geom in robot.all_geoms(link):
             m = geom.shape.mesh
             if m is not None and m.key not in out and (link.name, m.source) in where_source:

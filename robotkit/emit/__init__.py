@@ -82,6 +82,9 @@ EMITTERS = {
     "xacro": _xacro,
 }
 
+# outputs that programs load as robots: not written when a consumer would refuse the robot
+CONSUMED = ("urdf", "sdf", "mjcf")
+
 # the templates each emitter renders (their edits must rebuild the output)
 TEMPLATES = {
     "urdf": ["urdf/robot.urdf.j2", "sensors/sdf.j2", "sensors/classic.j2"],
