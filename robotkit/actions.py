@@ -9,6 +9,7 @@ build turns those into exit status 2.
 from __future__ import annotations
 
 import functools
+import os
 import json
 import shutil
 
@@ -131,6 +132,8 @@ def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[s
             raise ConsumerError(problems)
     if options.get("facts"):
         options = dict(options, facts=read_facts(fact_paths))
+    if options.get("meshes"):  # the emitter measures the mesh files written beside it
+        options = dict(options, meshes=os.path.join(os.path.dirname(os.path.dirname(target)), "meshes"))
     write_if_changed(target, EMITTERS[emitter](full, **options))
 
 

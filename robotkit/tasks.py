@@ -85,6 +85,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
+    mesh_outputs: list[str] = []  # mesh files written below meshes/ (the MJCF measures them)
     copies: dict[str, tuple[str, list[str]]] = {}
     processed: dict[str, object] = {}
     shown = {g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link) if g.shape.kind == "mesh"}
@@ -97,6 +98,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         copies.setdefault(mesh.file_name, (mesh.source, []))[1].append(facts[key])
     for rel, mesh in sorted(processed.items()):
         target = str(root / "meshes" / rel)
+        mesh_outputs.append(target)
         report = str(state / "visual" / f"{mesh.key}.json")
         tasks.append({
             "name": f"{robot.name}:visual:{mesh.file_name}",
@@ -130,6 +132,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         })
     for file_name, (source, checked) in sorted(copies.items()):
         target = str(root / "meshes" / "visual" / file_name)
+        mesh_outputs.append(target)
         tasks.append({
             "name": f"{robot.name}:copy:{file_name}",
             "doc": f"visual mesh {file_name}",
@@ -144,6 +147,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
 
     for rel, source in sorted(converted_meshes(robot).items()):
         target = str(root / "meshes" / rel)
+        mesh_outputs.append(target)
         checked = [facts[k] for k, m in robot.meshes().items() if m.source == source]
         tasks.append({
             "name": f"{robot.name}:convert:{rel}",
@@ -178,7 +182,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                          if g.shape.mesh is not None and g.recenter != "none"})
     out_facts = {**{k: facts[k] for k in recentered}, **proxies}
     structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
-    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True}}
+    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True},
+               "mjcf": {"meshes": True}}
     for emitter, rel in OUTPUTS.items():
         if emitter == "controllers" and not robot.actuators:
             continue
@@ -201,7 +206,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "doc": f"{rel(robot)}",
             "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts,
                                         {k[5:]: v for k, v in where.items() if k.startswith("link:")}])],
-            "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter),
+            "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter)
+            + (mesh_outputs if opts.get("meshes") else []),
             "targets": [target],
             "uptodate": [config_changed({"robot": reads, "options": opts})],
             # no output is written while any mesh of the robot fails
