@@ -138,12 +138,14 @@ def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[s
 
 
 @_user_errors_fail
-def convert_mesh(source: str, target: str):
-    """A mesh in a format MuJoCo reads (binary STL, same units as the source, byte-reproducible)."""
+def convert_mesh(source: str, target: str, scale=(1.0, 1.0, 1.0)):
+    """A mesh in a format its consumers read (OBJ for collision, binary STL for MuJoCo's
+    visuals), coordinates times ``scale``, byte-reproducible."""
+    from robotkit.mesh.export import obj_bytes, stl_bytes
     from robotkit.mesh.io import load_mesh
 
-    mesh = load_mesh(source)
-    write_if_changed(target, mesh.export(file_type="stl"))
+    mesh = load_mesh(source, scale)
+    write_if_changed(target, obj_bytes(mesh) if target.lower().endswith(".obj") else stl_bytes(mesh))
 
 
 @_user_errors_fail
@@ -183,7 +185,6 @@ def _cache():
 def process_visual(source: str, scale, decimate, repair: bool, where: dict, target: str, report: str):
     """A processed visual mesh: repaired and decimated, written as a binary STL in metres."""
     from robotkit.mesh.decimate import decimate as run_decimate
-    from robotkit.mesh.export import stl_bytes
     from robotkit.mesh.io import load_mesh
     from robotkit.mesh.repair import repair as run_repair
 
@@ -206,6 +207,8 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
     out, rep = _cache().get_or_compute("decimate/1", {"faces": target_faces, "aggression": 7, "samples": 4000,
                                                       "seed": 0, "report": True}, [mesh], compute)
     info["decimate"] = rep
+    from robotkit.mesh.export import stl_bytes
+
     write_if_changed(target, stl_bytes(out))
     write_if_changed(report, dump_json(_plain(info)))
 
@@ -221,7 +224,7 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
     """Collision pieces for one mesh and strategy (cached), their files, and a fidelity report."""
     import os
 
-    from robotkit.mesh.export import stl_bytes
+    from robotkit.mesh.export import obj_bytes
     from robotkit.mesh.io import load_mesh
     from robotkit.mesh.repair import repair as run_repair
 
@@ -239,8 +242,9 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
     out_pieces = []
     for i, piece in enumerate(pieces):
         if hasattr(piece, "vertices"):
-            name = f"{stem}_{kind}_{i}.stl" if len(pieces) > 1 or kind != "mesh" else f"{stem}.stl"
-            write_if_changed(os.path.join(meshes_dir, name), stl_bytes(piece))
+            # OBJ: Drake takes convex collision meshes only as OBJ, VTK or glTF
+            name = f"{stem}_{kind}_{i}.obj" if len(pieces) > 1 or kind != "mesh" else f"{stem}_mesh.obj"
+            write_if_changed(os.path.join(meshes_dir, name), obj_bytes(piece))
             out_pieces.append({"kind": "mesh", "file": f"collision/{name}", "vertices": int(len(piece.vertices))})
         else:
             d = piece.to_dict()

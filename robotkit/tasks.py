@@ -143,20 +143,20 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
-    from robotkit.emit.mjcf import converted_meshes
+    from robotkit.emit.meshfiles import conversions
 
-    for rel, source in sorted(converted_meshes(robot).items()):
+    for rel, (source, scale) in conversions(robot).items():
         target = str(root / "meshes" / rel)
         mesh_outputs.append(target)
         checked = [facts[k] for k, m in robot.meshes().items() if m.source == source]
         tasks.append({
             "name": f"{robot.name}:convert:{rel}",
-            "doc": f"meshes/{rel} for MuJoCo",
-            "actions": [(actions.convert_mesh, [source, target])],
+            "actions": [(actions.convert_mesh, [source, target, list(scale)])],
             "file_dep": [source, *checked],
             "targets": [target],
-            "uptodate": [config_changed({"version": actions.FACTS_VERSION})],
+            "uptodate": [config_changed({"version": actions.FACTS_VERSION, "scale": list(scale)})],
             "clean": True,
+            "doc": f"meshes/{rel}",
         })
 
     inertials: dict[str, str] = {}

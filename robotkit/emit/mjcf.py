@@ -30,29 +30,20 @@ def quat(rpy) -> tuple[float, float, float, float]:
     return q if q[0] >= 0 else tuple(-v for v in q)
 
 
-def mesh_file(mesh) -> str:
-    """The mesh file MJCF reads, relative to the robot's meshes/ folder (MuJoCo reads no DAE)."""
-    stem, ext = os.path.splitext(mesh.file_name)
-    if ext.lower() in MJCF_MESH_EXT:
-        return mesh.path
-    return f"mjcf/{stem}.stl"
+def mesh_file(mesh, role: str = "visual") -> str:
+    """The mesh file MJCF reads, relative to the robot's meshes/ folder."""
+    from robotkit.emit.meshfiles import collision_file, visual_file
 
-
-def converted_meshes(robot: Robot) -> dict[str, str]:
-    """Meshes that need converting for MJCF: output path below meshes/ -> source file."""
-    out = {}
-    for mesh in robot.meshes().values():
-        if mesh.processed:
-            continue
-        rel = mesh_file(mesh)
-        if rel.startswith("mjcf/"):
-            out.setdefault(rel, mesh.source)
-    return out
+    return collision_file(mesh) if role == "collision" else visual_file(mesh, "mjcf")
 
 
 def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     out = []
-    for rel, src in sorted(converted_meshes(robot).items()):
+    from robotkit.emit.meshfiles import conversions
+
+    for rel, (src, _) in conversions(robot).items():
+        if not rel.startswith("mjcf/"):
+            continue
         out.append(f"mesh '{os.path.basename(src)}': MuJoCo reads no {os.path.splitext(src)[1].upper()[1:]}; "
                    f"converted to meshes/{rel} (the file's own colours and textures are dropped, "
                    "the recipe's material is used)")
@@ -80,13 +71,13 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     return out + sensor_losses(robot)["mjcf"]
 
 
-def _geom(robot: Robot, geom: Geom, name: str, assets: dict) -> dict:
+def _geom(robot: Robot, geom: Geom, name: str, assets: dict, role: str = "visual") -> dict:
     s = geom.shape
     pose = geom.pose
     ctx = {"name": name, "pos": pose.xyz, "quat": quat(pose.rpy), "type": s.kind,
            "material": geom.material}
     if s.kind == "mesh":
-        key = (mesh_file(s.mesh), s.mesh.out_scale)
+        key = (mesh_file(s.mesh, role), s.mesh.out_scale)
         ctx["mesh"] = assets[key]["name"]
     elif s.kind == "box":
         ctx["size"] = tuple(v / 2 for v in s.size)
@@ -100,15 +91,16 @@ def _geom(robot: Robot, geom: Geom, name: str, assets: dict) -> dict:
 def _assets(robot: Robot) -> dict:
     assets: dict = {}
     used_names: set[str] = set()
-    for link in robot.links:
-        for g in link.visuals + link.collisions_for("mjcf"):
+    geoms = [(g, role) for link in robot.links
+             for role, gs in (("visual", link.visuals), ("collision", link.collisions_for("mjcf"))) for g in gs]
+    for g, role in geoms:
             m = g.shape.mesh
             if m is None:
                 continue
-            key = (mesh_file(m), m.out_scale)
+            key = (mesh_file(m, role), m.out_scale)
             if key in assets:
                 continue
-            base = os.path.splitext(m.file_name)[0]
+            base = os.path.splitext(os.path.basename(key[0]))[0]
             name, n = base, 1
             while name in used_names:
                 n += 1
@@ -173,7 +165,7 @@ def context(robot: Robot, lift: float = 0.0) -> dict:
             "joints": joints_of(joint) if joint is not None else [],
             "inertial": link.inertial,
             "visuals": [_geom(robot, g, f"{name}_visual_{i}", assets) for i, g in enumerate(link.visuals)],
-            "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets), friction=friction)
+            "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets, "collision"), friction=friction)
                            for i, g in enumerate(link.collisions_for("mjcf"))],
             "children": [j.child for j in by_parent.get(name, [])],
             "cameras": extras["cameras"],
@@ -285,7 +277,7 @@ def lowest_point(robot: Robot, meshes_dir: str | None) -> float | None:
             elif s.kind == "mesh" and meshes_dir is not None:
                 from robotkit.mesh.io import read_vertices
 
-                v = read_vertices(os.path.join(meshes_dir, mesh_file(s.mesh))) * np.asarray(s.mesh.out_scale)
+                v = read_vertices(os.path.join(meshes_dir, mesh_file(s.mesh, "collision"))) * np.asarray(s.mesh.out_scale)
                 lows.append(float((v @ R[2, :]).min() + c[2]))
     return min(lows) if lows else None
 

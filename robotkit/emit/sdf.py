@@ -107,7 +107,8 @@ def context(robot: Robot) -> dict:
             "sensors": [s for s in sensors if s["host"] == link.name],
             "visuals": [dict(geom_context(robot, g), uri=_uri(robot, g),
                              material=materials.get(g.material)) for g in visuals],
-            "collisions": [dict(geom_context(robot, g), uri=_uri(robot, g)) for g in collisions],
+            "collisions": [dict(geom_context(robot, g, "collision"), uri=_uri(robot, g, "collision"))
+                           for g in collisions],
             "inertial": link.inertial,
             "contact": link.contact,
         })
@@ -121,10 +122,13 @@ def context(robot: Robot) -> dict:
             "specular": SPECULAR}
 
 
-def _uri(robot: Robot, geom) -> str | None:
+def _uri(robot: Robot, geom, role: str = "visual") -> str | None:
+    from robotkit.emit.meshfiles import collision_file
+
     if geom.shape.mesh is None:
         return None
-    return f"model://{robot.name}/meshes/{geom.shape.mesh.path}"
+    path = collision_file(geom.shape.mesh) if role == "collision" else geom.shape.mesh.path
+    return f"model://{robot.name}/meshes/{path}"
 
 
 def render_sdf(robot: Robot) -> str:

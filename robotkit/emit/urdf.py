@@ -22,8 +22,11 @@ def massless_mass(robot: Robot, link) -> float | None:
     return MASSLESS
 
 
-def mesh_uri(robot: Robot, geom: Geom) -> str:
-    return f"package://{robot.name}/meshes/{geom.shape.mesh.path}"
+def mesh_uri(robot: Robot, geom: Geom, role: str = "visual") -> str:
+    from robotkit.emit.meshfiles import collision_file
+
+    path = collision_file(geom.shape.mesh) if role == "collision" else geom.shape.mesh.path
+    return f"package://{robot.name}/meshes/{path}"
 
 
 def urdf_geoms(geoms) -> list[Geom]:
@@ -44,12 +47,12 @@ def urdf_geoms(geoms) -> list[Geom]:
     return out
 
 
-def geom_context(robot: Robot, geom: Geom) -> dict:
+def geom_context(robot: Robot, geom: Geom, role: str = "visual") -> dict:
     s = geom.shape
     pose = geom.pose
     ctx = {"xyz": pose.xyz, "rpy": pose.rpy, "kind": s.kind, "material": geom.material}
     if s.kind == "mesh":
-        ctx["uri"] = mesh_uri(robot, geom)
+        ctx["uri"] = mesh_uri(robot, geom, role)
         ctx["scale"] = s.mesh.out_scale if any(v != 1.0 for v in s.mesh.out_scale) else None
     elif s.kind == "box":
         ctx["size"] = s.size
@@ -72,7 +75,7 @@ def context(robot: Robot) -> dict:
         links.append({
             "name": link.name,
             "visuals": [geom_context(robot, g) for g in link.visuals],
-            "collisions": [geom_context(robot, g) for g in urdf_geoms(link.collisions_for("urdf"))],
+            "collisions": [geom_context(robot, g, "collision") for g in urdf_geoms(link.collisions_for("urdf"))],
             "inertial": link.inertial,
             "massless": massless_mass(robot, link),
             "gazebo_material": gazebo_material,
