@@ -100,7 +100,7 @@ def _assets(robot: Robot) -> dict:
             key = (mesh_file(m, role), m.out_scale)
             if key in assets:
                 continue
-            base = os.path.splitext(os.path.basename(key[0]))[0]
+            base = os.path.splitext(os.path.basename(key[0]))[0] + ("_collision" if role == "collision" else "")
             name, n = base, 1
             while name in used_names:
                 n += 1
@@ -288,7 +288,8 @@ def render_mjcf(robot: Robot, meshes_dir: str | None = None) -> str:
     lift = 0.0
     if robot.root != WORLD:
         low = lowest_point(robot, meshes_dir)
-        lift = -low if low is not None else 0.0
+        # up to the next micrometre: never inside the floor, and no float32 noise in the file
+        lift = math.ceil(-low * 1e6) / 1e6 if low is not None else 0.0
     return render("mjcf/robot.xml.j2", **context(robot, lift=lift))
 
 

@@ -329,11 +329,12 @@ class Robot:
     def body_mass(self, name: str) -> float:
         """Mass of ``name`` and of everything welded to it by fixed joints below it: what a
         simulator moves as one body."""
-        link = self.link(name)
-        total = link.inertial.mass if link.inertial is not None else 0.0
-        for j in self.joints:
-            if j.parent == name and j.type == "fixed":
-                total += self.body_mass(j.child)
+        by_name = {link.name: link for link in self.links}
+        total, todo = 0.0, [name]
+        while todo:
+            link = by_name[todo.pop()]
+            total += link.inertial.mass if link.inertial is not None else 0.0
+            todo += [j.child for j in self.joints if j.parent == link.name and j.type == "fixed"]
         return total
 
     def consumer_problems(self) -> list[tuple[str, str]]:

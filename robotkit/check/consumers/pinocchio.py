@@ -24,7 +24,7 @@ def from_urdf(build) -> View:
     bodies = [(i, f) for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY]
     masses = {}
     for jid in range(model.njoints):  # each joint's body is named after its first link
-        link = next((f.name for _, f in bodies if f.parentJoint == jid), None)
+        link = next((f.name for _, f in bodies if f.parentJoint == jid and f.name != "world"), None)
         if link is not None:
             masses[link] = float(model.inertias[jid].mass)
 
