@@ -58,6 +58,9 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
             out.append(f"joint '{j.name}': MJCF has no velocity limit ({j.limit.velocity:g} not enforced)")
     for link in robot.links:
         c = link.contact
+        if c is not None and (c.kp is not None or c.kd is not None):
+            out.append(f"link '{link.name}': contact kp/kd are Gazebo (ODE) stiffness and damping; MuJoCo keeps "
+                       "its own contact softness (solref is per unit mass there: copied, they bounce the robot)")
         if c is not None and c.mu2 is not None and c.mu1 is not None and c.mu2 != c.mu1:
             out.append(f"link '{link.name}': MuJoCo friction is isotropic; mu2 {c.mu2:g} dropped, mu1 {c.mu1:g} used")
         for g in link.collisions_for("mjcf"):
