@@ -130,9 +130,14 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                                          "version": actions.FACTS_VERSION})],
             "clean": True,
         })
+    from robotkit.mesh.io import companions
+
+    extras: dict[str, str] = {}  # textures and material files the copied meshes reference
     for file_name, (source, checked) in sorted(copies.items()):
         target = str(root / "meshes" / "visual" / file_name)
         mesh_outputs.append(target)
+        for rel in companions(source):
+            extras.setdefault(rel, os.path.join(os.path.dirname(source), rel))
         tasks.append({
             "name": f"{robot.name}:copy:{file_name}",
             "doc": f"visual mesh {file_name}",
@@ -140,6 +145,16 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             # after its mesh tasks: a file that cannot be used is never copied
             "file_dep": [source, *checked],
             "targets": [target],
+            "clean": True,
+        })
+
+    for rel, source in sorted(extras.items()):
+        tasks.append({
+            "name": f"{robot.name}:copy:{rel}",
+            "doc": f"texture or material file {rel}",
+            "actions": [(actions.copy_file, [source, str(root / "meshes" / "visual" / rel)])],
+            "file_dep": [source],
+            "targets": [str(root / "meshes" / "visual" / rel)],
             "clean": True,
         })
 
