@@ -187,7 +187,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             subject, reads, facts_in, inertials_in = robot, structure, {**facts, **proxies}, inertials
         elif emitter in STRUCTURE_ONLY:
             subject, facts_in, inertials_in = robot, {}, {}
-            reads = {"name": robot.name, "ros_control": robot.ros_control,
+            reads = {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,
                      "actuators": [asdict(a) for a in robot.actuators]}
         elif emitter in METADATA_ONLY:
             subject = replace(robot, links=(), joints=(), materials=())
