@@ -21,7 +21,7 @@ from pathlib import Path
 from doit.tools import config_changed
 
 from robotkit import actions
-from robotkit.emit import TEMPLATES
+from robotkit.emit import TEMPLATES, ros
 from robotkit.emit.env import template_dirs
 from robotkit.model.robot import Robot
 
@@ -38,12 +38,18 @@ OUTPUTS = {
     "model.config": lambda r: "model.config",
     "package.xml": lambda r: "package.xml",
     "CMakeLists.txt": lambda r: "CMakeLists.txt",
+    "env-hook": lambda r: ros.env_hook_path(r),
+    "display-launch": lambda r: ros.launch_path(r, "display"),
+    "gazebo-launch": lambda r: ros.launch_path(r, "gazebo"),
+    "rviz": lambda r: f"rviz/{r.name}.rviz",
     "controllers": lambda r: "config/controllers.yaml",
 }
 # emitters that read only the robot's name and metadata (no geometry, no inertials)
-METADATA_ONLY = {"model.config", "package.xml", "CMakeLists.txt", "mjcf-scene"}
+METADATA_ONLY = {"model.config", "mjcf-scene"}
 # emitters that read the robot's structure but no inertial or mesh fact
 STRUCTURE_ONLY = {"controllers"}
+# the ROS package files: the unfinalized robot (which folders, sensors, actuators, worlds, metadata)
+ROS_PACKAGE = {"package.xml", "CMakeLists.txt", "env-hook", "display-launch", "gazebo-launch"}
 
 
 def _template_files(emitter: str) -> list[str]:
@@ -177,14 +183,17 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                          if g.shape.mesh is not None and g.recenter != "none"})
     out_facts = {**{k: facts[k] for k in recentered}, **proxies}
     structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
-    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True}}
+    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True},
+               "rviz": {"facts": True}, **{e: {"raw": True} for e in ROS_PACKAGE}}
     for emitter, rel in OUTPUTS.items():
         if emitter == "controllers" and not robot.actuators:
             continue
         target = str(root / rel(robot))
         opts = options.get(emitter, {})
-        if emitter == "report":
+        if emitter in ("report", "rviz"):
             subject, reads, facts_in, inertials_in = robot, structure, {**facts, **proxies}, inertials
+        elif emitter in ROS_PACKAGE:
+            subject, reads, facts_in, inertials_in = robot, structure, {}, {}
         elif emitter in STRUCTURE_ONLY:
             subject, facts_in, inertials_in = robot, {}, {}
             reads = {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,
@@ -288,8 +297,8 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
     return out
 
 
-def load_robots(recipe_files) -> list[tuple[object, Robot]]:
-    """Load and resolve every recipe; all problems of all recipes together."""
+def load_robots(recipe_files, ros: str | None = None) -> list[tuple[object, Robot]]:
+    """Load and resolve every recipe (``ros`` overrides their ``ros`` key); all problems together."""
     from robotkit.errors import Problem, RobotkitError, display_path
     from robotkit.model.resolve import resolve
     from robotkit.recipe.load import load_recipe
@@ -300,7 +309,7 @@ def load_robots(recipe_files) -> list[tuple[object, Robot]]:
     for f in recipe_files:
         try:
             loaded = load_recipe(f)
-            robot = resolve(loaded)
+            robot = resolve(loaded, ros)
         except RobotkitError as exc:
             problems.extend(exc.problems)
             continue
