@@ -242,6 +242,18 @@ def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
                                          "spawn": spawn, "templates": _world_templates()})],
             "clean": True,
         })
+        # the same world, without the robot (launch/gazebo spawns it), in the ROS package's worlds/
+        pkg = out_dir / robot.name / "worlds"
+        tasks.append({
+            "name": f"{robot.name}:world:{w.name}",
+            "doc": f"worlds/{w.name}/ of package {robot.name}",
+            "actions": [(actions.world, [w.map, str(pkg), w.name, w.height, w.unknown_as_wall, None])],
+            "file_dep": [w.map] + _map_image(w.map),
+            "targets": [str(pkg / t.relative_to(root.parent)) for t in targets],
+            "uptodate": [config_changed({"height": w.height, "unknown_as_wall": w.unknown_as_wall,
+                                         "templates": _world_templates()})],
+            "clean": True,
+        })
     return tasks
 
 
