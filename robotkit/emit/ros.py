@@ -292,6 +292,4 @@ def losses(robot: Robot) -> list[str]:
     if not robot.metadata.maintainers:
         out.append("no maintainer: package.xml names none, and catkin and colcon refuse a package without one "
                    "(give metadata.maintainers, or an author with an email)")
-    if not robot.metadata.license:
-        out.append("no licence: package.xml says TODO (give metadata.license)")
     return out
