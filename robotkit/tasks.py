@@ -184,16 +184,22 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     out_facts = {**{k: facts[k] for k in recentered}, **proxies}
     structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
     options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True},
-               "rviz": {"facts": True}, **{e: {"raw": True} for e in ROS_PACKAGE}}
+               "rviz": {"raw": True, "facts": True}, **{e: {"raw": True} for e in ROS_PACKAGE}}
     for emitter, rel in OUTPUTS.items():
         if emitter == "controllers" and not robot.actuators:
             continue
         target = str(root / rel(robot))
         opts = options.get(emitter, {})
-        if emitter in ("report", "rviz"):
+        if emitter == "report":
             subject, reads, facts_in, inertials_in = robot, structure, {**facts, **proxies}, inertials
+        elif emitter == "rviz":  # the visual geometry's extent, the sensors' topics: no inertial
+            subject, facts_in, inertials_in = robot, {k: facts[k] for k in shown if k in facts}, {}
+            reads = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
+                                            for link in structure["links"]]}
         elif emitter in ROS_PACKAGE:
-            subject, reads, facts_in, inertials_in = robot, structure, {}, {}
+            subject, facts_in, inertials_in = robot, {}, {}
+            reads = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators")}
+            reads.update(worlds=[asdict(w) for w in robot.worlds], meshes=bool(robot.meshes()))
         elif emitter in STRUCTURE_ONLY:
             subject, facts_in, inertials_in = robot, {}, {}
             reads = {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,

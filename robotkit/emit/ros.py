@@ -189,14 +189,17 @@ def _corners(geom, facts: dict) -> np.ndarray | None:
 
 
 def bounds(robot: Robot, facts: dict) -> tuple[np.ndarray, np.ndarray]:
-    """Axis-aligned box around the visual geometry and every link origin, in the root frame."""
+    """Axis-aligned box around the visual geometry and every link origin, in the root frame
+    (``robot`` as resolved: recentering offsets are taken from the mesh ``facts``)."""
+    from robotkit.model.resolve import recenter_offset
+
     poses = link_poses(robot)
     points = [T[:3, 3] for T in poses.values()]
     for link in robot.links:
         for g in link.visuals:
             c = _corners(g, facts)
             if c is not None:
-                T = poses[link.name] @ g.pose.matrix()
+                T = poses[link.name] @ g.origin.then(recenter_offset(g, facts)).matrix()
                 points.extend(c @ T[:3, :3].T + T[:3, 3])
     pts = np.array(points)
     return pts.min(axis=0), pts.max(axis=0)
