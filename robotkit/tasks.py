@@ -199,7 +199,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         elif emitter in ROS_PACKAGE:
             subject, facts_in, inertials_in = robot, {}, {}
             reads = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators")}
-            reads.update(worlds=[asdict(w) for w in robot.worlds], meshes=bool(robot.meshes()))
+            reads.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds],
+                         meshes=bool(robot.meshes()))
         elif emitter in STRUCTURE_ONLY:
             subject, facts_in, inertials_in = robot, {}, {}
             reads = {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,

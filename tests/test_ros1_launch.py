@@ -212,10 +212,13 @@ def test_display_launch(run, name):
     assert movable <= set(r["joint_states"]), movable - set(r["joint_states"])
     assert set(r["tf"]) == set(r["links"])
     # robot_state_publisher's transforms are robotkit's kinematics, at the published joint values
-    if not any(r["joint_states"].values()):
-        robot = resolve(load_recipe(RECIPES / f"{name}.yaml"), "ros1")
-        for link, T in link_poses(robot).items():
-            np.testing.assert_allclose(r["tf"][link][:3], T[:3, 3], atol=1e-6, err_msg=link)
+    from scipy.spatial.transform import Rotation
+
+    robot = resolve(load_recipe(RECIPES / f"{name}.yaml"), "ros1")
+    for link, T in link_poses(robot, r["joint_states"]).items():
+        np.testing.assert_allclose(r["tf"][link][:3], T[:3, 3], atol=1e-6, err_msg=link)
+        R = Rotation.from_quat(r["tf"][link][3:]).as_matrix()
+        np.testing.assert_allclose(R, T[:3, :3], atol=1e-6, err_msg=link)
     assert "Could not load resource" not in r["output"], r["output"][-3000:]
     assert "[rviz-" in r["output"]
 

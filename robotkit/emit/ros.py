@@ -155,8 +155,25 @@ def render_gazebo_launch(robot: Robot) -> str:
 # ---------------------------------------------------------------- RViz
 
 
-def link_poses(robot: Robot) -> dict[str, np.ndarray]:
-    """Every link's pose in the root frame with all joints at zero."""
+def _motion(joint, q: float) -> np.ndarray:
+    """The transform a joint at position ``q`` adds after its origin."""
+    from scipy.spatial.transform import Rotation
+
+    T = np.eye(4)
+    axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
+    if joint.type in ("revolute", "continuous"):
+        T[:3, :3] = Rotation.from_rotvec(axis * q).as_matrix()
+    elif joint.type == "prismatic":
+        T[:3, 3] = axis * q
+    return T
+
+
+def link_poses(robot: Robot, q: dict[str, float] | None = None) -> dict[str, np.ndarray]:
+    """Every link's pose in the root frame, the joints at ``q`` (by name; default 0; mimic joints follow)."""
+    q = dict(q or {})
+    for j in robot.joints:
+        if j.mimic is not None:
+            q[j.name] = j.mimic.multiplier * q.get(j.mimic.joint, 0.0) + j.mimic.offset
     children: dict[str, list] = {}
     for j in robot.joints:
         children.setdefault(j.parent, []).append(j)
@@ -165,7 +182,7 @@ def link_poses(robot: Robot) -> dict[str, np.ndarray]:
     while stack:
         name = stack.pop()
         for j in children.get(name, []):
-            poses[j.child] = poses[name] @ j.origin.matrix()
+            poses[j.child] = poses[name] @ j.origin.matrix() @ _motion(j, q.get(j.name, 0.0))
             stack.append(j.child)
     return poses
 
