@@ -239,3 +239,18 @@ def test_bad_ros_input(tmp_path, extra, args, line):
     assert proc.returncode == 2
     assert proc.stderr.splitlines() == [line]
     assert not (tmp_path / "out" / "bad").exists()
+
+
+def test_rviz_view_fits_the_robot(tmp_path):
+    """A 2 m cube raised 1 m: RViz looks at its centre from where its bounding sphere (radius
+    sqrt(3)) fills 80 % of the 45-degree view: sqrt(3) / sin(22.5 deg) / 0.8 = 5.658 m."""
+    from robotkit.build import build
+
+    recipe = write_recipe(tmp_path, "robot: cube\nlinks:\n  base: {visual: {box: {size: [2, 2, 2]}, "
+                                    "origin: {xyz: [0, 0, 1]}}}\n")
+    build([recipe], tmp_path / "out")
+    rviz = yaml.safe_load((tmp_path / "out" / "cube" / "rviz" / "cube.rviz").read_text())
+    view = rviz["Visualization Manager"]["Views"]["Current"]
+    assert view["Distance"] == 5.66
+    assert view["Focal Point"] == {"X": 0.0, "Y": 0.0, "Z": 1.0}
+    assert rviz["Visualization Manager"]["Global Options"]["Fixed Frame"] == "base"
