@@ -35,9 +35,10 @@ def _env(**extra) -> dict:
     return env
 
 
-def _sourced(ws: Path, command: str, **kw) -> subprocess.CompletedProcess:
-    return subprocess.run(["bash", "-c", f'source "{ws}/install/setup.bash" && {command}'], capture_output=True,
-                          text=True, env=_env(), **kw)
+def _sourced(ws: Path, command: str, *argv: str) -> subprocess.CompletedProcess:
+    """``command`` (bash; its arguments "$@" = ``argv``) with the workspace's install space sourced."""
+    return subprocess.run(["bash", "-c", f'source "{ws}/install/setup.bash" && {command}', "bash", *argv],
+                          capture_output=True, text=True, env=_env())
 
 
 @pytest.fixture(scope="session")
@@ -237,3 +238,17 @@ def _load(path: Path):
     from PIL import Image
 
     return Image.open(path)
+
+
+def test_gazebo_launch_world_argument_resolves(catkin_ws):
+    """Gazebo is not in Debian 12, so gazebo.launch is not launched; its world choice is a roslaunch
+    $(eval), resolved here by roslaunch's own substitution code."""
+    launch = ET.parse(catkin_ws / "install/share/turret_bot/launch/gazebo.launch").getroot()
+    value = launch.find("include/arg[@name='world_name']").get("value")
+    script = ("import sys; from roslaunch.substitution_args import resolve_args; "
+              f"print(resolve_args({value!r}, context={{'arg': {{'world': sys.argv[1]}}}}))")
+    for world, expected in (("empty", "worlds/empty.world"),
+                            ("room", f"{catkin_ws}/install/share/turret_bot/worlds/room/room.world")):
+        proc = _sourced(catkin_ws, '/usr/bin/python3 -c "$1" "$2"', script, world)
+        assert proc.returncode == 0, proc.stderr
+        assert proc.stdout.strip() == expected
