@@ -31,6 +31,8 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
     b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="run N tasks in parallel processes")
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
+    b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
+                                                           "recipes' `ros` key)")
 
     w = sub.add_parser("world", help="turn a ROS map_server occupancy map into a Gazebo world and MuJoCo scene",
                        description="Write OUT/<name>/ with model.config, model.sdf, meshes/<name>.stl, "
@@ -94,7 +96,7 @@ def _build(args) -> int:
         return 2
     start = time.perf_counter()
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
-    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr)
+    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, ros=args.ros)
     if result.ran or args.verbose:
         for w in result.warnings:
             print(f"warning: {w}", file=sys.stderr)
