@@ -110,7 +110,7 @@ def compare(reference, view: View, configs: list[dict[str, float]], tol: float =
                 diffs.append(f"link '{name}' weighs {m:.12g} kg and is not in the description")
             continue
         if abs(_mass(m) - expected[name]) > tol * max(expected[name], 1e-12 * scale):
-            hint = " (SDF's default for a link without <inertial>)" if m == 1.0 and expected[name] == 0 else ""
+            hint = " (its default for a link without <inertial>)" if m == 1.0 and expected[name] == 0 else ""
             diffs.append(f"link '{name}' weighs {m:.12g} kg{hint}, the description says {expected[name]:.12g} kg")
     for name, m in sorted(expected.items()):
         if m > 0 and name not in view.masses:
