@@ -76,12 +76,11 @@ class _Recorder:
         import time
 
         start = self.started.pop(task.name, None)
-        if start is None or self.progress is None:
-            return
+        if start is None or self.progress is None or not self.progress.isatty():
+            return  # quiet when not a terminal: logs and CI output stay deterministic
         elapsed = time.perf_counter() - start
         if elapsed >= SLOW:  # long tasks (CoACD, decimation) are named with their time
-            clear = "\r\033[K" if self.progress.isatty() else ""
-            self.progress.write(f"{clear}  {task.name}: {elapsed:.1f} s\n")
+            self.progress.write(f"\r\033[K  {task.name}: {elapsed:.1f} s\n")
             self.progress.flush()
 
     def skip_uptodate(self, task):
