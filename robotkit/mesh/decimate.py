@@ -43,6 +43,8 @@ Hausdorff distance, and the mean estimates the mean surface deviation.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import trimesh
 
@@ -53,15 +55,20 @@ NORMALISED_DIAGONAL = 1000.0
 LIBRARY = "meshlib"
 
 
-def library() -> dict:
-    """The decimation library and its version, for cache keys and reports."""
+@functools.lru_cache(maxsize=None)
+def _library() -> tuple:
     from importlib import metadata
 
     try:
-        version = metadata.version(LIBRARY)
+        return LIBRARY, metadata.version(LIBRARY)
     except metadata.PackageNotFoundError:
-        version = "not installed"
-    return {"library": LIBRARY, "library_version": version}
+        return LIBRARY, "not installed"
+
+
+def library() -> dict:
+    """The decimation library and its version, for cache keys and reports."""
+    name, version = _library()
+    return {"library": name, "library_version": version}
 
 
 def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, *,
