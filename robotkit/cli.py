@@ -62,8 +62,16 @@ def _add_build(sub) -> None:
                        description="Build each RECIPE into OUT/<robot>/ (incremental: only what changed reruns).")
     b.add_argument("recipes", nargs="+", metavar="RECIPE", help="recipe YAML file(s)")
     b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
-    b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="run N tasks in parallel processes")
+    b.add_argument("-j", "--jobs", type=int, default=_cores(), metavar="N",
+                   help=f"run N tasks in parallel processes (default: the {_cores()} cores this process may use)")
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
 
 
 def _build_parser() -> argparse.ArgumentParser:
