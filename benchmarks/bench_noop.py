@@ -2,8 +2,10 @@
 
 For each N (default 50 and 1000) the script writes, in a temporary folder:
 
-- ``robot.yaml``: an N-link serial chain (every other link a box, the others a shared
-  STL mesh, revolute joints with limits and dynamics); it is built once with
+- ``robot.yaml``: an N-link robot, arms of 10 links in series hanging off the first link
+  (every other link a box, the others a shared STL mesh, revolute joints with limits and
+  dynamics; a 1000-link serial chain overflows the MJCF emitter's recursion); it is
+  built once with
   ``robotkit build``, so the following builds have nothing to do;
 - ``dodo.py``: N trivial doit tasks, each copying one small file to another (file_dep
   and targets), run once, so ``doit`` then finds every task up to date: the cost of
@@ -35,6 +37,11 @@ BIN = Path(sys.executable).parent
 MESH = REPO / "recipes" / "meshes" / "turret_bot" / "slider.stl"
 
 
+def parent(i: int) -> int:
+    """Arms of 10 links in series, each hanging off link 0."""
+    return 0 if i % 10 == 1 else i - 1
+
+
 def recipe(n: int) -> str:
     lines = ["robot: chain", "units: m", "density: 1000", "links:"]
     for i in range(n):
@@ -44,7 +51,7 @@ def recipe(n: int) -> str:
             lines.append(f"  l{i}: {{visual: {{box: {{size: [0.1, 0.1, 0.2]}}}}}}")
     lines.append("joints:")
     for i in range(1, n):
-        lines += [f"  j{i}:", "    type: revolute", f"    parent: l{i - 1}", f"    child: l{i}",
+        lines += [f"  j{i}:", "    type: revolute", f"    parent: l{parent(i)}", f"    child: l{i}",
                   "    origin: {xyz: [0, 0, 0.2]}", "    axis: [0, 0, 1]",
                   "    limit: {lower: -1.5, upper: 1.5, effort: 10, velocity: 2}",
                   "    dynamics: {damping: 0.01, friction: 0.01}"]
@@ -84,7 +91,7 @@ def xacro_file(n: int) -> str:
     for i in range(n):
         out.append(f'  <xacro:{"mesh_link" if i % 2 else "box_link"} name="l{i}"/>')
     for i in range(1, n):
-        out.append(f'  <xacro:joint name="j{i}" parent="l{i - 1}" child="l{i}"/>')
+        out.append(f'  <xacro:joint name="j{i}" parent="l{parent(i)}" child="l{i}"/>')
     out.append("</robot>")
     return "\n".join(out) + "\n"
 
