@@ -102,17 +102,14 @@ def bench_decimate(pymeshlab, name, mesh, target, repeats):
 
     from robotkit.mesh.decimate import closed_volume, decimate, surface_distance
 
-    import fast_simplification
-
-    from robotkit.mesh.decimate import NORMALISED_DIAGONAL
+    from robotkit.mesh.decimate import NORMALISED_DIAGONAL, _meshlib_decimate
 
     t_ours, (out, rep) = best_time(lambda: decimate(mesh, target_faces=target, samples=0), repeats)
     t_dist, dist = best_time(lambda: surface_distance(mesh, out), 1)
     V, F = np.array(mesh.vertices), np.array(mesh.faces)
     # the simplification alone, on the same normalised arrays decimate() passes it
     Vn = (V - 0.5 * (V.min(axis=0) + V.max(axis=0))) * (NORMALISED_DIAGONAL / np.linalg.norm(np.ptp(V, axis=0)))
-    F32 = F.astype(np.int32)
-    t_core, _ = best_time(lambda: fast_simplification.simplify(Vn, F32, target_count=int(target)), repeats)
+    t_core, _ = best_time(lambda: _meshlib_decimate(Vn, F, int(target)), repeats)
 
     def run_pml():
         ms = pml_meshset(pymeshlab, V, F)  # decimation works in place: a fresh copy each run

@@ -269,7 +269,7 @@ def test_decimate_torus_ratio_is_deterministic():
 
 
 def test_decimate_does_not_depend_on_units():
-    """fast-simplification's thresholds are absolute: robotkit normalises the size first."""
+    """Decimation thresholds are absolute (MeshLib's stabilizer, float32): robotkit normalises the size first."""
     torus_m = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=96, minor_sections=48)
     torus_mm = trimesh.Trimesh(np.asarray(torus_m.vertices) * 1000.0, torus_m.faces, process=False)
     a, ra = decimate(torus_m, target_faces=900, samples=500)
