@@ -132,8 +132,11 @@ def to_doit(task: dict) -> dict:
 
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
-          echo=None, progress=None) -> BuildResult:
-    """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem."""
+          echo=None, progress=None, report: bool = False) -> BuildResult:
+    """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
+
+    ``report`` also writes each robot's picture report (``<robot>/report/report.html``); the
+    command line does unless ``--no-report``."""
     from doit.cmd_base import TaskLoader2
     from doit.doit_cmd import DoitMain
     from doit.task import dict_to_task
@@ -145,7 +148,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     result = BuildResult(robots=[r.name for _, r in robots])
     tasks = []
     for loaded, robot in robots:
-        tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot)))
+        tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot), report=report))
     (out / ".robotkit").mkdir(parents=True, exist_ok=True)
     recorder = _Recorder(result, echo, progress)
 
