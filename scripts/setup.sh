@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
 # Installs robotkit into ./.venv (Debian 12 / Python >= 3.11). With --test, also what the
-# tests need: pytest and MuJoCo from PyPI, and the validators check_urdf (liburdfdom-tools)
+# tests need: pytest and Playwright from PyPI, Chromium, and the validators check_urdf (liburdfdom-tools)
 # and `ign sdf` (libsdformat-dev, ignition-tools) from Debian's packages.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 apt_need=()
 python3 -c "import ensurepip, venv" 2>/dev/null || apt_need+=(python3-venv)
+# OSMesa: MuJoCo renders the picture report offscreen, with no display
+ldconfig -p 2>/dev/null | grep -q libOSMesa.so || apt_need+=(libosmesa6)
 if [ "${1:-}" = "--test" ]; then
   command -v check_urdf >/dev/null || apt_need+=(liburdfdom-tools)
   command -v ign >/dev/null || apt_need+=(libsdformat-dev ignition-tools)
+  command -v chromium >/dev/null || apt_need+=(chromium)  # the report and viewer tests (Playwright)
 fi
 if [ ${#apt_need[@]} -gt 0 ]; then
   sudo=""; [ "$(id -u)" = 0 ] || sudo="sudo"

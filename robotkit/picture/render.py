@@ -51,8 +51,14 @@ def equivalent_box(mass: float, moments) -> np.ndarray:
 
 
 def bounds(model, data) -> tuple[np.ndarray, float]:
-    """Centre and radius of the drawn robot: the corners of its visual geoms' boxes (all
-    geoms when it has none) in the world."""
+    """Centre and radius of the drawn robot."""
+    lo, hi = box(model, data)
+    return (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.05)
+
+
+def box(model, data) -> tuple[np.ndarray, np.ndarray]:
+    """World bounding box of the drawn robot: the corners of its visual geoms' boxes (all
+    geoms when it has none)."""
     ids = [i for i in range(model.ngeom) if model.geom_group[i] == VISUAL] or list(range(model.ngeom))
     ids = [i for i in ids if int(model.geom_type[i]) != int(mujoco.mjtGeom.mjGEOM_PLANE)]
     corners = [data.xpos[b] for b in range(1, model.nbody)] or [np.zeros(3)]
@@ -62,8 +68,7 @@ def bounds(model, data) -> tuple[np.ndarray, float]:
         R = data.geom_xmat[i].reshape(3, 3)
         corners.extend(data.geom_xpos[i] + (centre + signs * half) @ R.T)
     pts = np.asarray(corners)
-    lo, hi = pts.min(0), pts.max(0)
-    return (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.05)
+    return pts.min(0), pts.max(0)
 
 
 class Painter:
@@ -326,6 +331,12 @@ def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
     try:
         for name, kind, poses in p.joint_poses():
             images = []
+            corners = []
+            for _, q in poses:  # frame the joint's whole motion
+                small.pose(q)
+                corners += list(box(small.model, small.data))
+            lo, hi = np.min(corners, axis=0), np.max(corners, axis=0)
+            small.center, small.radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.05)
             for _, q in poses:
                 small.pose(q)
                 images.append(small._draw(135.0, -25.0, visual, ghost=False, overlays=(small.joint_axes,)))
