@@ -171,10 +171,7 @@ class Viewer:
 
         if self.viser_urdf is not None:
             self.viser_urdf.remove()
-        for nodes in self.overlay_nodes.values():
-            for n in nodes:
-                n.remove()
-        for f in self.link_frames.values():
+        for f in self.link_frames.values():  # their overlays go with them
             f.remove()
         self.overlay_nodes = {k: [] for k in self.overlay_nodes}
         self.link_frames = {}
@@ -190,7 +187,7 @@ class Viewer:
             lo, hi = urdf.scene.bounds
             centre, size = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
             self.server.initial_camera.look_at = centre
-            self.server.initial_camera.position = centre + np.array([1.0, 0.8, 0.6]) * max(size, 0.1) * 1.1
+            self.server.initial_camera.position = centre + np.array([1.0, 0.8, 0.6]) * max(size, 0.1) * 1.5
             self._camera_set = True
 
     def _joint_sliders(self, urdf) -> None:
