@@ -71,6 +71,18 @@ def box(model, data) -> tuple[np.ndarray, np.ndarray]:
     return pts.min(0), pts.max(0)
 
 
+def renderer(model, height: int, width: int):
+    """MuJoCo's offscreen renderer, or a RobotkitError that says how to get one."""
+    from robotkit.errors import Problem, RobotkitError
+
+    try:
+        return mujoco.Renderer(model, height, width)
+    except Exception as exc:  # noqa: BLE001  (no GL context: the backend is missing or needs a display)
+        raise RobotkitError(Problem(
+            f"cannot render offscreen with MUJOCO_GL={os.environ.get('MUJOCO_GL', '')!r}: {exc} (install "
+            "Debian's libosmesa6 and set MUJOCO_GL=osmesa before MuJoCo is first imported)")) from None
+
+
 class Painter:
     """One MuJoCo model and an offscreen renderer; draws the pictures of a report."""
 
@@ -82,7 +94,7 @@ class Painter:
         model.vis.headlight.ambient[:] = 0.45
         model.vis.headlight.diffuse[:] = 0.6
         model.vis.headlight.specular[:] = 0.1
-        self.renderer = mujoco.Renderer(model, height, width)
+        self.renderer = renderer(model, height, width)
         self.flagged: set[str] = set()
         mujoco.mj_forward(model, self.data)
         self.center, self.radius = bounds(model, self.data)
@@ -327,7 +339,7 @@ def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
     small = Painter.__new__(Painter)  # same model, a smaller renderer for the strips
     small.model, small.data, small.flagged = p.model, p.data, p.flagged
     small.center, small.radius = p.center, p.radius
-    small.renderer = mujoco.Renderer(p.model, 240, 320)
+    small.renderer = renderer(p.model, 240, 320)
     try:
         for name, kind, poses in p.joint_poses():
             images = []
