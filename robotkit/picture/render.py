@@ -22,10 +22,12 @@ import numpy as np  # noqa: E402
 VISUAL, COLLISION, SENSOR = 2, 3, 4  # MuJoCo geom/site groups in robotkit's MJCF
 HINGE, SLIDE = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
 BACKGROUND = (235, 238, 242)
+GHOST = 0.25  # alpha of the visual behind collision geometry and overlays
 COLLISION_RGBA = (0.1, 0.55, 0.95, 0.6)
 FLAGGED = (0.9, 0.1, 0.1)  # links a lint fired on
-PALETTE = [(0.12, 0.47, 0.71), (1.0, 0.5, 0.05), (0.17, 0.63, 0.17), (0.58, 0.4, 0.74),
-           (0.55, 0.34, 0.29), (0.89, 0.47, 0.76), (0.5, 0.5, 0.5), (0.74, 0.74, 0.13), (0.09, 0.75, 0.81)]
+PALETTE = [  # no red or brown: red is for flagged links
+(0.12, 0.47, 0.71), (1.0, 0.5, 0.05), (0.17, 0.63, 0.17), (0.58, 0.4, 0.74),
+           (0.89, 0.47, 0.76), (0.5, 0.5, 0.5), (0.74, 0.74, 0.13), (0.09, 0.75, 0.81)]
 # (file stem, title, azimuth, elevation)
 SIDES = [("front", "front", 180.0, -5.0), ("left", "left side", 270.0, -5.0),
          ("top", "top", 180.0, -89.0), ("iso", "three-quarter view", 135.0, -25.0)]
@@ -69,6 +71,22 @@ def box(model, data) -> tuple[np.ndarray, np.ndarray]:
         corners.extend(data.geom_xpos[i] + (centre + signs * half) @ R.T)
     pts = np.asarray(corners)
     return pts.min(0), pts.max(0)
+
+
+def load_model(mjcf: str | os.PathLike):
+    """The MJCF compiled by MuJoCo, with a plain light background (a flat skybox) unless it has
+    a skybox of its own; a file MuJoCo cannot load is a RobotkitError naming it."""
+    from robotkit.errors import Problem, RobotkitError
+
+    try:
+        spec = mujoco.MjSpec.from_file(str(mjcf))
+        if not any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in spec.textures):
+            rgb = [c / 255 for c in BACKGROUND]
+            spec.add_texture(name="robotkit_background", type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+                             builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT, rgb1=rgb, rgb2=rgb, width=8, height=8)
+        return spec.compile()
+    except ValueError as exc:
+        raise RobotkitError(Problem(f"MuJoCo cannot load it: {str(exc).strip()}", file=str(mjcf))) from None
 
 
 def renderer(model, height: int, width: int):
@@ -124,8 +142,8 @@ class Painter:
         m = self.model
         saved = m.geom_rgba.copy(), m.mat_rgba.copy()
         if ghost:  # visual geoms faint, so what is drawn inside them shows
-            m.geom_rgba[:, 3] = np.where(m.geom_group == VISUAL, 0.18, m.geom_rgba[:, 3])
-            m.mat_rgba[:, 3] = 0.18
+            m.geom_rgba[:, 3] = np.where(m.geom_group == VISUAL, GHOST, m.geom_rgba[:, 3])
+            m.mat_rgba[:, 3] = GHOST
             m.geom_rgba[m.geom_group == COLLISION] = COLLISION_RGBA
         try:
             scene_opt = self._option(groups)
@@ -135,9 +153,7 @@ class Painter:
             scn.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
             for overlay in overlays:
                 overlay(scn)
-            img = self.renderer.render().copy()
-            img[(img == 0).all(axis=2)] = BACKGROUND  # nothing drawn there (no skybox offscreen)
-            return img
+            return self.renderer.render().copy()
         finally:
             m.geom_rgba[:], m.mat_rgba[:] = saved
 
@@ -250,8 +266,14 @@ class Painter:
             else:
                 lo, hi = -self.radius / 2, self.radius / 2
             unit = "rad" if t == HINGE else "m"
+            # a small positive move shows the direction even when the limits are whole turns
+            step = min(hi, 0.6 if t == HINGE else (hi - lo) / 4) if hi > 0 else None
+            values = [(f"lower {lo:.3g} {unit}", lo), ("zero", 0.0)]
+            if step is not None and step < hi:
+                values.append((f"+{step:.3g} {unit}", step))
+            values.append((f"upper {hi:.3g} {unit}", hi))
             poses = []
-            for label, value in ((f"lower {lo:.3g} {unit}", lo), ("zero", 0.0), (f"upper {hi:.3g} {unit}", hi)):
+            for label, value in values:
                 q = m.qpos0.copy()
                 q[adr] = value
                 for f, (leader, coef) in followers.items():
@@ -299,7 +321,7 @@ def render_pictures(mjcf: str | os.PathLike, out_dir: str | os.PathLike, flagged
                     joints: bool = True) -> list[Picture]:
     """Write the report's PNG pictures of the MJCF model into ``out_dir``; return them in order."""
     out = Path(out_dir)
-    model = mujoco.MjModel.from_xml_path(str(mjcf))
+    model = load_model(mjcf)
     p = Painter(model)
     p.flagged = set(flagged)
     pics: list[Picture] = []
@@ -355,8 +377,8 @@ def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
             small.pose()
             file = "joint-" + re.sub(r"[^A-Za-z0-9_.-]", "_", name) + ".png"
             _save(_strip(images, [label for label, _ in poses]), out / file)
-            pics.append(Picture(file, f"Joint {name}", f"{kind} joint at its lower limit, zero and upper limit",
-                                "joint"))
+            pics.append(Picture(file, f"Joint {name}", f"{kind} joint at its lower limit, zero, a small positive "
+                                "move (when the upper limit is further) and its upper limit", "joint"))
     finally:
         small.renderer.close()
     return pics
