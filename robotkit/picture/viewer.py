@@ -61,7 +61,9 @@ def _build_recipe(recipe: Path, build_out: str) -> Built:
     (loaded, robot), = load_robots([recipe])
     watch = [Path(f) for f in loaded.files] + sorted({Path(m.source) for m in robot.meshes().values()})
     try:
-        build([recipe], build_out, report=False)
+        result = build([recipe], build_out, report=False)
+        if result.errors:  # a bug in a task: shown like a user error, the viewer stays up
+            raise RobotkitError([Problem(f"internal error in task {name}: {msg}") for name, msg in result.errors])
     except RobotkitError as exc:
         exc.watch = watch  # still watch what the recipe names, so fixing a mesh rebuilds too
         raise
