@@ -114,3 +114,15 @@ def test_viewer_in_chromium(viewer, tmp_path):
         assert page.get_by_text("density: must be > 0").count() >= 1
         browser.close()
     assert errors == []
+
+
+def test_view_bad_input(tmp_path):
+    from conftest import run_cli
+
+    (tmp_path / "robot.sdf").write_text("<sdf/>")
+    done = run_cli("view", tmp_path / "robot.sdf", "--no-browser")
+    assert (done.returncode, done.stdout) == (2, "")
+    assert done.stderr == (f"{tmp_path / 'robot.sdf'}: unknown kind of file (expected a recipe .yaml, a build "
+                           "folder or a .urdf)\n")
+    done = run_cli("view", tmp_path / "missing.yaml", "--no-browser")
+    assert (done.returncode, done.stderr) == (2, f"{tmp_path / 'missing.yaml'}: no such file or folder\n")
