@@ -172,7 +172,11 @@ class Viewer:
         from viser.extras import ViserUrdf
 
         if self.viser_urdf is not None:
-            self.viser_urdf.remove()
+            import warnings
+
+            with warnings.catch_warnings():  # ViserUrdf removes meshes whose frames went first
+                warnings.simplefilter("ignore", UserWarning)
+                self.viser_urdf.remove()
         for f in self.link_frames.values():  # their overlays go with them
             f.remove()
         self.overlay_nodes = {k: [] for k in self.overlay_nodes}
