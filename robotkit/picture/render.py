@@ -104,9 +104,9 @@ def renderer(model, height: int, width: int):
 class Painter:
     """One MuJoCo model and an offscreen renderer; draws the pictures of a report."""
 
-    def __init__(self, model, width: int = 640, height: int = 480):
+    def __init__(self, model, width: int = 640, height: int = 480, data=None):
         self.model = model
-        self.data = mujoco.MjData(model)
+        self.data = data if data is not None else mujoco.MjData(model)
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         model.vis.headlight.ambient[:] = 0.45
@@ -358,10 +358,8 @@ def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
     import re
 
     pics = []
-    small = Painter.__new__(Painter)  # same model, a smaller renderer for the strips
-    small.model, small.data, small.flagged = p.model, p.data, p.flagged
-    small.center, small.radius = p.center, p.radius
-    small.renderer = renderer(p.model, 240, 320)
+    small = Painter(p.model, 320, 240, data=p.data)  # the same model, smaller pictures for the strips
+    small.flagged = p.flagged
     try:
         for name, kind, poses in p.joint_poses():
             images = []
