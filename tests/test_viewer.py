@@ -120,9 +120,17 @@ def test_viewer_in_chromium(viewer, tmp_path):
         assert changed(recoloured, raised) > 0.002
 
         # a broken recipe: the error in the page, the viewer alive
-        recipe.write_text(recipe.read_text().replace("density: 1250", "density: -5"))
+        good = recipe.read_text()
+        recipe.write_text(good.replace("density: 1250", "density: -5"))
         page.get_by_text("Build failed").wait_for(timeout=60_000)
         assert page.get_by_text("density: must be > 0").count() >= 1
+        # ... and fixed again: the robot is back
+        recipe.write_text(good)
+        page.get_by_text("Build failed").wait_for(state="detached", timeout=60_000)
+        deadline = time.monotonic() + 30
+        while log.read_text().count("turret_bot updated") < 4:
+            assert time.monotonic() < deadline, log.read_text()
+            time.sleep(0.2)
         browser.close()
     assert errors == []
 

@@ -58,14 +58,15 @@ def _build_recipe(recipe: Path, build_out: str) -> Built:
     from robotkit.build import build
     from robotkit.tasks import load_robots
 
-    (loaded, robot), = load_robots([recipe])
-    watch = [Path(f) for f in loaded.files] + sorted({Path(m.source) for m in robot.meshes().values()})
+    watch = [recipe]
     try:
+        (loaded, robot), = load_robots([recipe])
+        watch = [Path(f) for f in loaded.files] + sorted({Path(m.source) for m in robot.meshes().values()})
         result = build([recipe], build_out, report=False)
         if result.errors:  # a bug in a task: shown like a user error, the viewer stays up
             raise RobotkitError([Problem(f"internal error in task {name}: {msg}") for name, msg in result.errors])
     except RobotkitError as exc:
-        exc.watch = watch  # still watch what the recipe names, so fixing a mesh rebuilds too
+        exc.watch = watch  # still watched: fixing the recipe or a mesh rebuilds
         raise
     robot_dir = Path(build_out) / robot.name
     return Built(robot_dir / "urdf" / f"{robot.name}.urdf", {robot.name: str(robot_dir)}, watch)
