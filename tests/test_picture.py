@@ -209,6 +209,17 @@ def test_report_of_a_foreign_urdf_and_an_mjcf_file(assets, turret, tmp_path):
     assert (tmp_path / "mjcf" / "frames.png").is_file()
     assert "<td>rotor</td>" in (tmp_path / "mjcf" / "report.html").read_text()
 
+    lone = tmp_path / "lone.sdf"  # an SDF outside a build folder: the table only, and why
+    shutil.copyfile(robot_dir / "model.sdf", lone)
+    done = run_cli("report", lone)
+    assert done.returncode == 0, done.stderr
+    html = (tmp_path / "lone-report" / "report.html").read_text()
+    assert "No pictures: an SDF file outside a robotkit build folder is not drawn yet (a URDF or MJCF is)." in html
+    assert "<img" not in html
+    built = (robot_dir / "report" / "report.html").read_text()
+    # name, mass, centre of mass, principal moments: libsdformat's reading agrees with the URDF's
+    assert row(html, "link", "rotor").split("</td>")[:5] == row(built, "link", "rotor").split("</td>")[:5]
+
 
 def test_report_bad_input(tmp_path):
     done = run_cli("report", tmp_path / "nothing.yaml")

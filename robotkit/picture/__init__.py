@@ -43,6 +43,8 @@ def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = No
         robot_dir = Path(build_out) / loaded.recipe.robot
         out = Path(out_dir) if out_dir else robot_dir / "report"
         return report_build_dir(robot_dir, out, str(p), loaded.recipe.measured_mass)
+    if suffix == ".sdf" and (p.parent / "mjcf" / f"{p.parent.name}.xml").is_file():  # a build folder's SDF
+        return report_build_dir(p.parent, Path(out_dir) if out_dir else p.parent / "report", str(p))
     out = Path(out_dir) if out_dir else p.parent / f"{p.stem}-report"
     if suffix == ".urdf":
         return report_urdf(p, out, package_paths)
@@ -129,7 +131,7 @@ def report_model_file(path: Path, out: Path, kind: str) -> Path:
         pictures = _pictures(path, out, findings)
     else:
         pictures = []
-        notes.append("No pictures: an SDF file is not drawn yet (its build folder's MJCF, or a URDF, is).")
+        notes.append("No pictures: an SDF file outside a robotkit build folder is not drawn yet (a URDF or MJCF is).")
     return _write(out, path.stem, str(path), pictures, links, joints, findings, {}, {}, None, notes)
 
 
