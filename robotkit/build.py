@@ -28,6 +28,7 @@ class BuildResult:
     errors: list[tuple[str, str]] = field(default_factory=list)  # (task, traceback) bugs
     warnings: list[str] = field(default_factory=list)
     robots: list[str] = field(default_factory=list)
+    exit_status: int = 0  # of the failed tasks: 2 bad input, 1 a robot a consumer refuses
 
 
 SLOW = 1.0  # seconds: tasks at least this long are reported with their time
@@ -69,6 +70,7 @@ class _Recorder:
             return
         if isinstance(fail, TaskFailed):
             self.result.failed.append((task.name, fail.message))
+            self.result.exit_status = max(self.result.exit_status, getattr(fail, "exit_status", 2))
         else:
             self.result.errors.append((task.name, fail.get_msg()))
 
@@ -132,11 +134,11 @@ def to_doit(task: dict) -> dict:
 
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
-          echo=None, progress=None, report: bool = False) -> BuildResult:
+          echo=None, progress=None, ros: str | None = None, report: bool = False) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
-
-    ``report`` also writes each robot's picture report (``<robot>/report/report.html``); the
-    command line does unless ``--no-report``."""
+    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key.  ``report`` also writes each
+    robot's picture report (``<robot>/report/report.html``); the command line does unless
+    ``--no-report``."""
     from doit.cmd_base import TaskLoader2
     from doit.doit_cmd import DoitMain
     from doit.task import dict_to_task
@@ -144,7 +146,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     from robotkit.tasks import load_robots, mesh_locations, robot_tasks
 
     out = Path(out_dir).absolute()
-    robots = load_robots(recipes)  # raises before anything is written
+    robots = load_robots(recipes, ros)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
     tasks = []
     for loaded, robot in robots:
@@ -174,7 +176,9 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
             for line in msg.splitlines():
                 if line not in lines:
                     lines.append(line)
-        raise RobotkitError([Problem(line) for line in lines])
+        error = RobotkitError([Problem(line) for line in lines])
+        error.exit_status = result.exit_status or 2
+        raise error
     if rc not in (0,) and not result.errors:
         result.errors.append(("doit", f"doit exited with status {rc}"))
     result.warnings = collect_warnings(tasks) + collect_losses(out, result.robots)
@@ -184,7 +188,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
 def collect_losses(out: Path, robots: list[str]) -> list[str]:
     """What each output format could not express (from each robot's report.json)."""
     lines = []
-    names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF"}
+    names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF", "package": "ROS package"}
     for name in robots:
         try:
             data = json.loads((out / name / "report.json").read_text(encoding="utf-8"))

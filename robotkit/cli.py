@@ -31,6 +31,8 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
     b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="run N tasks in parallel processes")
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
+    b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
+                                                           "recipes' `ros` key)")
     b.add_argument("--no-report", action="store_true",
                    help="do not write the picture report (<robot>/report/report.html)")
 
@@ -101,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     except RobotkitError as exc:
         for line in exc.lines():
             print(line, file=sys.stderr)
-        return 2
+        return exc.exit_status
     except KeyboardInterrupt:
         print("robotkit: interrupted", file=sys.stderr)
         return 130
@@ -115,7 +117,7 @@ def _build(args) -> int:
         return 2
     start = time.perf_counter()
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
-    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr,
+    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, ros=args.ros,
                    report=not args.no_report)
     if result.ran or args.verbose:
         for w in result.warnings:

@@ -21,7 +21,7 @@ from pathlib import Path
 from doit.tools import config_changed
 
 from robotkit import actions
-from robotkit.emit import TEMPLATES
+from robotkit.emit import TEMPLATES, ros
 from robotkit.emit.env import template_dirs
 from robotkit.model.robot import Robot
 
@@ -38,12 +38,18 @@ OUTPUTS = {
     "model.config": lambda r: "model.config",
     "package.xml": lambda r: "package.xml",
     "CMakeLists.txt": lambda r: "CMakeLists.txt",
+    "env-hook": lambda r: ros.env_hook_path(r),
+    "display-launch": lambda r: ros.launch_path(r, "display"),
+    "gazebo-launch": lambda r: ros.launch_path(r, "gazebo"),
+    "rviz": lambda r: f"rviz/{r.name}.rviz",
     "controllers": lambda r: "config/controllers.yaml",
 }
 # emitters that read only the robot's name and metadata (no geometry, no inertials)
-METADATA_ONLY = {"model.config", "package.xml", "CMakeLists.txt", "mjcf-scene"}
+METADATA_ONLY = {"model.config", "mjcf-scene"}
 # emitters that read the robot's structure but no inertial or mesh fact
 STRUCTURE_ONLY = {"controllers"}
+# the ROS package files: the unfinalized robot (which folders, sensors, actuators, worlds, metadata)
+ROS_PACKAGE = {"package.xml", "CMakeLists.txt", "env-hook", "display-launch", "gazebo-launch"}
 
 
 def _template_files(emitter: str) -> list[str]:
@@ -61,9 +67,10 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                 report: bool = False) -> list[dict]:
     """The task dicts that build ``robot`` into ``out_dir/<robot>/``.
 
-    ``where`` maps a mesh key to the recipe location naming it (for messages); ``report``
-    adds the picture report (``report/report.html``).
+    ``where`` maps a mesh key, and ``link:<name>``, to the recipe location naming it (for messages);
+    ``report`` adds the picture report (``report/report.html``).
     """
+    where = where or {}
     out_dir = Path(out_dir).absolute()
     root = out_dir / robot.name
     state = out_dir / STATE / robot.name
@@ -86,6 +93,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
+    mesh_outputs: list[str] = []  # mesh files written below meshes/ (the MJCF measures them)
     copies: dict[str, tuple[str, list[str]]] = {}
     processed: dict[str, object] = {}
     shown = {g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link) if g.shape.kind == "mesh"}
@@ -98,6 +106,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         copies.setdefault(mesh.file_name, (mesh.source, []))[1].append(facts[key])
     for rel, mesh in sorted(processed.items()):
         target = str(root / "meshes" / rel)
+        mesh_outputs.append(target)
         report = str(state / "visual" / f"{mesh.key}.json")
         tasks.append({
             "name": f"{robot.name}:visual:{mesh.file_name}",
@@ -129,8 +138,14 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                                          "version": actions.FACTS_VERSION})],
             "clean": True,
         })
+    from robotkit.mesh.io import companions
+
+    extras: dict[str, str] = {}  # textures and material files the copied meshes reference
     for file_name, (source, checked) in sorted(copies.items()):
         target = str(root / "meshes" / "visual" / file_name)
+        mesh_outputs.append(target)
+        for rel in companions(source):
+            extras.setdefault(rel, os.path.join(os.path.dirname(source), rel))
         tasks.append({
             "name": f"{robot.name}:copy:{file_name}",
             "doc": f"visual mesh {file_name}",
@@ -141,19 +156,30 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
-    from robotkit.emit.mjcf import converted_meshes
+    for rel, source in sorted(extras.items()):
+        tasks.append({
+            "name": f"{robot.name}:copy:{rel}",
+            "doc": f"texture or material file {rel}",
+            "actions": [(actions.copy_file, [source, str(root / "meshes" / "visual" / rel)])],
+            "file_dep": [source],
+            "targets": [str(root / "meshes" / "visual" / rel)],
+            "clean": True,
+        })
 
-    for rel, source in sorted(converted_meshes(robot).items()):
+    from robotkit.emit.meshfiles import conversions
+
+    for rel, (source, scale) in conversions(robot).items():
         target = str(root / "meshes" / rel)
+        mesh_outputs.append(target)
         checked = [facts[k] for k, m in robot.meshes().items() if m.source == source]
         tasks.append({
             "name": f"{robot.name}:convert:{rel}",
-            "doc": f"meshes/{rel} for MuJoCo",
-            "actions": [(actions.convert_mesh, [source, target])],
+            "actions": [(actions.convert_mesh, [source, target, list(scale)])],
             "file_dep": [source, *checked],
             "targets": [target],
-            "uptodate": [config_changed({"version": actions.FACTS_VERSION})],
+            "uptodate": [config_changed({"version": actions.FACTS_VERSION, "scale": list(scale)})],
             "clean": True,
+            "doc": f"meshes/{rel}",
         })
 
     inertials: dict[str, str] = {}
@@ -179,7 +205,9 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                          if g.shape.mesh is not None and g.recenter != "none"})
     out_facts = {**{k: facts[k] for k in recentered}, **proxies}
     structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
-    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True}}
+    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True},
+               "mjcf": {"meshes": True}, "rviz": {"raw": True, "facts": True},
+               **{e: {"raw": True} for e in ROS_PACKAGE}}
     for emitter, rel in OUTPUTS.items():
         if emitter == "controllers" and not robot.actuators:
             continue
@@ -187,9 +215,18 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         opts = options.get(emitter, {})
         if emitter == "report":
             subject, reads, facts_in, inertials_in = robot, structure, {**facts, **proxies}, inertials
+        elif emitter == "rviz":  # the visual geometry's extent, the sensors' topics: no inertial
+            subject, facts_in, inertials_in = robot, {k: facts[k] for k in shown if k in facts}, {}
+            reads = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
+                                            for link in structure["links"]]}
+        elif emitter in ROS_PACKAGE:
+            subject, facts_in, inertials_in = robot, {}, {}
+            reads = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators")}
+            reads.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds],
+                         meshes=bool(robot.meshes()))
         elif emitter in STRUCTURE_ONLY:
             subject, facts_in, inertials_in = robot, {}, {}
-            reads = {"name": robot.name, "ros_control": robot.ros_control,
+            reads = {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,
                      "actuators": [asdict(a) for a in robot.actuators]}
         elif emitter in METADATA_ONLY:
             subject = replace(robot, links=(), joints=(), materials=())
@@ -200,8 +237,10 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         tasks.append({
             "name": f"{robot.name}:{emitter}",
             "doc": f"{rel(robot)}",
-            "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts])],
-            "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter),
+            "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts,
+                                        {k[5:]: v for k, v in where.items() if k.startswith("link:")}])],
+            "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter)
+            + (mesh_outputs if opts.get("meshes") else []),
             "targets": [target],
             "uptodate": [config_changed({"robot": reads, "options": opts})],
             # no output is written while any mesh of the robot fails
@@ -264,6 +303,18 @@ def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
                                          "spawn": spawn, "templates": _world_templates()})],
             "clean": True,
         })
+        # the same world, without the robot (launch/gazebo spawns it), in the ROS package's worlds/
+        pkg = out_dir / robot.name / "worlds"
+        tasks.append({
+            "name": f"{robot.name}:world:{w.name}",
+            "doc": f"worlds/{w.name}/ of package {robot.name}",
+            "actions": [(actions.world, [w.map, str(pkg), w.name, w.height, w.unknown_as_wall, None])],
+            "file_dep": [w.map] + _map_image(w.map),
+            "targets": [str(pkg / t.relative_to(root.parent)) for t in targets],
+            "uptodate": [config_changed({"height": w.height, "unknown_as_wall": w.unknown_as_wall,
+                                         "templates": _world_templates()})],
+            "clean": True,
+        })
     return tasks
 
 
@@ -293,7 +344,8 @@ def _world_templates() -> list[str]:
 
 
 def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
-    """Recipe location (file, line, key) of the first geometry naming each mesh key."""
+    """Recipe location (file, line, key) of the first geometry naming each mesh key, and of
+    each link (``link:<name>``)."""
     marks = loaded.marks
     where_source: dict[tuple[str, str], dict] = {}  # (link, source file) -> location
     for name, link in loaded.recipe.links.items():
@@ -312,6 +364,9 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
                     where_source[(name, g.mesh)] = {"file": p.file, "line": p.line, "key": p.key}
     out: dict[str, dict] = {}
     for link in robot.links:
+        if link.name in loaded.recipe.links:
+            p = marks.problem(("links", link.name), "")
+            out[f"link:{link.name}"] = {"file": p.file, "line": p.line, "key": p.key}
         for geom in robot.all_geoms(link):
             m = geom.shape.mesh
             if m is not None and m.key not in out and (link.name, m.source) in where_source:
@@ -319,8 +374,8 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
     return out
 
 
-def load_robots(recipe_files) -> list[tuple[object, Robot]]:
-    """Load and resolve every recipe; all problems of all recipes together."""
+def load_robots(recipe_files, ros: str | None = None) -> list[tuple[object, Robot]]:
+    """Load and resolve every recipe (``ros`` overrides their ``ros`` key); all problems together."""
     from robotkit.errors import Problem, RobotkitError, display_path
     from robotkit.model.resolve import resolve
     from robotkit.recipe.load import load_recipe
@@ -331,7 +386,7 @@ def load_robots(recipe_files) -> list[tuple[object, Robot]]:
     for f in recipe_files:
         try:
             loaded = load_recipe(f)
-            robot = resolve(loaded)
+            robot = resolve(loaded, ros)
         except RobotkitError as exc:
             problems.extend(exc.problems)
             continue

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from robotkit.check.findings import Finding
+from robotkit.check.kinematics import NEGLIGIBLE
 from robotkit.errors import Problem, RobotkitError
 
 # thresholds (documented in docs/checks.md)
@@ -204,6 +205,8 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
                           [a.get("ixz", 0), a.get("iyz", 0), a.get("izz", 0)]])
             R = T[:3, :3]
             facts.com, facts.inertia = T[:3, 3], R @ I @ R.T
+            if 0 <= facts.mass < NEGLIGIBLE and not I.any():  # an explicitly massless link (a frame)
+                facts.mass = facts.com = facts.inertia = None
         for role in ("visual", "collision"):
             for g in el.findall(role):
                 gf = _geom_facts(g, role, path.parent, package_paths, subject, problems, cache)

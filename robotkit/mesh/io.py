@@ -39,7 +39,10 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
         if problem:
             raise fail(f"mesh file '{name}' {problem}")
     try:
-        loaded = trimesh.load(path, force="mesh", process=False)  # process would drop NaN faces unseen
+        if ext == ".dae":
+            loaded = _dae_in_metres(path)
+        else:
+            loaded = trimesh.load(path, force="mesh", process=False)  # process would drop NaN faces unseen
     except Exception as exc:  # trimesh raises many kinds on corrupt input
         raise fail(f"cannot read mesh file '{name}': {type(exc).__name__}: {exc}".rstrip(": ")) from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
@@ -52,6 +55,59 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
     if np.prod(scale) < 0:  # a mirroring scale turns the winding inside out
         mesh.invert()
     return mesh
+
+
+def _dae_in_metres(path: str):
+    """A COLLADA file as one mesh in metres: its ``<unit meter="...">`` applied, as RViz and
+    Gazebo apply it (trimesh reads the unit but leaves the coordinates in file units)."""
+    import trimesh
+
+    scene = trimesh.load(path, force="scene", process=False)
+    units = getattr(scene, "units", None)
+    if units and units not in ("meters", "m", "meter"):
+        scene = scene.convert_units("meters", guess=False)
+    geometry = scene.to_geometry() if hasattr(scene, "to_geometry") else scene.dump(concatenate=True)
+    return geometry
+
+
+def companions(path: str) -> list[str]:
+    """Files a mesh file references and its viewers load beside it, as relative paths: a
+    COLLADA file's images (``<init_from>``), an OBJ's material library and that library's
+    texture maps.  Only existing files below the mesh's own folder (no ``..``, no absolute
+    paths): what a copy of the mesh needs next to it.  Reads text only (cheap)."""
+    import re
+
+    folder = os.path.dirname(os.path.abspath(path))
+    ext = os.path.splitext(path)[1].lower()
+
+    def text(p: str) -> str:
+        try:
+            with open(p, encoding="utf-8", errors="replace") as f:
+                return f.read(4_000_000)
+        except OSError:
+            return ""
+
+    names: list[str] = []
+    if ext == ".dae":
+        names = re.findall(r"<init_from>\s*([^<]+?)\s*</init_from>", text(path))
+    elif ext == ".obj":
+        for lib in re.findall(r"^mtllib\s+(.+?)\s*$", text(path), re.M):
+            names.append(lib)
+            names += re.findall(r"^\s*(?:map_\w+|bump|disp|decal|refl)\s+(?:-\S+\s+\S+\s+)*(\S+)\s*$",
+                                text(os.path.join(folder, lib)), re.M)
+    out = []
+    for name in names:
+        name = name.strip().removeprefix("file://").removeprefix("./")
+        if not name or os.path.isabs(name) or ".." in name.replace("\\", "/").split("/"):
+            continue
+        if os.path.isfile(os.path.join(folder, name)) and name not in out:
+            out.append(name)
+    return out
+
+
+def read_vertices(path: str) -> np.ndarray:
+    """The vertices of a mesh file, in the file's coordinates (metres for COLLADA)."""
+    return np.asarray(load_mesh(path).vertices, dtype=np.float64)
 
 
 def _stl_problem(path: str) -> str | None:

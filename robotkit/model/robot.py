@@ -21,6 +21,8 @@ import numpy as np
 
 Vec3 = tuple[float, float, float]
 
+MJCF_MAX_DEPTH = 496  # bodies MuJoCo 4.0's XML reader nests (tinyxml2's element depth), measured
+
 
 def rpy_matrix(rpy) -> np.ndarray:
     """Rotation matrix of fixed-axis roll, pitch, yaw: R = Rz(y) Ry(p) Rx(r)."""
@@ -249,6 +251,10 @@ class Metadata:
     description: str = ""
     authors: tuple[Author, ...] = ()
     license: str | None = None
+    maintainers: tuple[Author, ...] = ()
+    """Given ones, else the authors with an e-mail address; may be empty (the build warns)."""
+    urls: tuple[tuple[str, str], ...] = ()
+    """(type, address) pairs: website, repository, bugtracker."""
 
 
 @dataclass(frozen=True)
@@ -294,21 +300,90 @@ class Robot:
     worlds: tuple[World, ...] = ()
     sensors: tuple[Sensor, ...] = ()
     actuators: tuple[Actuator, ...] = ()
-    gazebo: str = "sim"
-    ros_control: str = "ros2"
+    gazebo: str = "sim"  # sim | classic
+    ros: str = "ros2"  # ros2 | ros1: the package type, ros_control flavour, launch files
     base: str = "fixed"
 
     def frame_links(self) -> set[str]:
-        """Links that are only frames: no geometry, no inertial, fixed to a parent link.
-        SDF writes them as <frame> (an SDF link without an inertial would weigh 1 kg)."""
+        """Massless links fixed to another link: SDF writes them as ``<frame>`` (an SDF link
+        without an inertial would weigh 1 kg in Gazebo and Drake) and moves their geometry and
+        sensors into the link that carries them, as libsdformat lumps them in a URDF.
+
+        A massless root with a fixed child is a frame too, attached to that child
+        (:meth:`anchor`).  Call after ``finalize`` (inertials known)."""
         parent_joint = {j.child: j for j in self.joints}
         out = set()
         for link in self.links:
+            if link.inertial is not None or link.name == "world":
+                continue
             j = parent_joint.get(link.name)
-            if (j is not None and j.type == "fixed" and j.parent != "world" and not link.visuals
-                    and not link.collisions and link.inertial is None and link.inertial_spec.mode == "none"):
+            if j is None:
+                if self.anchor() is not None:
+                    out.add(link.name)
+            elif j.type == "fixed" and j.parent != "world":
                 out.add(link.name)
         return out
+
+    def anchor(self) -> str | None:
+        """The link a massless root is attached to when the root is only a frame (its first
+        child by a fixed joint, e.g. ``base_link`` below ``base_footprint``); None otherwise."""
+        root = self.root
+        if root == "world" or self.link(root).inertial is not None:
+            return None
+        return next((j.child for j in self.joints if j.parent == root and j.type == "fixed"), None)
+
+    def body_mass(self, name: str) -> float:
+        """Mass of ``name`` and of everything welded to it by fixed joints below it: what a
+        simulator moves as one body."""
+        by_name = {link.name: link for link in self.links}
+        total, todo = 0.0, [name]
+        while todo:
+            link = by_name[todo.pop()]
+            total += link.inertial.mass if link.inertial is not None else 0.0
+            todo += [j.child for j in self.joints if j.parent == link.name and j.type == "fixed"]
+        return total
+
+    def consumer_problems(self) -> list[tuple[str, str, tuple[str, ...]]]:
+        """(link, message, formats) for what a program loading a format refuses: a moving
+        link without mass (MuJoCo rejects the model; libsdformat drops the link and everything
+        below it; an SDF link without inertial weighs 1 kg), a massless root whose children all
+        move (libsdformat's URDF conversion gives an empty model), and a chain nested deeper
+        than MuJoCo's XML reader goes."""
+        out = []
+        moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
+        for j in self.joints:
+            if j.type in moving and not self.body_mass(j.child) > 0:
+                out.append((j.child, f"link '{j.child}' moves (joint '{j.name}') but has no mass: MuJoCo refuses "
+                            "to load it and Gazebo drops it with everything below it; give it an inertial "
+                            f"(links.{j.child}.inertial: {{mass: ...}}, or geometry and a density)",
+                            ("urdf", "sdf", "mjcf")))
+        root = self.root
+        if (root != "world" and self.link(root).inertial is None and self.anchor() is None
+                and any(j.parent == root for j in self.joints)):
+            out.append((root, f"link '{root}' is the root, has no mass and only moving joints below it: Gazebo's "
+                        "URDF conversion drops it and everything below it (an empty model); name the root "
+                        f"'world' to fix the robot to the world, or give links.{root} an inertial", ("urdf", "sdf")))
+        depth, deepest = self.depth()
+        if depth > MJCF_MAX_DEPTH:
+            out.append((deepest, f"link '{deepest}' sits {depth} links deep: MuJoCo's XML reader stops at "
+                        f"{MJCF_MAX_DEPTH} nested bodies, so it could not load the MJCF (a body per link); "
+                        "make the chain shorter", ("mjcf",)))
+        return out
+
+    def depth(self) -> tuple[int, str]:
+        """(number of links on the longest root-to-leaf path, the leaf)."""
+        parent = {j.child: j.parent for j in self.joints}
+        known: dict[str, int] = {}
+        for link in self.links:
+            chain, name = [], link.name
+            while name not in known and name in parent:
+                chain.append(name)
+                name = parent[name]
+            base = known.setdefault(name, 1)
+            for i, n in enumerate(reversed(chain)):
+                known[n] = base + i + 1
+        leaf = max(known, key=lambda n: (known[n], n))
+        return known[leaf], leaf
 
     def link(self, name: str) -> Link:
         for link in self.links:
