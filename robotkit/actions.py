@@ -300,3 +300,14 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
         op, make = "collision-coacd/1", (lambda: decompose(mesh, **args))
     pieces, info = cache.get_or_compute(op, {**args, "fidelity_samples": 4000}, [mesh], with_report(make))
     return list(pieces) if isinstance(pieces, (list, tuple)) else [pieces], info["fidelity"]
+
+
+@_user_errors_fail
+def picture_report(robot_dir: str, out_dir: str):
+    """report.html and its pictures (robotkit.picture; MuJoCo is imported here, in the task)."""
+    from pathlib import Path
+
+    from robotkit.picture import report_build_dir
+
+    name = Path(robot_dir).name
+    report_build_dir(Path(robot_dir), Path(out_dir), f"../urdf/{name}.urdf")

@@ -133,9 +133,12 @@ def to_doit(task: dict) -> dict:
 
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
-          echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None) -> BuildResult:
+          echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None,
+          report: bool = False) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
-    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key.
+    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key.  ``report`` also writes each
+    robot's picture report (``<robot>/report/report.html``); the command line does unless
+    ``--no-report``.
 
     The stamp of the no-op fast path (:mod:`robotkit.stamp`) is removed first and written
     again when the build succeeds; ``stamp_options`` are the options it is kept under
@@ -147,8 +150,8 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
 
     from robotkit import stamp
 
-    if stamp_options is None:
-        stamp_options = stamp.options(recipes, out_dir)
+    if stamp_options is None:  # a build without the report is another build than one with it
+        stamp_options = stamp.options(recipes, out_dir, None if report else {"no_report": True})
     stamp.remove(out_dir, stamp_options)
 
     from robotkit.tasks import load_robots, mesh_locations, robot_tasks
@@ -158,7 +161,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     result = BuildResult(robots=[r.name for _, r in robots])
     tasks = []
     for loaded, robot in robots:
-        tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot)))
+        tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot), report=report))
     (out / ".robotkit").mkdir(parents=True, exist_ok=True)
     recorder = _Recorder(result, echo, progress)
     inputs = _input_stats(robots, tasks)  # before running: an edit during the build is a change

@@ -52,6 +52,25 @@ def _parser() -> argparse.ArgumentParser:
 
     add_import(sub)
 
+    r = sub.add_parser("report", help="write a picture report (report.html and its pictures) of a robot",
+                       description="Render the robot offscreen (sides, collision, inertia boxes, frames, "
+                                   "joints at their limits) and write DIR/report.html with the pictures "
+                                   "beside it and a table per link and joint.")
+    r.add_argument("path", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
+    r.add_argument("-o", "--output", metavar="DIR",
+                   help="folder for report.html and its pictures (default: <build folder>/report)")
+    r.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    r.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
+                   help="where package://PKG/ meshes of a URDF are (repeatable)")
+
+    v = sub.add_parser("view", help="show the robot in the browser, rebuilt live as its recipe changes",
+                       description="Serve a 3D view of the robot (joint sliders, visual/collision/inertia/"
+                                   "frame toggles); a recipe is rebuilt on every save.")
+    v.add_argument("path", metavar="PATH", help="recipe .yaml, build folder, or .urdf file")
+    v.add_argument("--port", type=int, default=8080, metavar="N", help="port to serve on (default: 8080)")
+    v.add_argument("--no-browser", action="store_true", help="do not open a web browser")
+    v.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+
     s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
     s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
     return p
@@ -67,6 +86,8 @@ def _add_build(sub) -> None:
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
     b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
                                                            "recipes' `ros` key)")
+    b.add_argument("--no-report", action="store_true",
+                   help="do not write the picture report (<robot>/report/report.html)")
 
 
 def _cores() -> int:
@@ -97,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return {"build": _build, "world": _world, "schema": _schema, "check": _check,
-                "import": _import}[args.command](args)
+                "import": _import, "report": _report, "view": _view}[args.command](args)
     except Exception as exc:
         from robotkit.errors import RobotkitError  # imported late: dataclasses costs a no-op build 10 ms
 
@@ -118,7 +139,8 @@ def _build(args) -> int:
         print("robotkit: error: -j must be at least 1", file=sys.stderr)
         return 2
     start = time.perf_counter()
-    opts = stamp.options(args.recipes, args.out, {"ros": args.ros} if args.ros else None)
+    extra = {**({"ros": args.ros} if args.ros else {}), **({"no_report": True} if args.no_report else {})}
+    opts = stamp.options(args.recipes, args.out, extra or None)
     done = stamp.up_to_date(args.out, opts)  # nothing changed since the last successful build?
     if done is not None:
         return _report_up_to_date(args, done, start)
@@ -126,7 +148,7 @@ def _build(args) -> int:
 
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
     result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, ros=args.ros,
-                   stamp_options=opts)
+                   report=not args.no_report, stamp_options=opts)
     if result.ran or args.verbose:
         for w in result.warnings:
             print(f"warning: {w}", file=sys.stderr)
@@ -206,10 +228,63 @@ def _check(args) -> int:
             print(f"robotkit: error: --package-path takes PKG=DIR (got '{item}')", file=sys.stderr)
             return 2
         packages[pkg] = folder
-    findings = check(args.path, args.out, packages)
+    # github: the job summary points at the picture report, so a recipe's build writes it
+    findings = check(args.path, args.out, packages, report=args.format == "github")
     sys.stdout.write(render(findings, args.format, args.path))
+    if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
+        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.path, args.out)
     levels = ("error",) if args.fail_on == "error" else ("error", "warning")
     return 1 if any(f.severity in levels for f in findings) else 0
+
+
+def _package_paths(items: list[str]) -> dict[str, str] | None:
+    packages = {}
+    for item in items:
+        pkg, sep, folder = item.partition("=")
+        if not sep or not pkg or not folder:
+            print(f"robotkit: error: --package-path takes PKG=DIR (got '{item}')", file=sys.stderr)
+            return None
+        packages[pkg] = folder
+    return packages
+
+
+def _report(args) -> int:
+    from robotkit.picture import write_report
+
+    packages = _package_paths(args.package_path)
+    if packages is None:
+        return 2
+    start = time.perf_counter()
+    page = write_report(args.path, args.output, args.out, packages)
+    print(f"wrote {os.path.relpath(page)} ({time.perf_counter() - start:.2f} s)")
+    return 0
+
+
+def _view(args) -> int:
+    from robotkit.picture.viewer import serve
+
+    return serve(args.path, args.port, open_browser=not args.no_browser, build_out=args.out)
+
+
+def _job_summary(summary_file: str, findings, path: str, out: str) -> None:
+    """Append the check's summary, pointing at the picture report, to GitHub's job summary."""
+    from pathlib import Path
+
+    from robotkit.check.report import job_summary
+    from robotkit.tasks import REPORT
+
+    p = Path(path)
+    if p.suffix.lower() in (".yaml", ".yml"):
+        from robotkit.recipe.load import load_recipe
+
+        folders = [Path(out) / load_recipe(p).recipe.robot]
+    elif p.is_dir():
+        folders = [p] if (p / "model.sdf").is_file() else sorted(d for d in p.iterdir() if (d / "model.sdf").is_file())
+    else:
+        folders = []
+    pages = [os.path.relpath(f / REPORT) for f in folders if (f / REPORT).is_file()]
+    with open(summary_file, "a", encoding="utf-8") as f:
+        f.write(job_summary(findings, path, pages))
 
 
 def _import(args) -> int:

@@ -63,10 +63,12 @@ def _template_files(emitter: str) -> list[str]:
     return out
 
 
-def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None) -> list[dict]:
+def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None,
+                report: bool = False) -> list[dict]:
     """The task dicts that build ``robot`` into ``out_dir/<robot>/``.
 
-    ``where`` maps a mesh key, and ``link:<name>``, to the recipe location naming it (for messages).
+    ``where`` maps a mesh key, and ``link:<name>``, to the recipe location naming it (for messages);
+    ``report`` adds the picture report (``report/report.html``).
     """
     where = where or {}
     out_dir = Path(out_dir).absolute()
@@ -245,7 +247,36 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "task_dep": [f"{robot.name}:mesh:{k}" for k in facts],
             "clean": True,
         })
+    if report:
+        tasks.append(report_task(robot, root, tasks))
     return tasks + world_tasks(robot, out_dir)
+
+
+REPORT = "report/report.html"  # the picture report, below the robot folder
+
+
+def report_task(robot: Robot, root: Path, tasks: list[dict]) -> dict:
+    """``<robot>:report-html``: report.html and its pictures, from the written URDF, MJCF,
+    report.json and every mesh file MuJoCo reads (rendering imports stay in the action)."""
+    from robotkit.picture import VERSION
+    from robotkit.picture.page import TEMPLATE
+
+    inputs = [str(root / OUTPUTS[e](robot)) for e in ("urdf", "mjcf", "report")]
+    for t in tasks:  # the meshes the MJCF draws, and the collision pieces' records
+        kind = t["name"].split(":")[1]
+        if kind in ("copy", "visual", "convert", "collision"):
+            inputs += t["targets"]
+    template = [p for d in template_dirs() if (p := Path(d) / TEMPLATE).is_file()][:1]
+    return {
+        "name": f"{robot.name}:report-html",
+        "doc": REPORT,
+        "actions": [(actions.picture_report, [str(root), str(root / "report")])],
+        "file_dep": inputs + [str(p) for p in template],
+        "targets": [str(root / REPORT)],
+        "uptodate": [config_changed({"version": VERSION})],
+        "task_dep": [t["name"] for t in tasks if ":mesh:" in t["name"]],
+        "clean": True,
+    }
 
 
 def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
@@ -374,8 +405,8 @@ def load_robots(recipe_files, ros: str | None = None) -> list[tuple[object, Robo
     return robots
 
 
-def all_tasks(recipe_files, out_dir) -> list[dict]:
+def all_tasks(recipe_files, out_dir, report: bool = True) -> list[dict]:
     tasks = []
     for loaded, robot in load_robots(recipe_files):
-        tasks.extend(robot_tasks(robot, out_dir, mesh_locations(loaded, robot)))
+        tasks.extend(robot_tasks(robot, out_dir, mesh_locations(loaded, robot), report=report))
     return tasks

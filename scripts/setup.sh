@@ -1,16 +1,19 @@
 #!/usr/bin/env bash
 # Installs robotkit into ./.venv (Debian 12 / Python >= 3.11). With --test, also what the
-# tests need: pytest and MuJoCo from PyPI, and the validators check_urdf (liburdfdom-tools)
-# and `ign sdf` (libsdformat-dev, ignition-tools) from Debian's packages, and Debian's ROS 1
-# (catkin, roslaunch, RViz, tf2, Xvfb) that the generated ROS packages are launched with.
+# tests need: pytest, MuJoCo and Playwright from PyPI, Chromium, and the validators check_urdf
+# (liburdfdom-tools) and `ign sdf` (libsdformat-dev, ignition-tools) from Debian's packages, and
+# Debian's ROS 1 (catkin, roslaunch, RViz, tf2, Xvfb) that the generated ROS packages are launched with.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 apt_need=()
 python3 -c "import ensurepip, venv" 2>/dev/null || apt_need+=(python3-venv)
+# OSMesa: MuJoCo renders the picture report offscreen, with no display
+ldconfig -p 2>/dev/null | grep -q libOSMesa.so || apt_need+=(libosmesa6)
 if [ "${1:-}" = "--test" ]; then
   command -v check_urdf >/dev/null || apt_need+=(liburdfdom-tools)
   command -v ign >/dev/null || apt_need+=(libsdformat-dev ignition-tools)
+  command -v chromium >/dev/null || apt_need+=(chromium)  # the report and viewer tests (Playwright)
   # ROS 1 from Debian 12, for the generated catkin packages: build, launch, RViz under Xvfb, tf2
   ros1=(ros-core rosbash rospack-tools catkin python3-catkin-pkg python3-empy cmake g++ make
         ros-robot-state-publisher joint-state-publisher joint-state-publisher-gui rviz python3-rospy

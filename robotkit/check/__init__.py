@@ -77,12 +77,12 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
     return findings
 
 
-def check_recipe(path: Path, out_dir: str) -> list[Finding]:
+def check_recipe(path: Path, out_dir: str, report: bool = False) -> list[Finding]:
     from robotkit.build import build
     from robotkit.recipe.load import load_recipe
 
     loaded = load_recipe(path)
-    result = build([path], out_dir)
+    result = build([path], out_dir, report=report)
     findings = [Finding("warning", "build", f"robot '{loaded.recipe.robot}'", w) for w in result.warnings]
     findings += check_build_dir(Path(out_dir) / loaded.recipe.robot, loaded.recipe.measured_mass)
     marks = loaded.marks
@@ -98,7 +98,9 @@ def check_recipe(path: Path, out_dir: str) -> list[Finding]:
     return located
 
 
-def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None) -> list[Finding]:
+def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
+          report: bool = False) -> list[Finding]:
+    """``report``: a recipe's build also writes its picture report (as ``robotkit build`` does)."""
     p = Path(path)
     package_paths = package_paths or {}
     if p.is_dir():
@@ -112,7 +114,7 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
         raise RobotkitError(Problem("no such file or folder", file=path))
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
-        return check_recipe(p, out_dir)
+        return check_recipe(p, out_dir, report)
     if suffix == ".urdf":
         return check_urdf_file(p, package_paths)
     if suffix in (".sdf", ".world"):

@@ -74,3 +74,24 @@ def _junit(findings: list[Finding], source: str) -> str:
     suites = ET.Element("testsuites")
     suites.append(suite)
     return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(suites, encoding="unicode") + "\n"
+
+
+def job_summary(findings: list[Finding], source: str, reports: list[str]) -> str:
+    """Markdown for a GitHub job summary ($GITHUB_STEP_SUMMARY): the counts, the findings,
+    and where the picture report is (a folder to upload as an artifact)."""
+    errors = sum(f.severity == "error" for f in findings)
+    warnings = len(findings) - errors
+    out = [f"## robotkit check {source}", "",
+           f"{errors} error{'s' * (errors != 1)}, {warnings} warning{'s' * (warnings != 1)}", ""]
+    if findings:
+        out += ["| severity | subject | message | check |", "|---|---|---|---|"]
+        for f in findings:
+            cells = [f.severity, f.subject, f.message + (f" (hint: {f.hint})" if f.hint else ""), f.check]
+            out.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+        out.append("")
+    for page in reports:
+        folder = page.rsplit("/", 1)[0]
+        out.append(f"Picture report: `{page}` (upload the folder `{folder}` as an artifact to see it)")
+    if not reports:
+        out.append("No picture report: `robotkit report PATH -o DIR` writes one.")
+    return "\n".join(out) + "\n"

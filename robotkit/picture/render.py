@@ -1,0 +1,382 @@
+"""Offscreen pictures of a robot from its MJCF: MuJoCo's renderer (OSMesa by default, no
+display needed), overlays added to the scene with ``mjv_initGeom``.
+
+robotkit's MJCF puts visual geoms in group 2 and collision geoms in group 3; a body is a link.
+Overlays: the equivalent inertia box of each link (a uniform box with the link's mass and
+principal moments, at its centre of mass along its principal axes, as Gazebo draws it),
+centres of mass, link frames, joint axes, sensor frames and fields of view.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+os.environ.setdefault("MUJOCO_GL", "osmesa")  # before mujoco is imported: software GL, no display
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+
+VISUAL, COLLISION, SENSOR = 2, 3, 4  # MuJoCo geom/site groups in robotkit's MJCF
+HINGE, SLIDE = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
+BACKGROUND = (235, 238, 242)
+GHOST = 0.25  # alpha of the visual behind collision geometry and overlays
+COLLISION_RGBA = (0.1, 0.55, 0.95, 0.6)
+FLAGGED = (0.9, 0.1, 0.1)  # links a lint fired on
+PALETTE = [  # no red or brown: red is for flagged links
+(0.12, 0.47, 0.71), (1.0, 0.5, 0.05), (0.17, 0.63, 0.17), (0.58, 0.4, 0.74),
+           (0.89, 0.47, 0.76), (0.5, 0.5, 0.5), (0.74, 0.74, 0.13), (0.09, 0.75, 0.81)]
+# (file stem, title, azimuth, elevation)
+SIDES = [("front", "front", 180.0, -5.0), ("left", "left side", 270.0, -5.0),
+         ("top", "top", 180.0, -89.0), ("iso", "three-quarter view", 135.0, -25.0)]
+
+
+@dataclass(frozen=True)
+class Picture:
+    file: str  # below the report folder
+    title: str
+    caption: str
+    kind: str  # view | collision | inertia | frames | joint
+
+
+def equivalent_box(mass: float, moments) -> np.ndarray:
+    """Full side lengths of the uniform box with ``mass`` and principal ``moments`` (Gazebo's
+    View > Inertia): a = sqrt(6 (I2 + I3 - I1) / m), and so on; a side that comes out
+    imaginary (moments that break the triangle inequality) is drawn flat."""
+    i1, i2, i3 = (float(v) for v in moments)
+    if mass <= 0:
+        return np.zeros(3)
+    sides = [6.0 * (i2 + i3 - i1) / mass, 6.0 * (i1 + i3 - i2) / mass, 6.0 * (i1 + i2 - i3) / mass]
+    return np.sqrt(np.maximum(sides, 0.0))
+
+
+def bounds(model, data) -> tuple[np.ndarray, float]:
+    """Centre and radius of the drawn robot."""
+    lo, hi = box(model, data)
+    return (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.05)
+
+
+def box(model, data) -> tuple[np.ndarray, np.ndarray]:
+    """World bounding box of the drawn robot: the corners of its visual geoms' boxes (all
+    geoms when it has none)."""
+    ids = [i for i in range(model.ngeom) if model.geom_group[i] == VISUAL] or list(range(model.ngeom))
+    ids = [i for i in ids if int(model.geom_type[i]) != int(mujoco.mjtGeom.mjGEOM_PLANE)]
+    corners = [data.xpos[b] for b in range(1, model.nbody)] or [np.zeros(3)]
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+    for i in ids:
+        centre, half = model.geom_aabb[i][:3], model.geom_aabb[i][3:]
+        R = data.geom_xmat[i].reshape(3, 3)
+        corners.extend(data.geom_xpos[i] + (centre + signs * half) @ R.T)
+    pts = np.asarray(corners)
+    return pts.min(0), pts.max(0)
+
+
+def load_model(mjcf: str | os.PathLike):
+    """The MJCF compiled by MuJoCo, with a plain light background (a flat skybox) unless it has
+    a skybox of its own; a file MuJoCo cannot load is a RobotkitError naming it."""
+    from robotkit.errors import Problem, RobotkitError
+
+    try:
+        spec = mujoco.MjSpec.from_file(str(mjcf))
+        if not any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in spec.textures):
+            rgb = [c / 255 for c in BACKGROUND]
+            spec.add_texture(name="robotkit_background", type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+                             builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT, rgb1=rgb, rgb2=rgb, width=8, height=8)
+        return spec.compile()
+    except ValueError as exc:
+        raise RobotkitError(Problem(f"MuJoCo cannot load it: {str(exc).strip()}", file=str(mjcf))) from None
+
+
+def renderer(model, height: int, width: int):
+    """MuJoCo's offscreen renderer, or a RobotkitError that says how to get one."""
+    from robotkit.errors import Problem, RobotkitError
+
+    try:
+        return mujoco.Renderer(model, height, width)
+    except Exception as exc:  # noqa: BLE001  (no GL context: the backend is missing or needs a display)
+        raise RobotkitError(Problem(
+            f"cannot render offscreen with MUJOCO_GL={os.environ.get('MUJOCO_GL', '')!r}: {exc} (install "
+            "Debian's libosmesa6 and set MUJOCO_GL=osmesa before MuJoCo is first imported)")) from None
+
+
+class Painter:
+    """One MuJoCo model and an offscreen renderer; draws the pictures of a report."""
+
+    def __init__(self, model, width: int = 640, height: int = 480, data=None):
+        self.model = model
+        self.data = data if data is not None else mujoco.MjData(model)
+        model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
+        model.vis.global_.offheight = max(model.vis.global_.offheight, height)
+        model.vis.headlight.ambient[:] = 0.45
+        model.vis.headlight.diffuse[:] = 0.6
+        model.vis.headlight.specular[:] = 0.1
+        self.renderer = renderer(model, height, width)
+        self.flagged: set[str] = set()
+        mujoco.mj_forward(model, self.data)
+        self.center, self.radius = bounds(model, self.data)
+
+    def close(self):
+        self.renderer.close()
+
+    # ---------------------------------------------------------------- scene
+    def _camera(self, azimuth: float, elevation: float):
+        cam = mujoco.MjvCamera()
+        cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+        cam.lookat[:] = self.center
+        cam.distance = self.radius / math.sin(math.radians(self.model.vis.global_.fovy) / 2) * 0.9
+        cam.azimuth, cam.elevation = azimuth, elevation
+        return cam
+
+    def _option(self, groups: dict[int, bool]):
+        opt = mujoco.MjvOption()
+        for g in range(len(opt.geomgroup)):
+            opt.geomgroup[g] = 0
+            opt.sitegroup[g] = 0
+        for g, on in groups.items():
+            opt.geomgroup[g] = on
+        return opt
+
+    def _draw(self, azimuth, elevation, groups, ghost: bool, overlays=()) -> np.ndarray:
+        m = self.model
+        saved = m.geom_rgba.copy(), m.mat_rgba.copy()
+        if ghost:  # visual geoms faint, so what is drawn inside them shows
+            m.geom_rgba[:, 3] = np.where(m.geom_group == VISUAL, GHOST, m.geom_rgba[:, 3])
+            m.mat_rgba[:, 3] = GHOST
+            m.geom_rgba[m.geom_group == COLLISION] = COLLISION_RGBA
+        try:
+            scene_opt = self._option(groups)
+            self.renderer.update_scene(self.data, self._camera(azimuth, elevation), scene_opt)
+            scn = self.renderer.scene
+            scn.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+            scn.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+            for overlay in overlays:
+                overlay(scn)
+            return self.renderer.render().copy()
+        finally:
+            m.geom_rgba[:], m.mat_rgba[:] = saved
+
+    # ---------------------------------------------------------------- overlays
+    def _add(self, scn, type_, size, pos, mat, rgba):
+        if scn.ngeom >= scn.maxgeom:
+            return None
+        g = scn.geoms[scn.ngeom]
+        mujoco.mjv_initGeom(g, type_, np.asarray(size, float), np.asarray(pos, float),
+                            np.asarray(mat, float).reshape(9), np.asarray(rgba, np.float32))
+        scn.ngeom += 1
+        return g
+
+    def _line(self, scn, a, b, width, rgba, type_=mujoco.mjtGeom.mjGEOM_CAPSULE):
+        g = self._add(scn, type_, np.zeros(3), np.zeros(3), np.eye(3), rgba)
+        if g is not None:
+            mujoco.mjv_connector(g, type_, width, np.asarray(a, float), np.asarray(b, float))
+
+    def colour(self, body: int) -> tuple:
+        name = self.model.body(body).name
+        return FLAGGED if name in self.flagged else PALETTE[body % len(PALETTE)]
+
+    def inertia_boxes(self, scn):
+        m, d = self.model, self.data
+        for b in range(1, m.nbody):
+            if m.body_mass[b] <= 0:
+                continue
+            sides = equivalent_box(m.body_mass[b], m.body_inertia[b])
+            half = np.maximum(sides / 2, self.radius * 0.002)
+            self._add(scn, mujoco.mjtGeom.mjGEOM_BOX, half, d.xipos[b], d.ximat[b], (*self.colour(b), 0.55))
+
+    def centres_of_mass(self, scn):
+        m, d = self.model, self.data
+        r = self.radius * 0.025
+        for b in range(1, m.nbody):
+            if m.body_mass[b] > 0:
+                self._add(scn, mujoco.mjtGeom.mjGEOM_SPHERE, [r, r, r], d.xipos[b], np.eye(3), (*self.colour(b), 1))
+
+    def frames(self, scn):
+        m, d = self.model, self.data
+        length, width = self.radius * 0.12, self.radius * 0.006
+        for b in range(1, m.nbody):
+            R = d.xmat[b].reshape(3, 3)
+            for k, rgb in enumerate(((0.9, 0.1, 0.1), (0.1, 0.8, 0.1), (0.1, 0.2, 0.95))):
+                self._line(scn, d.xpos[b], d.xpos[b] + R[:, k] * length, width, (*rgb, 1))
+
+    def joint_axes(self, scn):
+        m, d = self.model, self.data
+        length, width = self.radius * 0.3, self.radius * 0.012
+        for j in range(m.njnt):
+            if int(m.jnt_type[j]) not in (HINGE, SLIDE):
+                continue
+            a = d.xanchor[j]
+            self._line(scn, a, a + d.xaxis[j] * length, width, (1.0, 0.85, 0.0, 1), mujoco.mjtGeom.mjGEOM_ARROW)
+
+    def sensors(self, scn):
+        """Sensor sites (frames, rangefinder rays, contact boxes) and camera frusta."""
+        m, d = self.model, self.data
+        length, width = self.radius * 0.08, self.radius * 0.004
+        ray = self.radius * 0.35
+        rangefinders = {int(m.sensor_objid[s]) for s in range(m.nsensor)
+                        if int(m.sensor_type[s]) == int(mujoco.mjtSensor.mjSENS_RANGEFINDER)}
+        for s in range(m.nsite):
+            if m.site_group[s] != SENSOR:
+                continue
+            R, p = d.site_xmat[s].reshape(3, 3), d.site_xpos[s]
+            if s in rangefinders:
+                self._line(scn, p, p + R[:, 2] * ray, width * 0.5, (1.0, 0.2, 0.6, 0.7), mujoco.mjtGeom.mjGEOM_LINE)
+            elif int(m.site_type[s]) == int(mujoco.mjtGeom.mjGEOM_BOX):
+                self._add(scn, mujoco.mjtGeom.mjGEOM_BOX, m.site_size[s], p, R, (1.0, 0.5, 0.0, 0.25))
+            else:
+                for k, rgb in enumerate(((0.9, 0.1, 0.1), (0.1, 0.8, 0.1), (0.1, 0.2, 0.95))):
+                    self._line(scn, p, p + R[:, k] * length, width, (*rgb, 1))
+        for c in range(m.ncam):
+            R, p = d.cam_xmat[c].reshape(3, 3), d.cam_xpos[c]
+            fovy = math.radians(m.cam_fovy[c])
+            w, h = m.cam_resolution[c] if m.cam_resolution[c][1] > 0 else (4, 3)
+            ty = math.tan(fovy / 2)
+            tx = ty * w / h
+            far = self.radius * 0.25
+            corners = [p + far * (R @ np.array([sx * tx, sy * ty, -1.0])) for sx in (-1, 1) for sy in (-1, 1)]
+            for q in corners:
+                self._line(scn, p, q, width, (0.0, 0.7, 0.9, 1), mujoco.mjtGeom.mjGEOM_LINE)
+            for i, j in ((0, 1), (1, 3), (3, 2), (2, 0)):
+                self._line(scn, corners[i], corners[j], width, (0.0, 0.7, 0.9, 1), mujoco.mjtGeom.mjGEOM_LINE)
+
+    # ---------------------------------------------------------------- configurations
+    def pose(self, qpos=None):
+        d = self.data
+        d.qpos[:] = self.model.qpos0 if qpos is None else qpos
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_comPos(self.model, d)
+        mujoco.mj_camlight(self.model, d)
+
+    def joint_poses(self) -> list[tuple[str, str, list[tuple[str, np.ndarray]]]]:
+        """(joint, kind, [(label, qpos)]) for each hinge and slide joint: at its lower limit,
+        zero and its upper limit (a continuous joint at -90 and +90 degrees); mimic joints follow."""
+        m = self.model
+        out = []
+        followers = self._mimics()
+        for j in range(m.njnt):
+            t = int(m.jnt_type[j])
+            if t not in (HINGE, SLIDE) or j in followers:
+                continue
+            adr = m.jnt_qposadr[j]
+            if m.jnt_limited[j]:
+                lo, hi = (float(v) for v in m.jnt_range[j])
+            elif t == HINGE:
+                lo, hi = -math.pi / 2, math.pi / 2
+            else:
+                lo, hi = -self.radius / 2, self.radius / 2
+            unit = "rad" if t == HINGE else "m"
+            # a small positive move shows the direction even when the limits are whole turns
+            step = min(hi, 0.6 if t == HINGE else (hi - lo) / 4) if hi > 0 else None
+            values = [(f"lower {lo:.3g} {unit}", lo), ("zero", 0.0)]
+            if step is not None and step < hi:
+                values.append((f"+{step:.3g} {unit}", step))
+            values.append((f"upper {hi:.3g} {unit}", hi))
+            poses = []
+            for label, value in values:
+                q = m.qpos0.copy()
+                q[adr] = value
+                for f, (leader, coef) in followers.items():
+                    q[m.jnt_qposadr[f]] = sum(c * q[m.jnt_qposadr[leader]] ** k for k, c in enumerate(coef))
+                poses.append((label, q))
+            out.append((m.joint(j).name, "hinge" if t == HINGE else "slide", poses))
+        return out
+
+    def _mimics(self) -> dict[int, tuple[int, np.ndarray]]:
+        m = self.model
+        out = {}
+        for e in range(m.neq):
+            if int(m.eq_type[e]) == int(mujoco.mjtEq.mjEQ_JOINT) and m.eq_obj2id[e] >= 0:
+                out[int(m.eq_obj1id[e])] = (int(m.eq_obj2id[e]), np.array(m.eq_data[e][:5]))
+        return out
+
+
+def _save(img: np.ndarray, path: Path) -> None:
+    import io
+
+    from PIL import Image
+
+    from robotkit.ioutil import write_if_changed
+
+    buf = io.BytesIO()
+    Image.fromarray(img).save(buf, format="PNG")
+    write_if_changed(path, buf.getvalue())
+
+
+def _strip(images: list[np.ndarray], labels: list[str]) -> np.ndarray:
+    """Images side by side, each labelled at its top left."""
+    from PIL import Image, ImageDraw
+
+    h, w = images[0].shape[:2]
+    out = Image.new("RGB", (w * len(images), h))
+    draw = ImageDraw.Draw(out)
+    for i, (img, label) in enumerate(zip(images, labels)):
+        out.paste(Image.fromarray(img), (i * w, 0))
+        draw.rectangle([i * w, 0, i * w + 8 + 7 * len(label), 18], fill=(255, 255, 255))
+        draw.text((i * w + 4, 3), label, fill=(0, 0, 0))
+    return np.asarray(out)
+
+
+def render_pictures(mjcf: str | os.PathLike, out_dir: str | os.PathLike, flagged: set[str] = frozenset(),
+                    joints: bool = True) -> list[Picture]:
+    """Write the report's PNG pictures of the MJCF model into ``out_dir``; return them in order."""
+    out = Path(out_dir)
+    model = load_model(mjcf)
+    p = Painter(model)
+    p.flagged = set(flagged)
+    pics: list[Picture] = []
+    iso = SIDES[3]
+    visual = {VISUAL: True}
+    has_visual = bool((model.geom_group == VISUAL).any())
+    if not has_visual:  # an MJCF not written by robotkit: draw what it has
+        visual = {g: True for g in range(6)}
+    try:
+        for stem, title, az, el in SIDES:
+            _save(p._draw(az, el, visual, ghost=False), out / f"{stem}.png")
+            pics.append(Picture(f"{stem}.png", f"Visual, {title}", "the visual meshes and primitives", "view"))
+        _save(p._draw(iso[2], iso[3], {VISUAL: True, COLLISION: True}, ghost=True), out / "collision.png")
+        pics.append(Picture("collision.png", "Collision over the visual",
+                            "collision geometry (blue) inside a ghost of the visual", "collision"))
+        _save(p._draw(iso[2], iso[3], visual, ghost=True, overlays=(p.inertia_boxes, p.centres_of_mass)),
+              out / "inertia.png")
+        pics.append(Picture("inertia.png", "Inertia boxes and centres of mass",
+                            "each link's equivalent inertia box (uniform box with its mass and principal "
+                            "moments) and its centre of mass; red: a lint fired on the link", "inertia"))
+        _save(p._draw(iso[2], iso[3], visual, ghost=True, overlays=(p.frames, p.joint_axes, p.sensors)),
+              out / "frames.png")
+        pics.append(Picture("frames.png", "Frames, joint axes and sensors",
+                            "link frames (x red, y green, z blue), joint axes (yellow arrows), sensor "
+                            "frames, rangefinder rays and camera fields of view", "frames"))
+        if joints:
+            pics += _joint_pictures(p, out, visual)
+    finally:
+        p.close()
+    return pics
+
+
+def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
+    import re
+
+    pics = []
+    small = Painter(p.model, 320, 240, data=p.data)  # the same model, smaller pictures for the strips
+    small.flagged = p.flagged
+    try:
+        for name, kind, poses in p.joint_poses():
+            images = []
+            corners = []
+            for _, q in poses:  # frame the joint's whole motion
+                small.pose(q)
+                corners += list(box(small.model, small.data))
+            lo, hi = np.min(corners, axis=0), np.max(corners, axis=0)
+            small.center, small.radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.05)
+            for _, q in poses:
+                small.pose(q)
+                images.append(small._draw(135.0, -25.0, visual, ghost=False, overlays=(small.joint_axes,)))
+            small.pose()
+            file = "joint-" + re.sub(r"[^A-Za-z0-9_.-]", "_", name) + ".png"
+            _save(_strip(images, [label for label, _ in poses]), out / file)
+            pics.append(Picture(file, f"Joint {name}", f"{kind} joint at its lower limit, zero, a small positive "
+                                "move (when the upper limit is further) and its upper limit", "joint"))
+    finally:
+        small.renderer.close()
+    return pics

@@ -1,0 +1,283 @@
+"""The picture report: equivalent inertia boxes against known answers, report.html against a
+golden file, the build's report task (no-op rebuilds do not re-render), known defects named
+in the table and visible in the pictures, and the page in a real browser (Chromium)."""
+
+from __future__ import annotations
+
+import re
+import shutil
+
+import numpy as np
+import pytest
+import trimesh
+from PIL import Image
+
+from conftest import GOLDEN, RECIPES, assert_golden, run_cli, write_recipe
+from robotkit.build import build
+
+CHROMIUM_ARGS = ["--no-sandbox", "--headless", "--disable-gpu", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync", "--no-first-run"]
+
+
+def chromium(playwright):
+    """Debian's Chromium driven by Playwright (never a downloaded browser)."""
+    return playwright.chromium.launch(executable_path=shutil.which("chromium") or "/usr/bin/chromium",
+                                      args=CHROMIUM_ARGS)
+
+
+@pytest.fixture(scope="session")
+def turret(tmp_path_factory):
+    """turret_bot built once for the session, with its picture report."""
+    out = tmp_path_factory.mktemp("picture-build")
+    recipe = out / "turret_bot.yaml"
+    shutil.copyfile(RECIPES / "turret_bot.yaml", recipe)
+    shutil.copytree(RECIPES / "meshes" / "turret_bot", out / "meshes" / "turret_bot")
+    assert "turret_bot:report-html" in build_cli([recipe], out / "build")
+    return out / "build" / "turret_bot", recipe
+
+
+def build_cli(recipes, out) -> list[str]:
+    """``robotkit build -v`` in its own process (rendering never happens in the test process,
+    which doit's worker processes may later be forked from); the names of the tasks that ran."""
+    done = run_cli("build", *recipes, "--out", out, "-v")
+    assert done.returncode == 0, done.stderr
+    return [line.strip() for line in done.stderr.splitlines() if line.startswith("  ") and ":" in line
+            and not line.strip().startswith(("warning", "collision"))]
+
+
+def pixels(path) -> np.ndarray:
+    return np.asarray(Image.open(path).convert("RGB"), dtype=np.int16)
+
+
+def test_equivalent_box_known_answer():
+    from robotkit.picture.render import equivalent_box
+
+    m, (a, b, c) = 2.0, (0.3, 0.2, 0.1)
+    moments = (m / 12 * (b * b + c * c), m / 12 * (a * a + c * c), m / 12 * (a * a + b * b))
+    assert np.allclose(equivalent_box(m, moments), [a, b, c], rtol=1e-12)
+    # moments that break the triangle inequality: that side is drawn flat, never NaN
+    assert equivalent_box(1.0, (1.0, 0.1, 0.1)).tolist()[0] == 0.0
+
+
+def test_build_writes_the_report_and_a_noop_build_does_not_rerender(turret):
+    robot_dir, recipe = turret
+    report = robot_dir / "report"
+    names = sorted(p.name for p in report.iterdir())
+    assert names == ["collision.png", "frames.png", "front.png", "inertia.png", "iso.png", "joint-j1.png",
+                     "joint-j2.png", "left.png", "report.html", "top.png"]
+    assert_golden(report / "report.html", GOLDEN / "turret_bot" / "report.html")
+    before = {p.name: p.stat().st_mtime_ns for p in report.iterdir()}
+    again = build([recipe], robot_dir.parent, report=True)
+    assert again.ran == [] and "turret_bot:report-html" in again.uptodate
+    assert {p.name: p.stat().st_mtime_ns for p in report.iterdir()} == before
+
+
+def test_report_task_reruns_on_a_recipe_edit_and_pictures_are_byte_identical(turret, tmp_path):
+    robot_dir, recipe = turret
+    edited = tmp_path / "turret_bot.yaml"
+    shutil.copytree(recipe.parent / "meshes", tmp_path / "meshes")
+    edited.write_text(recipe.read_text().replace("blue:  {rgba: [0, 0, 0.8, 1]", "blue:  {rgba: [0.9, 0.9, 0, 1]"))
+    assert "turret_bot:report-html" in build_cli([edited], tmp_path / "build")
+    new = tmp_path / "build" / "turret_bot" / "report"
+    old = robot_dir / "report"
+    assert (new / "inertia.png").read_bytes() != (old / "front.png").read_bytes()
+    assert (new / "collision.png").read_bytes() == (old / "collision.png").read_bytes()  # colour not drawn there
+    assert (new / "front.png").read_bytes() != (old / "front.png").read_bytes()  # the rotor turned yellow
+    assert (new / "report.html").read_text() == (old / "report.html").read_text()
+
+
+def test_no_report_flag(tmp_path):
+    recipe = write_recipe(tmp_path, """
+        robot: cube
+        links:
+          base: {visual: {box: {size: [0.1, 0.1, 0.1]}}}
+        """)
+    done = run_cli("build", recipe, "--out", tmp_path / "build", "--no-report")
+    assert done.returncode == 0, done.stderr
+    assert not (tmp_path / "build" / "cube" / "report").exists()
+    done = run_cli("build", recipe, "--out", tmp_path / "build")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "build" / "cube" / "report" / "report.html").is_file()
+
+
+ARM = """
+    robot: {name}
+    links:
+      base: {{visual: {{box: {{size: [0.2, 0.2, 0.05]}}}}, inertial: {{mass: 5}}}}
+      arm:
+        visual: {{box: {{size: [0.05, 0.05, 0.4]}}, origin: {{xyz: [0, 0, 0.2]}}}}
+        inertial: {inertial}
+      tool:
+        visual: {{mesh: tool.stl{units}}}
+        inertial: {{mass: 0.3}}
+    joints:
+      shoulder:
+        type: revolute
+        parent: base
+        child: arm
+        origin: {{xyz: [0, 0, 0.025]}}
+        axis: [0, {axis}, 0]
+        limit: {{lower: -1, upper: 1, effort: 10, velocity: 2}}
+      wrist:
+        type: fixed
+        parent: arm
+        child: tool
+        origin: {{xyz: [0, 0, 0.4]}}
+    """
+# a uniform 0.05 x 0.05 x 0.4 m box of 2.7 kg about its centre
+ARM_INERTIA = {"ixx": 2.7 / 12 * (0.05 ** 2 + 0.4 ** 2), "iyy": 2.7 / 12 * (0.05 ** 2 + 0.4 ** 2),
+               "izz": 2.7 / 12 * (2 * 0.05 ** 2)}
+
+
+def arm_inertial(scale: float) -> str:
+    tensor = ", ".join(f"{k}: {v * scale!r}" for k, v in ARM_INERTIA.items())
+    return f"{{mass: 2.7, com: [0, 0, 0.2], inertia: {{{tensor}, ixy: 0, ixz: 0, iyz: 0}}}}"
+
+
+@pytest.fixture(scope="module")
+def arms(tmp_path_factory):
+    """Three builds of one small arm: healthy, with its joint axis flipped, and with two
+    defects (an inertia ten times too large, a millimetre mesh used as metres)."""
+    folder = tmp_path_factory.mktemp("arms")
+    tool_mm = trimesh.creation.box(extents=[40.0, 40.0, 60.0])  # millimetres
+    tool_mm.apply_translation([0, 0, 30.0])
+    recipes = []
+    for name, axis, scale, units in (("healthy", 1, 1.0, ", units: mm"), ("flipped", -1, 1.0, ", units: mm"),
+                                     ("defects", 1, 10.0, "")):
+        recipes.append(write_recipe(folder, ARM.format(name=name, axis=axis, inertial=arm_inertial(scale),
+                                                       units=units), f"{name}.yaml", {"tool.stl": tool_mm}))
+    build_cli(recipes, folder / "build")
+    return folder / "build"
+
+
+def row(html: str, kind: str, name: str) -> str:
+    match = re.search(rf'<tr id="{kind}-{name}">(.*?)</tr>', html, re.S)
+    assert match, f"no row for {kind} {name}"
+    return match.group(1)
+
+
+def test_defects_are_named_in_the_table(arms):
+    html = (arms / "defects" / "report" / "report.html").read_text()
+    assert "[inertia-box]" in row(html, "link", "arm")
+    assert "[part-size]" in row(html, "link", "tool")
+    assert "visual tool.stl is 60 m across" in row(html, "link", "tool")
+    assert '<span class="error" id="errors">' in html
+    healthy = (arms / "healthy" / "report" / "report.html").read_text()
+    assert "[inertia-box]" not in healthy and "[part-size]" not in healthy
+    # the arm's equivalent box: 0.05 x 0.05 x 0.4 m healthy; sqrt(10) times that when 10x the inertia
+    assert "(0.4, 0.05, 0.05)" in row(healthy, "link", "arm")  # along the smallest moment first
+    assert "(1.265, 0.1581, 0.1581)" in row(html, "link", "arm")
+    flipped = (arms / "flipped" / "report" / "report.html").read_text()
+    assert "(0, -1, 0)" in row(flipped, "joint", "shoulder")
+
+
+def test_defects_are_visible_in_the_pictures(arms):
+    healthy, defects = arms / "healthy" / "report", arms / "defects" / "report"
+    # the flagged links' inertia boxes are drawn red, the 60 m "tool" fills the picture
+    def red(path):
+        img = pixels(path)
+        r, g, b = img[..., 0], img[..., 1], img[..., 2]
+        return ((r > 120) & (r > 1.6 * g) & (np.abs(g - b) < 25)).mean()
+
+    assert red(defects / "inertia.png") > 0.2
+    assert red(healthy / "inertia.png") == 0
+
+
+def test_flipped_axis_shows_in_the_limit_pictures(arms):
+    """q -> -q: the flipped joint at its lower limit is the healthy one at its upper limit."""
+    def panels(name):
+        strip = pixels(arms / name / "report" / "joint-shoulder.png")
+        w = 320  # lower, zero, +0.6 rad, upper
+        assert strip.shape[1] == 4 * w
+        return [strip[20:, i * w:(i + 1) * w] for i in (0, 1, 3)]  # below the labels
+
+    def differ(a, b):  # share of pixels that differ
+        return (np.abs(a - b).max(axis=2) > 30).mean()
+
+    healthy, flipped = panels("healthy"), panels("flipped")
+    # the same arm pose; only the joint-axis arrow (drawn over it) points the other way
+    assert differ(flipped[0], healthy[2]) < 0.002 and differ(flipped[2], healthy[0]) < 0.002
+    assert differ(flipped[0], healthy[0]) > 0.02
+    assert differ(healthy[0], healthy[2]) > 0.02  # the joint moves visibly
+
+
+def test_report_of_a_foreign_urdf_and_an_mjcf_file(assets, turret, tmp_path):
+    done = run_cli("report", assets / "turret_bot" / "urdf" / "turret_bot.urdf", "-o", tmp_path / "urdf",
+                   "--package-path", f"turret_bot={assets / 'turret_bot'}")
+    assert done.returncode == 0, done.stderr
+    assert re.fullmatch(r"wrote \S*urdf/report\.html \(\d+\.\d\d s\)\n", done.stdout), done.stdout
+    html = (tmp_path / "urdf" / "report.html").read_text()
+    assert "[com-offset]" in row(html, "link", "base")
+    assert (tmp_path / "urdf" / "inertia.png").is_file() and (tmp_path / "urdf" / "joint-j2.png").is_file()
+
+    robot_dir, _ = turret
+    done = run_cli("report", robot_dir / "mjcf" / "turret_bot.xml", "-o", tmp_path / "mjcf")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "mjcf" / "frames.png").is_file()
+    assert "<td>rotor</td>" in (tmp_path / "mjcf" / "report.html").read_text()
+
+    lone = tmp_path / "lone.sdf"  # an SDF outside a build folder: the table only, and why
+    shutil.copyfile(robot_dir / "model.sdf", lone)
+    done = run_cli("report", lone)
+    assert done.returncode == 0, done.stderr
+    html = (tmp_path / "lone-report" / "report.html").read_text()
+    assert "No pictures: an SDF file outside a robotkit build folder is not drawn yet (a URDF or MJCF is)." in html
+    assert "<img" not in html
+    built = (robot_dir / "report" / "report.html").read_text()
+    # name, mass, centre of mass, principal moments: libsdformat's reading agrees with the URDF's
+    assert row(html, "link", "rotor").split("</td>")[:5] == row(built, "link", "rotor").split("</td>")[:5]
+
+
+def test_report_bad_input(tmp_path):
+    done = run_cli("report", tmp_path / "nothing.yaml")
+    assert (done.returncode, done.stderr) == (2, f"{tmp_path / 'nothing.yaml'}: no such file or folder\n")
+    (tmp_path / "robot.txt").write_text("x")
+    done = run_cli("report", tmp_path / "robot.txt")
+    assert done.returncode == 2
+    assert done.stderr == (f"{tmp_path / 'robot.txt'}: unknown kind of file (expected a recipe .yaml, .urdf, "
+                           ".sdf or MJCF .xml)\n")
+
+
+def test_report_in_chromium(turret):
+    """The page loads with no console error, every picture loads and is not blank, and the
+    inertia-box picture is not the visual picture."""
+    from playwright.sync_api import sync_playwright
+
+    report = turret[0] / "report"
+    with sync_playwright() as p:
+        browser = chromium(p)
+        page = browser.new_page()
+        errors = []
+        page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.goto((report / "report.html").as_uri())
+        page.wait_for_load_state("load")
+        images = page.eval_on_selector_all(
+            "img", "els => els.map(e => [e.getAttribute('src'), e.complete, e.naturalWidth, e.naturalHeight])")
+        browser.close()
+    assert errors == []
+    assert len(images) == 9
+    for src, complete, w, h in images:
+        assert complete and w > 0 and h > 0, src
+        img = pixels(report / src)
+        assert img.reshape(-1, 3).std(axis=0).max() > 10, f"{src} is blank"
+    diff = np.abs(pixels(report / "inertia.png") - pixels(report / "iso.png")).max(axis=2)
+    assert (diff > 30).mean() > 0.01
+
+
+def test_check_github_writes_a_job_summary(turret, tmp_path):
+    robot_dir, _ = turret
+    summary = tmp_path / "summary.md"
+    summary.write_text("earlier step\n")
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "GITHUB_STEP_SUMMARY": str(summary)}
+    done = subprocess.run([sys.executable, "-m", "robotkit", "check", str(robot_dir), "--format", "github"],
+                          capture_output=True, text=True, env=env, cwd=robot_dir.parent)
+    assert done.returncode == 0, done.stderr
+    text = summary.read_text()
+    assert text.startswith("earlier step\n## robotkit check ")
+    assert "Picture report: `turret_bot/report/report.html` (upload the folder `turret_bot/report` as an " \
+           "artifact to see it)" in text

@@ -1,0 +1,147 @@
+"""`robotkit view` driven from headless Chromium: the page connects, a joint slider moves the
+robot, editing the recipe (a colour, a joint origin) rebuilds it in place, and a broken recipe
+shows its error in the page while the last good robot stays."""
+
+from __future__ import annotations
+
+import shutil
+import socket
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from conftest import RECIPES
+from test_picture import chromium
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def viewer(tmp_path):
+    recipe = tmp_path / "turret_bot.yaml"
+    shutil.copyfile(RECIPES / "turret_bot.yaml", recipe)
+    shutil.copytree(RECIPES / "meshes" / "turret_bot", tmp_path / "meshes" / "turret_bot")
+    port = free_port()
+    log = open(tmp_path / "view.log", "w+")
+    proc = subprocess.Popen([sys.executable, "-m", "robotkit", "view", str(recipe), "--port", str(port),
+                             "--no-browser", "--out", str(tmp_path / "build")],
+                            stdout=log, stderr=subprocess.STDOUT, text=True)
+    url = f"http://127.0.0.1:{port}"
+    deadline = time.monotonic() + 60
+    while f"at {url}" not in (tmp_path / "view.log").read_text():
+        assert proc.poll() is None and time.monotonic() < deadline, (tmp_path / "view.log").read_text()
+        time.sleep(0.1)
+    try:
+        yield url, recipe, tmp_path / "view.log"
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
+        log.close()
+
+
+def shot(page, path) -> np.ndarray:
+    page.wait_for_timeout(700)  # let the scene update reach the canvas
+    page.locator("canvas").first.screenshot(path=str(path))
+    return np.asarray(Image.open(path).convert("RGB"), dtype=np.int16)
+
+
+def changed(a, b) -> float:
+    return (np.abs(a - b).max(axis=2) > 30).mean()
+
+
+def shot_after_change(page, before, path, least: float = 0.002, timeout: float = 20.0) -> np.ndarray:
+    """The canvas once it differs from ``before`` by ``least`` (the update may take a moment)."""
+    deadline = time.monotonic() + timeout
+    while True:
+        now = shot(page, path)
+        if changed(before, now) > least or time.monotonic() > deadline:
+            return now
+
+
+def wait_for_status(page, text: str, timeout: float = 60_000):
+    page.get_by_text(text).first.wait_for(timeout=timeout)
+
+
+def test_viewer_in_chromium(viewer, tmp_path):
+    from playwright.sync_api import sync_playwright
+
+    url, recipe, log = viewer
+    with sync_playwright() as p:
+        browser = chromium(p)
+        page = browser.new_page(viewport={"width": 1000, "height": 700})
+        errors = []
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.goto(url)
+        page.get_by_text("Connected").wait_for(timeout=30_000)
+        wait_for_status(page, "turret_bot: 2 joints")
+        first = shot(page, tmp_path / "0.png")
+        assert first.reshape(-1, 3).std(axis=0).max() > 10, "blank canvas"
+
+        # a joint slider (its number box) moves the slider link
+        number = page.locator("xpath=//label[normalize-space()='j1']/following::input[@type='text'][1]")
+        number.fill("0.9")
+        number.press("Enter")
+        moved = shot_after_change(page, first, tmp_path / "1.png")
+        assert changed(first, moved) > 0.002
+
+        # a toggle: the inertia boxes drawn over the robot, and gone again
+        page.get_by_text("Inertia boxes", exact=True).click()
+        boxes = shot_after_change(page, moved, tmp_path / "boxes.png")
+        assert changed(moved, boxes) > 0.002
+        page.get_by_text("Inertia boxes", exact=True).click()
+        deadline = time.monotonic() + 20  # back to the picture before (but the checkbox's own look)
+        while changed(moved, shot(page, tmp_path / "no-boxes.png")) >= changed(moved, boxes) / 4:
+            assert time.monotonic() < deadline, "the inertia boxes stayed"
+
+        # the recipe's colour, then a joint origin: rebuilt and redrawn in place
+        text = recipe.read_text()
+        recipe.write_text(text.replace("red:   {rgba: [0.8, 0, 0, 1]", "red:   {rgba: [0.1, 0.8, 0.9, 1]"))
+        wait_for_status(page, "turret_bot: 2 joints; shown in", timeout=60_000)
+        deadline = time.monotonic() + 60
+        while log.read_text().count("turret_bot updated") < 2:
+            assert time.monotonic() < deadline, log.read_text()
+            time.sleep(0.2)
+        recoloured = shot_after_change(page, moved, tmp_path / "2.png")
+        assert changed(moved, recoloured) > 0.002
+        text = recipe.read_text()
+        recipe.write_text(text.replace("origin: {xyz: [0, 0.05, 0.475]}", "origin: {xyz: [0, 0.05, 1.2]}"))
+        while log.read_text().count("turret_bot updated") < 3:
+            assert time.monotonic() < deadline, log.read_text()
+            time.sleep(0.2)
+        raised = shot_after_change(page, recoloured, tmp_path / "3.png")
+        assert changed(recoloured, raised) > 0.002
+
+        # a broken recipe: the error in the page, the viewer alive
+        good = recipe.read_text()
+        recipe.write_text(good.replace("density: 1250", "density: -5"))
+        page.get_by_text("Build failed").wait_for(timeout=60_000)
+        assert page.get_by_text("density: must be > 0").count() >= 1
+        # ... and fixed again: the robot is back
+        recipe.write_text(good)
+        page.get_by_text("Build failed").wait_for(state="detached", timeout=60_000)
+        deadline = time.monotonic() + 30
+        while log.read_text().count("turret_bot updated") < 4:
+            assert time.monotonic() < deadline, log.read_text()
+            time.sleep(0.2)
+        browser.close()
+    assert errors == []
+
+
+def test_view_bad_input(tmp_path):
+    from conftest import run_cli
+
+    (tmp_path / "robot.sdf").write_text("<sdf/>")
+    done = run_cli("view", tmp_path / "robot.sdf", "--no-browser")
+    assert (done.returncode, done.stdout) == (2, "")
+    assert done.stderr == (f"{tmp_path / 'robot.sdf'}: unknown kind of file (expected a recipe .yaml, a build "
+                           "folder or a .urdf)\n")
+    done = run_cli("view", tmp_path / "missing.yaml", "--no-browser")
+    assert (done.returncode, done.stderr) == (2, f"{tmp_path / 'missing.yaml'}: no such file or folder\n")
