@@ -132,7 +132,7 @@ def to_doit(task: dict) -> dict:
 
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
-          echo=None, progress=None) -> BuildResult:
+          echo=None, progress=None, args: dict[str, str] | None = None) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem."""
     from doit.cmd_base import TaskLoader2
     from doit.doit_cmd import DoitMain
@@ -141,7 +141,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     from robotkit.tasks import load_robots, mesh_locations, robot_tasks
 
     out = Path(out_dir).absolute()
-    robots = load_robots(recipes)  # raises before anything is written
+    robots = load_robots(recipes, args)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
     tasks = []
     for loaded, robot in robots:

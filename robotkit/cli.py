@@ -31,6 +31,7 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
     b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="run N tasks in parallel processes")
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
+    _add_arg_option(b)
 
     w = sub.add_parser("world", help="turn a ROS map_server occupancy map into a Gazebo world and MuJoCo scene",
                        description="Write OUT/<name>/ with model.config, model.sdf, meshes/<name>.stl, "
@@ -52,6 +53,14 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--fail-on", choices=["error", "warning"], default="error",
                    help="lowest severity that makes the exit status 1 (default: error)")
     c.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    _add_arg_option(c)
+
+    e = sub.add_parser("expand", help="print the flat recipe that a recipe's arguments, expressions, units, "
+                                      "parts, conditions and variants expand to",
+                       description="Print RECIPE expanded (one YAML document per variant).")
+    e.add_argument("recipe", metavar="RECIPE", help="recipe YAML file")
+    e.add_argument("--variant", metavar="NAME", help="print only this variant")
+    _add_arg_option(e)
 
     from robotkit.importer.cli import add_parser as add_import
 
@@ -59,7 +68,20 @@ def _parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
     s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
+    s.add_argument("--part", action="store_true", help="print the JSON Schema of a part file instead")
     return p
+
+
+def _recipe_arg(text: str) -> tuple[str, str]:
+    name, sep, value = text.partition(":=")
+    if not sep or not name:
+        raise argparse.ArgumentTypeError(f"'{text}' is not NAME:=VALUE")
+    return name, value
+
+
+def _add_arg_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--arg", action="append", type=_recipe_arg, default=[], metavar="NAME:=VALUE",
+                   help="set a recipe argument (repeatable; see the recipe's args:)")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -76,7 +98,7 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         return {"build": _build, "world": _world, "schema": _schema, "check": _check,
-                "import": _import}[args.command](args)
+                "import": _import, "expand": _expand}[args.command](args)
     except RobotkitError as exc:
         for line in exc.lines():
             print(line, file=sys.stderr)
@@ -94,7 +116,7 @@ def _build(args) -> int:
         return 2
     start = time.perf_counter()
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
-    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr)
+    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, args=dict(args.arg))
     if result.ran or args.verbose:
         for w in result.warnings:
             print(f"warning: {w}", file=sys.stderr)
@@ -159,7 +181,7 @@ def _check(args) -> int:
             print(f"robotkit: error: --package-path takes PKG=DIR (got '{item}')", file=sys.stderr)
             return 2
         packages[pkg] = folder
-    findings = check(args.path, args.out, packages)
+    findings = check(args.path, args.out, packages, args=dict(args.arg))
     sys.stdout.write(render(findings, args.format, args.path))
     levels = ("error",) if args.fail_on == "error" else ("error", "warning")
     return 1 if any(f.severity in levels for f in findings) else 0
@@ -171,10 +193,17 @@ def _import(args) -> int:
     return run(args)
 
 
+def _expand(args) -> int:
+    from robotkit.recipe.flat import flat_yaml
+
+    sys.stdout.write(flat_yaml(args.recipe, dict(args.arg), args.variant))
+    return 0
+
+
 def _schema(args) -> int:
     from robotkit.recipe.reference import json_schema, markdown
 
-    print(markdown() if args.markdown else json_schema(), end="")
+    print(markdown() if args.markdown else json_schema(part=args.part), end="")
     return 0
 
 

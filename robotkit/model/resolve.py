@@ -35,6 +35,21 @@ def _t(v) -> tuple[float, ...]:
     return tuple(float(x) for x in v)
 
 
+def resolve_checked(loaded: LoadedRecipe) -> Robot:
+    """The resolved robot; RecipeError with the loading problems and resolution's own, all together."""
+    from robotkit.recipe.load import sort_problems
+
+    if not loaded.problems:
+        return resolve(loaded)
+    problems = list(loaded.problems)
+    if loaded.recipe is not None:
+        try:
+            resolve(loaded)
+        except RecipeError as exc:
+            problems.extend(p for p in exc.problems if p not in problems)
+    raise RecipeError(sort_problems(problems, loaded.file))
+
+
 def resolve(loaded: LoadedRecipe) -> Robot:
     r = loaded.recipe
     marks = loaded.marks
