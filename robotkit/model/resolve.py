@@ -104,10 +104,16 @@ def resolve(loaded: LoadedRecipe) -> Robot:
                 scale = (f, f, f)
             dec = (g.decimate or r.meshes.decimate) if role == "visual" else g.decimate
             dec = (("faces", dec.faces) if dec.faces is not None else ("ratio", dec.ratio)) if dec else None
+            # a mirroring scale (a mirrored part): consumers render negative scales inside out, so
+            # the outputs get a mirrored copy in metres with its faces flipped (robotkit.actions)
+            mirrored = scale[0] * scale[1] * scale[2] < 0
+            if mirrored and dec is None:
+                dec = ("none", 0)
             key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((g.mesh, scale, policy, dec)))}"
-            file_name = sources[g.mesh] if dec is None else os.path.splitext(sources[g.mesh])[0] + ".stl"
+            file_name = sources[g.mesh] if dec is None else (
+                os.path.splitext(sources[g.mesh])[0] + ("_mirrored" if mirrored else "") + ".stl")
             shape = Shape("mesh", mesh=MeshRef(g.mesh, scale, file_name, key, policy, decimate=dec,
-                                               repair=dec is not None and r.meshes.repair))
+                                               repair=dec is not None and dec[0] != "none" and r.meshes.repair))
         return Geom(shape, origin, (0.0, 0.0, 0.0), g.material, g.recenter)
 
     links: list[Link] = []

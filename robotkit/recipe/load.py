@@ -153,10 +153,19 @@ def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = ()):
         if sub is None:
             continue
         for key in sub:
-            if key not in MERGED_SECTIONS + ("include",):
+            if key not in MERGED_SECTIONS + ("include", "urdf_extras"):
                 f, line = sub_marks[(key,)]
                 problems.append(Problem(
-                    f"an included file may only hold {', '.join(MERGED_SECTIONS)}", file=f, line=line, key=key))
+                    f"an included file may only hold {', '.join(MERGED_SECTIONS)}, urdf_extras", file=f, line=line,
+                    key=key))
+        extras = sub.get("urdf_extras")
+        if isinstance(extras, list) and isinstance(data.setdefault("urdf_extras", []), list):
+            offset = len(data["urdf_extras"])  # appended after the including file's own
+            data["urdf_extras"] = data["urdf_extras"] + extras
+            for p, m in sub_marks.items():
+                if p[:1] == ("urdf_extras",) and len(p) > 1 and isinstance(p[1], int):
+                    marks[("urdf_extras", p[1] + offset) + p[2:]] = m
+            marks.setdefault(("urdf_extras",), sub_marks[("urdf_extras",)])
         for section in MERGED_SECTIONS:
             items = sub.get(section)
             if not isinstance(items, dict):

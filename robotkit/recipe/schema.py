@@ -594,7 +594,7 @@ class Recipe(Strict):
     robot: str
     """Robot name: the ROS package, Gazebo model and output folder name."""
     include: list[str] = []
-    """Other YAML files (relative to this one) whose materials, links and joints are merged into this recipe."""
+    """Other YAML files (relative to this one) whose materials, links and joints are merged into this recipe (and whose urdf_extras are appended)."""
     units: Units = "m"
     """Default units of mesh files (m, cm, mm, in)."""
     density: Positive = 1000.0

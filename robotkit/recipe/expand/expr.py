@@ -87,6 +87,8 @@ class _Eval:
         value = method(node)
         if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > MAX_INT_BITS:
             raise ExprError("number too large")
+        if isinstance(value, float) and math.isinf(value):
+            raise ExprError("number too large")
         if isinstance(value, float) and math.isnan(value):
             raise ExprError("result is not a number (nan)")
         if isinstance(value, str) and len(value) > MAX_STRING:
@@ -182,7 +184,9 @@ class _Eval:
             return FUNCTIONS[node.func.id](*args)
         except ExprError as exc:
             raise ExprError(f"{node.func.id}() {exc}") from None
-        except (ValueError, OverflowError, TypeError) as exc:
+        except OverflowError:
+            raise ExprError(f"{node.func.id}(): number too large") from None
+        except (ValueError, TypeError) as exc:
             raise ExprError(f"{node.func.id}(): {exc}") from None
 
 
