@@ -485,6 +485,17 @@ def test_conditions_and_variants_build_one_folder_each(tmp_path):
     assert proc.stderr == f"{recipe}: --variant: no variant named 'big' (variants: small, handy)\n"
 
 
+def test_a_plain_if_false_drops_the_entry(tmp_path):
+    write_recipe(tmp_path, """
+        robot: r
+        links: {base: {}, spare: {if: false}}
+        joints: {j: {if: false, type: fixed, parent: base, child: spare}}
+        """)
+    proc = run_cli("expand", "robot.yaml", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == "robot: r\nlinks:\n  base: {}\n"
+
+
 def test_changing_an_argument_reruns_only_what_reads_it(tmp_path):
     box = trimesh.creation.box([0.1, 0.1, 0.1])
     recipe = write_recipe(tmp_path, """

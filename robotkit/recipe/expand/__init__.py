@@ -298,7 +298,7 @@ def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_y
 
     ctx = Context(read_yaml, problems)
     top = Source(where)
-    if not any(k in data for k in CONTROL) and not _has_dollar(data) and not overrides:
+    if not any(k in data for k in CONTROL) and not _has_dollar(data) and not overrides and not _has_if(data):
         return [Expanded(None, data)]
     declared = declare_args(data.get("args"), {}, ctx, top.sub("args"))
     arg_line = top.locate(("args",)) if "args" in data else (file, None)
@@ -346,6 +346,11 @@ def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_y
             flat["robot"] = f"{flat['robot']}_{variant}"
         out.append(result)
     return out
+
+
+def _has_if(data: dict) -> bool:
+    return any(isinstance(items, dict) and any(isinstance(v, dict) and "if" in v for v in items.values())
+               for items in (data.get(s) for s in ITEM_SECTIONS))
 
 
 def _has_dollar(node) -> bool:
