@@ -608,7 +608,7 @@ class Recipe(Strict):
     self_collide: bool = False
     """Whether the robot's links collide with each other (Gazebo's ``self_collide``; MJCF contact filtering). Links joined by a joint never collide."""
     urdf_extras: list[str] = []
-    """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML."""
+    """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
     metadata: Metadata = Metadata()
     materials: dict[str, Material] = {}
     defaults: Defaults = Defaults()

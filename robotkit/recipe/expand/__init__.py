@@ -27,6 +27,7 @@ from robotkit.recipe.expand import units as _units
 
 CONTROL = ("args", "values", "parts", "instances", "variants")
 ITEM_SECTIONS = ("links", "joints", "sensors", "actuators")
+VERBATIM = ("urdf_extras",)  # raw XML, copied as written (it may hold ${...} of its own)
 IDENT_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 WHOLE_RE = re.compile(r"^\$\{([^{}]*)\}$")
 PART_RE = re.compile(r"\$\$\{|\$\{([^{}]*)\}")
@@ -298,7 +299,8 @@ def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_y
 
     ctx = Context(read_yaml, problems)
     top = Source(where)
-    if not any(k in data for k in CONTROL) and not _has_dollar(data) and not overrides and not _has_if(data):
+    if not any(k in data for k in CONTROL) and not overrides and not _has_if(data) and not _has_dollar(
+            {k: v for k, v in data.items() if k not in VERBATIM}):
         return [Expanded(None, data)]
     declared = declare_args(data.get("args"), {}, ctx, top.sub("args"))
     arg_line = top.locate(("args",)) if "args" in data else (file, None)
@@ -321,7 +323,8 @@ def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_y
         for key, value in data.items():
             if key in CONTROL:
                 continue
-            flat[key] = evaluate_tree(value, scope, ctx, top.sub(key)) if key not in ITEM_SECTIONS else value
+            flat[key] = evaluate_tree(value, scope, ctx, top.sub(key)) if key not in ITEM_SECTIONS + VERBATIM \
+                else value
         result = Expanded(variant, flat, arg_names=tuple(declared))
         for section in ITEM_SECTIONS:
             items = data.get(section)
