@@ -9,6 +9,7 @@ build turns those into exit status 2.
 from __future__ import annotations
 
 import functools
+import os
 import json
 import shutil
 
@@ -26,7 +27,9 @@ def _user_errors_fail(fn):
         try:
             fn(*args, **kwargs)
         except RobotkitError as exc:
-            return TaskFailed("\n".join(exc.lines()))
+            failed = TaskFailed("\n".join(exc.lines()))
+            failed.exit_status = exc.exit_status  # survives pickling to -j workers
+            return failed
         return None
 
     return run
@@ -112,23 +115,37 @@ def _finalized(robot, fact_paths: dict[str, str], inertial_paths: dict[str, str]
 
 @_user_errors_fail
 def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[str, str], target: str,
-         options: dict):
-    """Render one output file of a finalized robot through a registered emitter."""
-    from robotkit.emit import EMITTERS
+         options: dict, where: dict | None = None):
+    """Render one output file of a finalized robot through a registered emitter.
+
+    The robot descriptions (URDF, SDF, MJCF) are not written for a robot that their consumers
+    would refuse (a moving link without mass...): ConsumerError, naming the link (``where``:
+    link -> recipe location)."""
+    from robotkit.emit import CONSUMED, EMITTERS
 
     full = robot if options.get("raw") else _finalized(robot, fact_paths, inertial_paths)
+    if emitter in CONSUMED:
+        from robotkit.errors import ConsumerError
+
+        problems = [Problem(msg, **(where or {}).get(link, {})) for link, msg in full.consumer_problems()]
+        if problems:
+            raise ConsumerError(problems)
     if options.get("facts"):
         options = dict(options, facts=read_facts(fact_paths))
+    if options.get("meshes"):  # the emitter measures the mesh files written beside it
+        options = dict(options, meshes=os.path.join(os.path.dirname(os.path.dirname(target)), "meshes"))
     write_if_changed(target, EMITTERS[emitter](full, **options))
 
 
 @_user_errors_fail
-def convert_mesh(source: str, target: str):
-    """A mesh in a format MuJoCo reads (binary STL, same units as the source, byte-reproducible)."""
+def convert_mesh(source: str, target: str, scale=(1.0, 1.0, 1.0)):
+    """A mesh in a format its consumers read (OBJ for collision, binary STL for MuJoCo's
+    visuals), coordinates times ``scale``, byte-reproducible."""
+    from robotkit.mesh.export import obj_bytes, stl_bytes
     from robotkit.mesh.io import load_mesh
 
-    mesh = load_mesh(source)
-    write_if_changed(target, mesh.export(file_type="stl"))
+    mesh = load_mesh(source, scale)
+    write_if_changed(target, obj_bytes(mesh) if target.lower().endswith(".obj") else stl_bytes(mesh))
 
 
 @_user_errors_fail
@@ -168,7 +185,6 @@ def _cache():
 def process_visual(source: str, scale, decimate, repair: bool, where: dict, target: str, report: str):
     """A processed visual mesh: repaired and decimated, written as a binary STL in metres."""
     from robotkit.mesh.decimate import decimate as run_decimate
-    from robotkit.mesh.export import stl_bytes
     from robotkit.mesh.io import load_mesh
     from robotkit.mesh.repair import repair as run_repair
 
@@ -195,6 +211,8 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
     out, rep = _cache().get_or_compute("decimate/1", {"faces": target_faces, "aggression": 7, "samples": 4000,
                                                       "seed": 0, "report": True}, [mesh], compute)
     info["decimate"] = rep
+    from robotkit.mesh.export import stl_bytes
+
     write_if_changed(target, stl_bytes(out))
     write_if_changed(report, dump_json(_plain(info)))
 
@@ -210,7 +228,7 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
     """Collision pieces for one mesh and strategy (cached), their files, and a fidelity report."""
     import os
 
-    from robotkit.mesh.export import stl_bytes
+    from robotkit.mesh.export import obj_bytes
     from robotkit.mesh.io import load_mesh
     from robotkit.mesh.repair import repair as run_repair
 
@@ -228,8 +246,9 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
     out_pieces = []
     for i, piece in enumerate(pieces):
         if hasattr(piece, "vertices"):
-            name = f"{stem}_{kind}_{i}.stl" if len(pieces) > 1 or kind != "mesh" else f"{stem}.stl"
-            write_if_changed(os.path.join(meshes_dir, name), stl_bytes(piece))
+            # OBJ: Drake takes convex collision meshes only as OBJ, VTK or glTF
+            name = f"{stem}_{kind}_{i}.obj" if len(pieces) > 1 or kind != "mesh" else f"{stem}_mesh.obj"
+            write_if_changed(os.path.join(meshes_dir, name), obj_bytes(piece))
             out_pieces.append({"kind": "mesh", "file": f"collision/{name}", "vertices": int(len(piece.vertices))})
         else:
             d = piece.to_dict()

@@ -28,6 +28,7 @@ class BuildResult:
     errors: list[tuple[str, str]] = field(default_factory=list)  # (task, traceback) bugs
     warnings: list[str] = field(default_factory=list)
     robots: list[str] = field(default_factory=list)
+    exit_status: int = 0  # of the failed tasks: 2 bad input, 1 a robot a consumer refuses
 
 
 SLOW = 1.0  # seconds: tasks at least this long are reported with their time
@@ -69,6 +70,7 @@ class _Recorder:
             return
         if isinstance(fail, TaskFailed):
             self.result.failed.append((task.name, fail.message))
+            self.result.exit_status = max(self.result.exit_status, getattr(fail, "exit_status", 2))
         else:
             self.result.errors.append((task.name, fail.get_msg()))
 
@@ -171,7 +173,9 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
             for line in msg.splitlines():
                 if line not in lines:
                     lines.append(line)
-        raise RobotkitError([Problem(line) for line in lines])
+        error = RobotkitError([Problem(line) for line in lines])
+        error.exit_status = result.exit_status or 2
+        raise error
     if rc not in (0,) and not result.errors:
         result.errors.append(("doit", f"doit exited with status {rc}"))
     result.warnings = collect_warnings(tasks) + collect_losses(out, result.robots)

@@ -102,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     except RobotkitError as exc:
         for line in exc.lines():
             print(line, file=sys.stderr)
-        return 2
+        return exc.exit_status
     except KeyboardInterrupt:
         print("robotkit: interrupted", file=sys.stderr)
         return 130
@@ -172,7 +172,7 @@ def _world(args) -> int:
 
 
 def _check(args) -> int:
-    from robotkit.checks import check, render
+    from robotkit.check import check, render
 
     packages = {}
     for item in args.package_path:

@@ -47,7 +47,12 @@ class Problem:
 
 
 class RobotkitError(Exception):
-    """A problem with the user's input; carries every problem found, in order."""
+    """A problem with the user's input; carries every problem found, in order.
+
+    ``exit_status`` is what the CLI exits with: 2 for bad input, 1 for a robot that a
+    consumer would refuse (:class:`ConsumerError`)."""
+
+    exit_status = 2
 
     def __init__(self, problems: Problem | str | list[Problem]):
         if isinstance(problems, (Problem, str)):
@@ -57,6 +62,13 @@ class RobotkitError(Exception):
 
     def lines(self) -> list[str]:
         return [str(p) for p in self.problems]
+
+
+class ConsumerError(RobotkitError):
+    """The recipe is valid but asks for a robot that a program loading the outputs refuses
+    (MuJoCo, Gazebo): the build stops, naming the link and the fix; exit status 1."""
+
+    exit_status = 1
 
 
 class RecipeError(RobotkitError):

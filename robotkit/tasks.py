@@ -60,8 +60,9 @@ def _template_files(emitter: str) -> list[str]:
 def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None) -> list[dict]:
     """The task dicts that build ``robot`` into ``out_dir/<robot>/``.
 
-    ``where`` maps a mesh key to the recipe location naming it (for messages).
+    ``where`` maps a mesh key, and ``link:<name>``, to the recipe location naming it (for messages).
     """
+    where = where or {}
     out_dir = Path(out_dir).absolute()
     root = out_dir / robot.name
     state = out_dir / STATE / robot.name
@@ -84,6 +85,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
+    mesh_outputs: list[str] = []  # mesh files written below meshes/ (the MJCF measures them)
     copies: dict[str, tuple[str, list[str]]] = {}
     processed: dict[str, object] = {}
     shown = {g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link) if g.shape.kind == "mesh"}
@@ -96,6 +98,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         copies.setdefault(mesh.file_name, (mesh.source, []))[1].append(facts[key])
     for rel, mesh in sorted(processed.items()):
         target = str(root / "meshes" / rel)
+        mesh_outputs.append(target)
         report = str(state / "visual" / f"{mesh.key}.json")
         tasks.append({
             "name": f"{robot.name}:visual:{mesh.file_name}",
@@ -129,6 +132,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         })
     for file_name, (source, checked) in sorted(copies.items()):
         target = str(root / "meshes" / "visual" / file_name)
+        mesh_outputs.append(target)
         tasks.append({
             "name": f"{robot.name}:copy:{file_name}",
             "doc": f"visual mesh {file_name}",
@@ -139,19 +143,20 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "clean": True,
         })
 
-    from robotkit.emit.mjcf import converted_meshes
+    from robotkit.emit.meshfiles import conversions
 
-    for rel, source in sorted(converted_meshes(robot).items()):
+    for rel, (source, scale) in conversions(robot).items():
         target = str(root / "meshes" / rel)
+        mesh_outputs.append(target)
         checked = [facts[k] for k, m in robot.meshes().items() if m.source == source]
         tasks.append({
             "name": f"{robot.name}:convert:{rel}",
-            "doc": f"meshes/{rel} for MuJoCo",
-            "actions": [(actions.convert_mesh, [source, target])],
+            "actions": [(actions.convert_mesh, [source, target, list(scale)])],
             "file_dep": [source, *checked],
             "targets": [target],
-            "uptodate": [config_changed({"version": actions.FACTS_VERSION})],
+            "uptodate": [config_changed({"version": actions.FACTS_VERSION, "scale": list(scale)})],
             "clean": True,
+            "doc": f"meshes/{rel}",
         })
 
     inertials: dict[str, str] = {}
@@ -177,7 +182,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                          if g.shape.mesh is not None and g.recenter != "none"})
     out_facts = {**{k: facts[k] for k in recentered}, **proxies}
     structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
-    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True}}
+    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True},
+               "mjcf": {"meshes": True}}
     for emitter, rel in OUTPUTS.items():
         if emitter == "controllers" and not robot.actuators:
             continue
@@ -198,8 +204,10 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         tasks.append({
             "name": f"{robot.name}:{emitter}",
             "doc": f"{rel(robot)}",
-            "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts])],
-            "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter),
+            "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts,
+                                        {k[5:]: v for k, v in where.items() if k.startswith("link:")}])],
+            "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter)
+            + (mesh_outputs if opts.get("meshes") else []),
             "targets": [target],
             "uptodate": [config_changed({"robot": reads, "options": opts})],
             # no output is written while any mesh of the robot fails
@@ -262,7 +270,8 @@ def _world_templates() -> list[str]:
 
 
 def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
-    """Recipe location (file, line, key) of the first geometry naming each mesh key."""
+    """Recipe location (file, line, key) of the first geometry naming each mesh key, and of
+    each link (``link:<name>``)."""
     marks = loaded.marks
     where_source: dict[tuple[str, str], dict] = {}  # (link, source file) -> location
     for name, link in loaded.recipe.links.items():
@@ -281,6 +290,9 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
                     where_source[(name, g.mesh)] = {"file": p.file, "line": p.line, "key": p.key}
     out: dict[str, dict] = {}
     for link in robot.links:
+        if link.name in loaded.recipe.links:
+            p = marks.problem(("links", link.name), "")
+            out[f"link:{link.name}"] = {"file": p.file, "line": p.line, "key": p.key}
         for geom in robot.all_geoms(link):
             m = geom.shape.mesh
             if m is not None and m.key not in out and (link.name, m.source) in where_source:

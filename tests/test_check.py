@@ -10,7 +10,7 @@ import pytest
 import trimesh
 
 from conftest import RECIPES, run_cli
-from robotkit.lint import lint, read_urdf_facts
+from robotkit.check.lints import lint, read_urdf_facts
 
 
 def box_inertia(m, x, y, z):
@@ -135,7 +135,7 @@ def test_joint_lints(tmp_path):
 
 
 def test_mimic_loop(tmp_path):
-    from robotkit.lint import JointFacts, lint_joints
+    from robotkit.check.lints import JointFacts, lint_joints
 
     joints = [JointFacts("a", "revolute", mimic="b"), JointFacts("b", "revolute", mimic="c"),
               JointFacts("c", "revolute", mimic="a"), JointFacts("d", "revolute", mimic="a")]

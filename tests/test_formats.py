@@ -15,7 +15,8 @@ import pytest
 
 from conftest import GOLDEN, assert_golden, RECIPES, run_cli, write_recipe
 from robotkit.build import build
-from robotkit.verify import equivalence, smoke_test
+from robotkit.check.equivalence import equivalence
+from robotkit.check.simulation import smoke_test
 from validators import check_urdf, ign_sdf_check, mujoco, require
 
 

@@ -1,7 +1,7 @@
 """Issue 8: `robotkit import` of URDF and xacro into a recipe.
 
 Round trips: import, build, and the rebuilt URDF read through MuJoCo's URDF compiler must be
-equivalent to the original (robotkit.verify.kinematics.compare: links, joints, masses,
+equivalent to the original (robotkit.check.kinematics.compare: links, joints, masses,
 centres of mass, inertia tensors, limits, damping, friction, mimic, link poses at 100 random
 configurations) at 1e-9.  Also: the xacro macro output, untrusted xacro expressions, and the
 exact error messages for missing packages and meshes.
@@ -25,7 +25,7 @@ from robotkit.build import build
 from robotkit.errors import RobotkitError
 from robotkit.importer import import_file
 from robotkit.importer.urdf_to_recipe import no_inertial_form
-from robotkit.verify.kinematics import KModel, compare, read_urdf
+from robotkit.check.kinematics import KModel, compare, read_urdf
 from tests.validators import check_urdf, mujoco
 
 ASSETS = Path(__file__).resolve().parents[1].parent / "shared" / "assets"

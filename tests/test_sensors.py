@@ -13,7 +13,7 @@ import yaml
 
 from conftest import RECIPES, write_recipe
 from robotkit.build import build
-from robotkit.verify import kinematics as k
+from robotkit.check import kinematics as k
 from validators import check_urdf, ign_sdf_check, mujoco
 
 

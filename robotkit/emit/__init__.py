@@ -37,10 +37,10 @@ def _sdf(robot, **_):
     return render_sdf(robot)
 
 
-def _mjcf(robot, **_):
+def _mjcf(robot, meshes=None, **_):
     from robotkit.emit.mjcf import render_mjcf
 
-    return render_mjcf(robot)
+    return render_mjcf(robot, meshes if isinstance(meshes, str) else None)
 
 
 def _mjcf_scene(robot, **_):
@@ -81,6 +81,9 @@ EMITTERS = {
     "controllers": _controllers,
     "xacro": _xacro,
 }
+
+# outputs that programs load as robots: not written when a consumer would refuse the robot
+CONSUMED = ("urdf", "sdf", "mjcf")
 
 # the templates each emitter renders (their edits must rebuild the output)
 TEMPLATES = {

@@ -30,29 +30,20 @@ def quat(rpy) -> tuple[float, float, float, float]:
     return q if q[0] >= 0 else tuple(-v for v in q)
 
 
-def mesh_file(mesh) -> str:
-    """The mesh file MJCF reads, relative to the robot's meshes/ folder (MuJoCo reads no DAE)."""
-    stem, ext = os.path.splitext(mesh.file_name)
-    if ext.lower() in MJCF_MESH_EXT:
-        return mesh.path
-    return f"mjcf/{stem}.stl"
+def mesh_file(mesh, role: str = "visual") -> str:
+    """The mesh file MJCF reads, relative to the robot's meshes/ folder."""
+    from robotkit.emit.meshfiles import collision_file, visual_file
 
-
-def converted_meshes(robot: Robot) -> dict[str, str]:
-    """Meshes that need converting for MJCF: output path below meshes/ -> source file."""
-    out = {}
-    for mesh in robot.meshes().values():
-        if mesh.processed:
-            continue
-        rel = mesh_file(mesh)
-        if rel.startswith("mjcf/"):
-            out.setdefault(rel, mesh.source)
-    return out
+    return collision_file(mesh) if role == "collision" else visual_file(mesh, "mjcf")
 
 
 def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     out = []
-    for rel, src in sorted(converted_meshes(robot).items()):
+    from robotkit.emit.meshfiles import conversions
+
+    for rel, (src, _) in conversions(robot).items():
+        if not rel.startswith("mjcf/"):
+            continue
         out.append(f"mesh '{os.path.basename(src)}': MuJoCo reads no {os.path.splitext(src)[1].upper()[1:]}; "
                    f"converted to meshes/{rel} (the file's own colours and textures are dropped, "
                    "the recipe's material is used)")
@@ -80,13 +71,13 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     return out + sensor_losses(robot)["mjcf"]
 
 
-def _geom(robot: Robot, geom: Geom, name: str, assets: dict) -> dict:
+def _geom(robot: Robot, geom: Geom, name: str, assets: dict, role: str = "visual") -> dict:
     s = geom.shape
     pose = geom.pose
     ctx = {"name": name, "pos": pose.xyz, "quat": quat(pose.rpy), "type": s.kind,
            "material": geom.material}
     if s.kind == "mesh":
-        key = (mesh_file(s.mesh), s.mesh.out_scale)
+        key = (mesh_file(s.mesh, role), s.mesh.out_scale)
         ctx["mesh"] = assets[key]["name"]
     elif s.kind == "box":
         ctx["size"] = tuple(v / 2 for v in s.size)
@@ -100,15 +91,16 @@ def _geom(robot: Robot, geom: Geom, name: str, assets: dict) -> dict:
 def _assets(robot: Robot) -> dict:
     assets: dict = {}
     used_names: set[str] = set()
-    for link in robot.links:
-        for g in link.visuals + link.collisions_for("mjcf"):
+    geoms = [(g, role) for link in robot.links
+             for role, gs in (("visual", link.visuals), ("collision", link.collisions_for("mjcf"))) for g in gs]
+    for g, role in geoms:
             m = g.shape.mesh
             if m is None:
                 continue
-            key = (mesh_file(m), m.out_scale)
+            key = (mesh_file(m, role), m.out_scale)
             if key in assets:
                 continue
-            base = os.path.splitext(m.file_name)[0]
+            base = os.path.splitext(os.path.basename(key[0]))[0]
             name, n = base, 1
             while name in used_names:
                 n += 1
@@ -127,7 +119,8 @@ def _plane_axes(normal) -> tuple[tuple, tuple]:
     return tuple(u), tuple(v)
 
 
-def context(robot: Robot) -> dict:
+def context(robot: Robot, lift: float = 0.0) -> dict:
+    """``lift``: height of the root body (a robot not rooted in ``world`` stands on the floor)."""
     assets = _assets(robot)
     by_parent: dict[str, list] = {}
     for j in robot.joints:
@@ -165,7 +158,6 @@ def context(robot: Robot) -> dict:
                 site["size"], site["pos"] = _touch_volume(link)
         c = link.contact
         friction = c.mu1 if c is not None else None
-        solref = (-c.kp, -(c.kd or 0.0)) if c is not None and c.kp is not None else None
         return {
             "name": name,
             "pos": joint.origin.xyz if joint is not None else (0.0, 0.0, 0.0),
@@ -173,23 +165,35 @@ def context(robot: Robot) -> dict:
             "joints": joints_of(joint) if joint is not None else [],
             "inertial": link.inertial,
             "visuals": [_geom(robot, g, f"{name}_visual_{i}", assets) for i, g in enumerate(link.visuals)],
-            "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets), friction=friction, solref=solref)
+            "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets, "collision"), friction=friction)
                            for i, g in enumerate(link.collisions_for("mjcf"))],
-            "children": [body(j.child, j) for j in by_parent.get(name, [])],
+            "children": [j.child for j in by_parent.get(name, [])],
             "cameras": extras["cameras"],
             "sites": extras["sites"],
         }
 
     root = robot.root
+    parent_joint = {j.child: j for j in robot.joints}
     if root == WORLD:
         world = body(root, None)
         world_geoms = world["visuals"] + world["collisions"]
-        bodies = world["children"]
+        tops = [body(name, parent_joint[name]) for name in world["children"]]
     else:
         world_geoms = []
-        bodies = [body(root, None)]
+        tops = [body(root, None)]
+        tops[0]["pos"] = (0.0, 0.0, lift) if lift else tops[0]["pos"]
         if robot.base == "free":
-            bodies[0]["joints"] = [{"name": f"{root}_free", "type": "free"}]
+            tops[0]["joints"] = [{"name": f"{root}_free", "type": "free"}]
+    tree = []  # opening and closing steps, depth first, without recursion (chains of 1000 links)
+    stack = [(b, 2) for b in reversed(tops)]
+    while stack:
+        b, depth = stack.pop()
+        if b is None:
+            tree.append({"body": None, "indent": "  " * depth})
+            continue
+        tree.append({"body": b, "indent": "  " * depth})
+        stack.append((None, depth))
+        stack.extend((body(c, parent_joint[c]), depth + 1) for c in reversed(b["children"]))
     equalities = [{"name": f"{j.name}_mimic", "joint1": j.name, "joint2": j.mimic.joint,
                    "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
                   for j in robot.joints if j.mimic is not None]
@@ -210,7 +214,7 @@ def context(robot: Robot) -> dict:
             act.update(kind="motor", ctrlrange=(-effort, effort))
         actuators.append(act)
     return {"robot": robot, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "assets": sorted(assets.values(), key=lambda a: a["name"]),
-            "materials": robot.materials, "world_geoms": world_geoms, "bodies": bodies,
+            "materials": robot.materials, "world_geoms": world_geoms, "tree": tree,
             "equalities": equalities}
 
 
@@ -235,8 +239,57 @@ def _touch_volume(link) -> tuple[tuple[float, ...], tuple[float, float, float]]:
     return tuple(float(v) for v in (hi - lo) / 2 * 1.05 + 0.002), tuple(float(v) for v in (hi + lo) / 2)
 
 
-def render_mjcf(robot: Robot) -> str:
-    return render("mjcf/robot.xml.j2", **context(robot))
+def zero_pose_frames(robot: Robot) -> dict[str, np.ndarray]:
+    """Every link frame in the root frame with all joints at zero (no recursion)."""
+    frames = {robot.root: np.eye(4)}
+    pending = list(robot.joints)
+    while pending:
+        rest = [j for j in pending if j.parent not in frames]
+        for j in pending:
+            if j.parent in frames:
+                frames[j.child] = frames[j.parent] @ j.origin.matrix()
+        if len(rest) == len(pending):
+            break
+        pending = rest
+    return frames
+
+
+def lowest_point(robot: Robot, meshes_dir: str | None) -> float | None:
+    """Lowest z of the robot's MJCF collision geometry at its zero pose, in the root frame
+    (mesh geoms: their vertices, as MuJoCo collides with their convex hulls); None without any."""
+    frames = zero_pose_frames(robot)
+    lows = []
+    for link in robot.links:
+        for g in link.collisions_for("mjcf"):
+            T = frames[link.name] @ g.pose.matrix()
+            R, c = T[:3, :3], T[:3, 3]
+            s = g.shape
+            if s.kind == "sphere":
+                lows.append(c[2] - s.radius)
+            elif s.kind in ("cylinder", "capsule"):
+                axis = R[:, 2] * s.length / 2
+                if s.kind == "capsule":
+                    lows.append(c[2] - abs(axis[2]) - s.radius)
+                else:
+                    lows.append(c[2] - abs(axis[2]) - s.radius * math.sqrt(max(0.0, 1 - R[2, 2] ** 2)))
+            elif s.kind == "box":
+                lows.append(c[2] - float(np.abs(R[2, :]) @ (np.asarray(s.size) / 2)))
+            elif s.kind == "mesh" and meshes_dir is not None:
+                from robotkit.mesh.io import read_vertices
+
+                v = read_vertices(os.path.join(meshes_dir, mesh_file(s.mesh, "collision"))) * np.asarray(s.mesh.out_scale)
+                lows.append(float((v @ R[2, :]).min() + c[2]))
+    return min(lows) if lows else None
+
+
+def render_mjcf(robot: Robot, meshes_dir: str | None = None) -> str:
+    """The robot's MJCF.  A robot not rooted in ``world`` stands on the floor at its zero pose:
+    its root body is raised (or lowered) so that its lowest collision point is at z = 0."""
+    lift = 0.0
+    if robot.root != WORLD:
+        low = lowest_point(robot, meshes_dir)
+        lift = -low if low is not None else 0.0
+    return render("mjcf/robot.xml.j2", **context(robot, lift=lift))
 
 
 def render_scene(robot: Robot) -> str:

@@ -2,7 +2,11 @@
 
 Frames mirror URDF exactly: a joint's pose is relative to its parent link, a child link's
 pose is the joint frame (``relative_to`` the joint), the axis is expressed in the joint
-frame.  Fixed joints stay joints.  What SDF 1.9 cannot express is listed by :func:`losses`.
+frame.  Fixed joints stay joints.  Massless links are ``<frame>``s, never links (an SDF link
+without an inertial weighs 1 kg in Gazebo and Drake): a massless link fixed to another is a
+frame attached to it and its geometry and sensors move into the link that carries it; a
+massless root with a fixed child is a frame on that child.  Joints named like a link are
+renamed (:func:`joint_names`).  What SDF 1.9 cannot express is listed by :func:`losses`.
 """
 
 from __future__ import annotations
@@ -20,13 +24,11 @@ def losses(robot: Robot) -> list[str]:
     from robotkit.emit.sensors import losses as sensor_losses
 
     out = []
-    frames = robot.frame_links()
-    children = {j.child for j in robot.joints}
-    for link in robot.links:
-        if (link.name not in frames and link.name != "world" and link.inertial is None
-                and (link.name in children or len(robot.links) > 1)):
-            out.append(f"link '{link.name}' has no inertial; Gazebo gives such a link a mass of 1 kg")
+    names = joint_names(robot)
     for j in robot.joints:
+        if names[j.name] != j.name:
+            out.append(f"joint '{j.name}' is named '{names[j.name]}' in model.sdf: SDF needs link, joint "
+                       "and frame names unique within a model")
         if j.type == "floating" and j.parent == "world":
             out.append(f"joint '{j.name}': SDF has no floating joint; link '{j.child}' is a free body "
                        "placed at the joint's pose")
@@ -44,45 +46,89 @@ def losses(robot: Robot) -> list[str]:
     return out + sensor_losses(robot)["sdf"]
 
 
+def joint_names(robot: Robot) -> dict[str, str]:
+    """SDF name of each joint: links, joints and frames share one namespace in an SDF model,
+    so a joint named like a link (ANYmal's ``LF_HAA``) gets ``_joint`` appended (then a number)."""
+    taken = {link.name for link in robot.links}
+    out = {}
+    for j in robot.joints:
+        name, n = j.name, 1
+        while name in taken:
+            name = f"{j.name}_joint" + (str(n) if n > 1 else "")
+            n += 1
+        taken.add(name)
+        out[j.name] = name
+    return out
+
+
+def _moved(geom, pose):
+    """``geom`` of a frame link, re-posed into the link that carries it."""
+    from dataclasses import replace
+
+    from robotkit.model.robot import Pose, matrix_rpy
+
+    T = pose.matrix() @ geom.pose.matrix()
+    return replace(geom, origin=Pose(tuple(float(v) for v in T[:3, 3]), matrix_rpy(T[:3, :3])),
+                   offset=(0.0, 0.0, 0.0))
+
+
 def context(robot: Robot) -> dict:
-    from robotkit.emit.sensors import contexts
+    from robotkit.emit.sensors import contexts, host_of
 
     materials = {m.name: m for m in robot.materials}
     parent_joint = {j.child: j for j in robot.joints}
     frames = robot.frame_links()
+    anchor = robot.anchor() if robot.root in frames else None
+    names = joint_names(robot)
     sensors = contexts(robot)
+    carried: dict[str, list] = {}  # link -> frame links whose geometry it carries, with their pose in it
+    for name in sorted(frames):
+        host, pose = host_of(robot, name)
+        carried.setdefault(host, []).append((robot.link(name), pose))
     links = []
     for link in robot.links:
         if link.name in frames or link.name == "world":
             continue
         j = parent_joint.get(link.name)
         ctx_pose = None  # (relative_to, pose)
-        if j is not None:
+        if link.name == anchor:  # the massless root is a frame on this link: the model frame
+            ctx_pose = ("__model__", j.origin)
+        elif j is not None:
             if j.type in JOINT_TYPES:
-                ctx_pose = (j.name, None)
+                ctx_pose = (names[j.name], None)
             else:  # no SDF joint: a free body placed at the joint's pose
                 ctx_pose = ("__model__" if j.parent == "world" else j.parent, j.origin)
+        visuals = list(link.visuals) + [_moved(g, pose) for f, pose in carried.get(link.name, []) for g in f.visuals]
+        collisions = list(link.collisions_for("sdf")) + [
+            _moved(g, pose) for f, pose in carried.get(link.name, []) for g in f.collisions_for("sdf")]
         links.append({
             "name": link.name,
             "pose": ctx_pose,
             "sensors": [s for s in sensors if s["host"] == link.name],
             "visuals": [dict(geom_context(robot, g), uri=_uri(robot, g),
-                             material=materials.get(g.material)) for g in link.visuals],
-            "collisions": [dict(geom_context(robot, g), uri=_uri(robot, g)) for g in link.collisions_for("sdf")],
+                             material=materials.get(g.material)) for g in visuals],
+            "collisions": [dict(geom_context(robot, g, "collision"), uri=_uri(robot, g, "collision"))
+                           for g in collisions],
             "inertial": link.inertial,
             "contact": link.contact,
         })
-    joints = [{"j": j, "type": JOINT_TYPES.get(j.type)} for j in robot.joints
-              if j.child not in frames and j.type in JOINT_TYPES]
-    frame_list = [j for j in robot.joints if j.child in frames]
+    joints = [{"j": j, "name": names[j.name], "type": JOINT_TYPES.get(j.type)} for j in robot.joints
+              if j.child not in frames and j.type in JOINT_TYPES and j.child != anchor]
+    frame_list = [{"name": j.child, "attached_to": j.parent, "origin": j.origin}
+                  for j in robot.joints if j.child in frames]
+    if anchor is not None:
+        frame_list.insert(0, {"name": robot.root, "attached_to": anchor, "origin": None})
     return {"robot": robot, "version": SDF_VERSION, "links": links, "joints": joints, "frames": frame_list,
             "specular": SPECULAR}
 
 
-def _uri(robot: Robot, geom) -> str | None:
+def _uri(robot: Robot, geom, role: str = "visual") -> str | None:
+    from robotkit.emit.meshfiles import collision_file
+
     if geom.shape.mesh is None:
         return None
-    return f"model://{robot.name}/meshes/{geom.shape.mesh.path}"
+    path = collision_file(geom.shape.mesh) if role == "collision" else geom.shape.mesh.path
+    return f"model://{robot.name}/meshes/{path}"
 
 
 def render_sdf(robot: Robot) -> str:

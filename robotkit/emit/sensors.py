@@ -21,13 +21,19 @@ CLASSIC_TYPES = {"camera": "camera", "depth": "depth", "lidar": "ray", "sonar": 
 
 
 def host_of(robot: Robot, link: str) -> tuple[str, Pose]:
-    """The nearest non-frame ancestor of ``link`` and the pose of ``link`` in it."""
+    """The link that carries ``link`` in SDF (itself, or for a massless frame link the nearest
+    ancestor with mass, or a massless root's anchor) and the pose of ``link`` in it."""
     frames = robot.frame_links()
     parent_joint = {j.child: j for j in robot.joints}
     T = np.eye(4)
     name = link
     while name in frames:
-        j = parent_joint[name]
+        j = parent_joint.get(name)
+        if j is None:  # a massless root: a frame on the link fixed below it
+            anchor = robot.anchor()
+            T = np.linalg.inv(parent_joint[anchor].origin.matrix()) @ T
+            name = anchor
+            break
         T = j.origin.matrix() @ T
         name = j.parent
     return name, Pose(tuple(float(v) for v in T[:3, 3]), matrix_rpy(T[:3, :3]))

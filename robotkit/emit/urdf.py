@@ -6,8 +6,27 @@ from robotkit.emit.env import render
 from robotkit.model.robot import Geom, Robot
 
 
-def mesh_uri(robot: Robot, geom: Geom) -> str:
-    return f"package://{robot.name}/meshes/{geom.shape.mesh.path}"
+MASSLESS = 1e-300
+"""The mass a URDF gives a massless link: every consumer reads it as massless (it vanishes in
+any sum with a real mass), PyBullet does not replace it by 1 kg as it does a missing
+``<inertial>``, and libsdformat can lump two of them (0 + 0 is a NaN centre of mass there)."""
+
+
+def massless_mass(robot: Robot, link) -> float | None:
+    """None for a link with mass; otherwise the mass its URDF ``<inertial>`` carries: 0 for a
+    root fixed to the world (PyBullet then keeps the base static), else :data:`MASSLESS`."""
+    if link.inertial is not None:
+        return None
+    if link.name == robot.root and (robot.base == "fixed" or link.name == "world"):
+        return 0.0
+    return MASSLESS
+
+
+def mesh_uri(robot: Robot, geom: Geom, role: str = "visual") -> str:
+    from robotkit.emit.meshfiles import collision_file
+
+    path = collision_file(geom.shape.mesh) if role == "collision" else geom.shape.mesh.path
+    return f"package://{robot.name}/meshes/{path}"
 
 
 def urdf_geoms(geoms) -> list[Geom]:
@@ -28,12 +47,12 @@ def urdf_geoms(geoms) -> list[Geom]:
     return out
 
 
-def geom_context(robot: Robot, geom: Geom) -> dict:
+def geom_context(robot: Robot, geom: Geom, role: str = "visual") -> dict:
     s = geom.shape
     pose = geom.pose
     ctx = {"xyz": pose.xyz, "rpy": pose.rpy, "kind": s.kind, "material": geom.material}
     if s.kind == "mesh":
-        ctx["uri"] = mesh_uri(robot, geom)
+        ctx["uri"] = mesh_uri(robot, geom, role)
         ctx["scale"] = s.mesh.out_scale if any(v != 1.0 for v in s.mesh.out_scale) else None
     elif s.kind == "box":
         ctx["size"] = s.size
@@ -56,8 +75,9 @@ def context(robot: Robot) -> dict:
         links.append({
             "name": link.name,
             "visuals": [geom_context(robot, g) for g in link.visuals],
-            "collisions": [geom_context(robot, g) for g in urdf_geoms(link.collisions_for("urdf"))],
+            "collisions": [geom_context(robot, g, "collision") for g in urdf_geoms(link.collisions_for("urdf"))],
             "inertial": link.inertial,
+            "massless": massless_mass(robot, link),
             "gazebo_material": gazebo_material,
             "contact": link.contact if link.collisions else None,
         })
@@ -65,6 +85,8 @@ def context(robot: Robot) -> dict:
 
     return {
         "robot": robot,
+        "massless_note": any(link["massless"] for link in links),
+        "massless_mass": MASSLESS,
         "sensors": contexts(robot),
         "actuators": actuator_contexts(robot),
         "materials": [materials[name] for name in used],

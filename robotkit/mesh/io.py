@@ -39,7 +39,10 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
         if problem:
             raise fail(f"mesh file '{name}' {problem}")
     try:
-        loaded = trimesh.load(path, force="mesh", process=False)  # process would drop NaN faces unseen
+        if ext == ".dae":
+            loaded = _dae_in_metres(path)
+        else:
+            loaded = trimesh.load(path, force="mesh", process=False)  # process would drop NaN faces unseen
     except Exception as exc:  # trimesh raises many kinds on corrupt input
         raise fail(f"cannot read mesh file '{name}': {type(exc).__name__}: {exc}".rstrip(": ")) from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
@@ -52,6 +55,24 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
     if np.prod(scale) < 0:  # a mirroring scale turns the winding inside out
         mesh.invert()
     return mesh
+
+
+def _dae_in_metres(path: str):
+    """A COLLADA file as one mesh in metres: its ``<unit meter="...">`` applied, as RViz and
+    Gazebo apply it (trimesh reads the unit but leaves the coordinates in file units)."""
+    import trimesh
+
+    scene = trimesh.load(path, force="scene", process=False)
+    units = getattr(scene, "units", None)
+    if units and units not in ("meters", "m", "meter"):
+        scene = scene.convert_units("meters", guess=False)
+    geometry = scene.to_geometry() if hasattr(scene, "to_geometry") else scene.dump(concatenate=True)
+    return geometry
+
+
+def read_vertices(path: str) -> np.ndarray:
+    """The vertices of a mesh file, in the file's coordinates (metres for COLLADA)."""
+    return np.asarray(load_mesh(path).vertices, dtype=np.float64)
 
 
 def _stl_problem(path: str) -> str | None:

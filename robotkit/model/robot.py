@@ -299,15 +299,61 @@ class Robot:
     base: str = "fixed"
 
     def frame_links(self) -> set[str]:
-        """Links that are only frames: no geometry, no inertial, fixed to a parent link.
-        SDF writes them as <frame> (an SDF link without an inertial would weigh 1 kg)."""
+        """Massless links fixed to another link: SDF writes them as ``<frame>`` (an SDF link
+        without an inertial would weigh 1 kg in Gazebo and Drake) and moves their geometry and
+        sensors into the link that carries them, as libsdformat lumps them in a URDF.
+
+        A massless root with a fixed child is a frame too, attached to that child
+        (:meth:`anchor`).  Call after ``finalize`` (inertials known)."""
         parent_joint = {j.child: j for j in self.joints}
         out = set()
         for link in self.links:
+            if link.inertial is not None or link.name == "world":
+                continue
             j = parent_joint.get(link.name)
-            if (j is not None and j.type == "fixed" and j.parent != "world" and not link.visuals
-                    and not link.collisions and link.inertial is None and link.inertial_spec.mode == "none"):
+            if j is None:
+                if self.anchor() is not None:
+                    out.add(link.name)
+            elif j.type == "fixed" and j.parent != "world":
                 out.add(link.name)
+        return out
+
+    def anchor(self) -> str | None:
+        """The link a massless root is attached to when the root is only a frame (its first
+        child by a fixed joint, e.g. ``base_link`` below ``base_footprint``); None otherwise."""
+        root = self.root
+        if root == "world" or self.link(root).inertial is not None:
+            return None
+        return next((j.child for j in self.joints if j.parent == root and j.type == "fixed"), None)
+
+    def body_mass(self, name: str) -> float:
+        """Mass of ``name`` and of everything welded to it by fixed joints below it: what a
+        simulator moves as one body."""
+        link = self.link(name)
+        total = link.inertial.mass if link.inertial is not None else 0.0
+        for j in self.joints:
+            if j.parent == name and j.type == "fixed":
+                total += self.body_mass(j.child)
+        return total
+
+    def consumer_problems(self) -> list[tuple[str, str]]:
+        """(link, message) for what a consumer refuses to load: a moving link without mass
+        (MuJoCo rejects the model; libsdformat drops the link and everything below it), and a
+        massless root whose children all move (libsdformat's URDF conversion gives an empty
+        model)."""
+        out = []
+        moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
+        for j in self.joints:
+            if j.type in moving and not self.body_mass(j.child) > 0:
+                out.append((j.child, f"link '{j.child}' moves (joint '{j.name}') but has no mass: MuJoCo refuses "
+                            "to load it and Gazebo drops it with everything below it; give it an inertial "
+                            f"(links.{j.child}.inertial: {{mass: ...}}, or geometry and a density)"))
+        root = self.root
+        if (root != "world" and self.link(root).inertial is None and self.anchor() is None
+                and any(j.parent == root for j in self.joints)):
+            out.append((root, f"link '{root}' is the root, has no mass and only moving joints below it: Gazebo's "
+                        "URDF conversion drops it and everything below it (an empty model); name the root "
+                        f"'world' to fix the robot to the world, or give links.{root} an inertial"))
         return out
 
     def link(self, name: str) -> Link:

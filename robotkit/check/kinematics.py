@@ -21,6 +21,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 WORLD = "world"
+NEGLIGIBLE = 1e-200  # kg: robotkit's URDF writes massless links as 1e-300 kg (see emit/urdf.py)
+
+
+def _mass(m: float) -> float:
+    return 0.0 if abs(m) < NEGLIGIBLE else m
 
 
 @dataclass
@@ -246,17 +251,21 @@ def read_sdf_text(text: str, source: str) -> KModel:
 
     links = {}
     for name, lk in link_els.items():
+        # SDF's defaults, as libsdformat, Gazebo and Drake apply them: a link without <inertial>
+        # weighs 1 kg with a unit inertia (never 0: a massless thing must be a <frame>)
         inertial = lk.find("inertial")
         if inertial is None:
-            links[name] = KLink(name)
+            links[name] = KLink(name, 1.0, np.zeros(3), np.eye(3))
             continue
         T, _ = _pose(inertial)
-        mass = float(inertial.findtext("mass", "0"))
+        mass = float(inertial.findtext("mass", "1"))
         i = inertial.find("inertia")
-        g = {k: float(i.findtext(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")} if i is not None else {}
-        I = np.array([[g.get("ixx", 0), g.get("ixy", 0), g.get("ixz", 0)],
-                      [g.get("ixy", 0), g.get("iyy", 0), g.get("iyz", 0)],
-                      [g.get("ixz", 0), g.get("iyz", 0), g.get("izz", 0)]])
+        defaults = {"ixx": "1", "iyy": "1", "izz": "1"}
+        g = {k: float(i.findtext(k, defaults.get(k, "0")) if i is not None else defaults.get(k, "0"))
+             for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+        I = np.array([[g["ixx"], g["ixy"], g["ixz"]],
+                      [g["ixy"], g["iyy"], g["iyz"]],
+                      [g["ixz"], g["iyz"], g["izz"]]])
         R = T[:3, :3]
         links[name] = KLink(name, mass, T[:3, 3].copy(), R @ I @ R.T)
     joints = {}
@@ -315,7 +324,47 @@ def read_urdf_via_libsdformat(path) -> KModel:
     proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
     if proc.returncode != 0 or "<sdf" not in proc.stdout:
         raise RuntimeError(f"ign sdf -p {path} failed: {proc.stderr.strip() or proc.stdout.strip()}")
-    return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)")
+    # libsdformat prints namespaced elements (<ignition::corrected_offsets>) without their namespace
+    text = re.sub(r"<(/?)(\w+)::", r"<\1\2__", proc.stdout)
+    return read_sdf_text(text, f"URDF {path} (libsdformat)")
+
+
+def lump(model: KModel) -> KModel:
+    """``model`` as libsdformat's URDF conversion (Gazebo's spawn path) sees it: every link
+    joined to its parent by a fixed joint merged into that parent (masses added, centres of
+    mass combined, inertias moved by the parallel-axis theorem), the joints below re-attached."""
+    parent_of = model.parent_of()
+
+    def carrier(name: str) -> tuple[str, np.ndarray]:
+        j = parent_of.get(name)
+        if j is None or j.type != "fixed" or j.parent == WORLD or j.parent not in model.links:
+            return name, np.eye(4)
+        top, T = carrier(j.parent)
+        return top, T @ j.T_pj @ j.T_jc
+
+    sums: dict[str, list] = {}
+    for name, link in model.links.items():
+        top, T = carrier(name)
+        sums.setdefault(top, []).append((link, T))
+    links = {}
+    for top, parts in sums.items():
+        m = sum(_mass(p.mass) for p, _ in parts)
+        if m <= 0:
+            links[top] = KLink(top)
+            continue
+        com = sum(_mass(p.mass) * (T[:3, :3] @ p.com + T[:3, 3]) for p, T in parts) / m
+        inertia = np.zeros((3, 3))
+        for p, T in parts:
+            R, d = T[:3, :3], T[:3, :3] @ p.com + T[:3, 3] - com
+            inertia += R @ p.inertia @ R.T + _mass(p.mass) * (d @ d * np.eye(3) - np.outer(d, d))
+        links[top] = KLink(top, m, com, inertia)
+    joints = {}
+    for name, j in model.joints.items():
+        if j.type == "fixed" and j.parent != WORLD and j.parent in model.links:
+            continue
+        top, T = carrier(j.parent) if j.parent in model.links else (j.parent, np.eye(4))
+        joints[name] = KJoint(**{**j.__dict__, "parent": top, "T_pj": T @ j.T_pj})
+    return KModel(f"{model.source} lumped", links, joints)
 
 
 # ---------------------------------------------------------------- comparison
@@ -340,16 +389,20 @@ def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: i
         ja, jb = pa.get(name), pb.get(name)
         par_a = ja.parent if ja else None
         par_b = jb.parent if jb else None
-        if (par_a or WORLD) != (par_b or WORLD) and not ({par_a, par_b} <= {None, WORLD}):
+        rigid = (ja is None or ja.type == "fixed") and (jb is None or jb.type == "fixed")
+        # links rigidly attached may hang the other way round (a massless root is an SDF frame on
+        # its child): their poses below say whether they sit in the same place
+        if not rigid and (par_a or WORLD) != (par_b or WORLD) and not ({par_a, par_b} <= {None, WORLD}):
             diffs.append(f"link '{name}': parent '{par_a}' in {a.source}, '{par_b}' in {b.source}")
         A, B = a.links[name], b.links[name]
-        if not _close(A.mass, B.mass, tol, abs(A.mass)):
+        mass_a, mass_b = _mass(A.mass), _mass(B.mass)
+        if not _close(mass_a, mass_b, tol, abs(mass_a)):
             diffs.append(f"link '{name}': mass {A.mass!r} vs {B.mass!r}")
         size = max(1.0, float(np.abs(A.com).max()))
-        if A.mass > 0 and not _close(A.com, B.com, tol, size):
+        if mass_a > 0 and not _close(A.com, B.com, tol, size):
             diffs.append(f"link '{name}': centre of mass {A.com.tolist()} vs {B.com.tolist()}")
         scale = float(np.abs(A.inertia).max())
-        if A.mass > 0 and not _close(A.inertia, B.inertia, tol, scale):
+        if mass_a > 0 and not _close(A.inertia, B.inertia, tol, scale):
             diffs.append(f"link '{name}': inertia tensor {A.inertia.tolist()} vs {B.inertia.tolist()}")
     movable = ("revolute", "continuous", "prismatic")
     ma = {n: j for n, j in a.joints.items() if j.type in movable}
@@ -389,7 +442,7 @@ def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: i
             lo, hi = (j.lower, j.upper) if j.lower is not None else ((-math.pi, math.pi) if j.type != "prismatic" else (-1, 1))
             q[n] = float(rng.uniform(lo, hi)) if k else 0.0
         Ta, Tb = a.fk(q), b.fk(q)
-        ra, rb = np.linalg.inv(Ta[root_a]), np.linalg.inv(Tb[root_b])
+        ra, rb = np.linalg.inv(Ta[root_a]), np.linalg.inv(Tb[root_a if root_a in Tb else root_b])
         for name in sorted(la & lb):
             A, B = ra @ Ta[name], rb @ Tb[name]
             size = max(1.0, float(np.abs(A[:3, 3]).max()))

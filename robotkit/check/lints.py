@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robotkit.check.findings import Finding
+from robotkit.check.kinematics import NEGLIGIBLE
 from robotkit.errors import Problem, RobotkitError
 
 # thresholds (documented in docs/checks.md)
@@ -26,21 +28,6 @@ BOX_ERROR, BOX_WARNING = 3.0, 1.5
 FACE_BUDGET = 200_000  # visual faces per link before rendering rates suffer
 COLLISION_VOLUME_RANGE = (0.5, 2.0)  # collision / visual volume
 MASS_TOLERANCE = 0.10  # declared total mass vs computed
-
-
-@dataclass(frozen=True)
-class Finding:
-    severity: str  # error | warning
-    check: str  # rule name, e.g. "implied-density"
-    subject: str  # "link 'base'", "joint 'j1'", a file or the robot
-    message: str
-    hint: str = ""
-    file: str | None = None
-    line: int | None = None
-
-    def __str__(self) -> str:
-        hint = f" (hint: {self.hint})" if self.hint else ""
-        return f"{self.severity}: {self.subject}: {self.message}{hint} [{self.check}]"
 
 
 @dataclass
@@ -218,6 +205,8 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
                           [a.get("ixz", 0), a.get("iyz", 0), a.get("izz", 0)]])
             R = T[:3, :3]
             facts.com, facts.inertia = T[:3, 3], R @ I @ R.T
+            if 0 <= facts.mass < NEGLIGIBLE and not I.any():  # an explicitly massless link (a frame)
+                facts.mass = facts.com = facts.inertia = None
         for role in ("visual", "collision"):
             for g in el.findall(role):
                 gf = _geom_facts(g, role, path.parent, package_paths, subject, problems, cache)

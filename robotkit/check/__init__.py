@@ -1,0 +1,119 @@
+"""`robotkit check`: validators, physics lints, cross-format equivalence and a simulation
+smoke test, folded into one list of findings and rendered for people, CI and editors.
+
+PATH may be a recipe (built first), a build folder (``OUT/<robot>`` or ``OUT``), or a URDF,
+SDF or MJCF file written anywhere (meshes resolved relative to it or via --package-path).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+from robotkit.check.findings import Finding
+from robotkit.check.report import render  # noqa: F401  (the CLI renders through here)
+from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
+from robotkit.errors import Problem, RobotkitError
+
+
+def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
+    from robotkit.check.lints import lint, read_urdf_facts
+
+    links, joints, notes = read_urdf_facts(path, package_paths)
+    return validate_urdf(path) + notes + lint(links, joints)
+
+
+def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list[Finding]:
+    from robotkit.check.lints import lint, read_urdf_facts
+    from robotkit.check.equivalence import equivalence
+    from robotkit.check.simulation import smoke_test
+
+    name = robot_dir.name
+    urdf, sdf = robot_dir / "urdf" / f"{name}.urdf", robot_dir / "model.sdf"
+    mjcf, scene = robot_dir / "mjcf" / f"{name}.xml", robot_dir / "mjcf" / "scene.xml"
+    for p in (urdf, sdf, mjcf, scene):
+        if not p.is_file():
+            raise RobotkitError(Problem(f"not a robotkit build folder: {p.relative_to(robot_dir)} is missing",
+                                        file=str(robot_dir)))
+    links, joints, notes = read_urdf_facts(urdf, {name: str(robot_dir)})
+    findings = notes + lint(links, joints, declared_mass)
+    validators = validate_urdf(urdf) + validate_sdf(sdf) + validate_mjcf(mjcf) + validate_mjcf(scene)
+    findings += validators
+    if any(f.severity == "error" for f in findings):
+        return findings
+    try:
+        notes: list[str] = []
+        for what, diffs in equivalence(robot_dir, notes=notes).items():
+            findings += [Finding("error", "equivalence", f"robot '{name}'", f"{what}: {d}") for d in diffs]
+        findings += [Finding("warning", "equivalence", f"robot '{name}'", n) for n in notes]
+    except (RuntimeError, ValueError) as exc:
+        findings.append(Finding("warning", "equivalence", f"robot '{name}'", str(exc)))
+    sim_notes: list[str] = []
+    findings += [Finding("error", "simulation", f"robot '{name}'", p,
+                         "MuJoCo scene mjcf/scene.xml") for p in smoke_test(scene, notes=sim_notes)]
+    findings += [Finding("warning", "simulation", f"robot '{name}'", n) for n in sim_notes]
+    return findings
+
+
+def check_recipe(path: Path, out_dir: str) -> list[Finding]:
+    from robotkit.build import build
+    from robotkit.recipe.load import load_recipe
+
+    loaded = load_recipe(path)
+    result = build([path], out_dir)
+    findings = [Finding("warning", "build", f"robot '{loaded.recipe.robot}'", w) for w in result.warnings]
+    findings += check_build_dir(Path(out_dir) / loaded.recipe.robot, loaded.recipe.measured_mass)
+    marks = loaded.marks
+    located = []
+    for f in findings:
+        key = ("robot",)
+        if f.subject.startswith("link '"):
+            key = ("links", f.subject[6:-1])
+        elif f.subject.startswith("joint '"):
+            key = ("joints", f.subject[7:-1])
+        file, line = marks.locate(key)
+        located.append(replace(f, file=file, line=line))
+    return located
+
+
+def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None) -> list[Finding]:
+    p = Path(path)
+    package_paths = package_paths or {}
+    if p.is_dir():
+        if (p / "model.sdf").is_file():
+            return check_build_dir(p)
+        dirs = sorted(d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
+        if not dirs:
+            raise RobotkitError(Problem("not a build folder (no <robot>/model.sdf below it)", file=path))
+        return [f for d in dirs for f in check_build_dir(d)]
+    if not p.is_file():
+        raise RobotkitError(Problem("no such file or folder", file=path))
+    suffix = p.suffix.lower()
+    if suffix in (".yaml", ".yml"):
+        return check_recipe(p, out_dir)
+    if suffix == ".urdf":
+        return check_urdf_file(p, package_paths)
+    if suffix in (".sdf", ".world"):
+        return validate_sdf(p) + _inertial_lints(p, "sdf")
+    if suffix == ".xml":
+        return validate_mjcf(p) or _inertial_lints(p, "mjcf")
+    raise RobotkitError(Problem("unknown kind of file (expected a recipe .yaml, .urdf, .sdf or MJCF .xml)", file=path))
+
+
+def _inertial_lints(path: Path, kind: str) -> list[Finding]:
+    """Mass and inertia lints for SDF and MJCF files (their geometry is not measured yet)."""
+    from robotkit.check.lints import LinkFacts, lint_link
+    from robotkit.check import kinematics as k
+
+    try:
+        model = k.read_sdf(path) if kind == "sdf" else k.read_mjcf(path)
+    except Exception as exc:  # an invalid file is reported by its validator
+        return [Finding("warning", "inertia", str(path), f"could not read inertials: {exc}")]
+    out = []
+    for link in model.links.values():
+        if link.mass == 0 and not link.inertia.any():
+            continue
+        out += lint_link(LinkFacts(link.name, link.mass, link.com, link.inertia))
+    return out
+
+

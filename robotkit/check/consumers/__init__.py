@@ -1,0 +1,163 @@
+"""The programs people load a robot into, each read back as it sees the robot.
+
+One module per program; ``CONSUMERS`` registers each reading (name -> module, function), and
+:func:`consumer_findings` compares every reading with the robot's own description (its URDF as
+written, read by :mod:`robotkit.check.kinematics`): per-link and total mass, and every link
+frame's pose at random joint configurations.  A program that refuses the robot, or is not
+installed, is a finding too, never a silent skip.
+
+A reading is a :class:`View`.  Gazebo lumps links joined by fixed joints when it converts a
+URDF, so its view is compared with the description lumped the same way.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from robotkit.check.findings import Finding
+
+CONSUMERS = {
+    "Gazebo (URDF)": ("robotkit.check.consumers.gazebo", "from_urdf"),
+    "Gazebo (model.sdf)": ("robotkit.check.consumers.gazebo", "from_sdf"),
+    "Drake (URDF)": ("robotkit.check.consumers.drake", "from_urdf"),
+    "Drake (model.sdf)": ("robotkit.check.consumers.drake", "from_sdf"),
+    "Pinocchio (URDF)": ("robotkit.check.consumers.pinocchio", "from_urdf"),
+    "PyBullet (URDF)": ("robotkit.check.consumers.pybullet", "from_urdf"),
+    "MuJoCo (MJCF)": ("robotkit.check.consumers.mujoco", "from_mjcf"),
+}
+
+REL_TOL = 1e-9
+
+
+class Refused(Exception):
+    """The program refused to load the robot (its own message)."""
+
+
+class Missing(Exception):
+    """The program is not installed (the message says how to install it)."""
+
+
+@dataclass
+class View:
+    """A robot as one program sees it."""
+
+    masses: dict[str, float]  # link (as the program splits the robot) -> kg
+    poses: Callable[[dict[str, float]], dict[str, np.ndarray]] | None = None  # joint values -> link frames
+    lumped: bool = False  # the program merges links joined by fixed joints
+    pose_tol: float = REL_TOL  # relative: what the program's arithmetic can hold
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass
+class Build:
+    """What a consumer reads: a build folder (or the folder of a foreign URDF)."""
+
+    name: str
+    dir: Path
+    urdf: Path
+    sdf: Path | None
+    mjcf: Path | None
+    base: str = "fixed"  # fixed | free: how the root sits (Pinocchio, PyBullet)
+    package_paths: dict[str, str] = field(default_factory=dict)
+
+
+def read(consumer: str, build: Build) -> View:
+    module, function = CONSUMERS[consumer]
+    return getattr(importlib.import_module(module), function)(build)
+
+
+def configurations(reference, count: int, seed: int = 0) -> list[dict[str, float]]:
+    """Joint values: the zero pose, then random ones within limits (mimic joints follow)."""
+    rng = np.random.default_rng(seed)
+    movable = {n: j for n, j in reference.joints.items() if j.type in ("revolute", "continuous", "prismatic")}
+    out = []
+    for k in range(count):
+        q = {}
+        for n, j in sorted(movable.items()):
+            if j.mimic is not None:
+                continue
+            lo, hi = (j.lower, j.upper) if j.lower is not None else (
+                (-math.pi, math.pi) if j.type != "prismatic" else (-0.5, 0.5))
+            q[n] = float(rng.uniform(lo, hi)) if k else 0.0
+        for n, j in sorted(movable.items()):
+            if j.mimic is not None:
+                q[n] = j.mimic[1] * q.get(j.mimic[0], 0.0) + j.mimic[2]
+        out.append(q)
+    return out
+
+
+def compare(reference, view: View, configs: list[dict[str, float]], tol: float = REL_TOL) -> list[str]:
+    """Differences between the description (``reference``, a KModel) and a program's view."""
+    from robotkit.check.kinematics import _mass, lump
+
+    ref = lump(reference) if view.lumped else reference
+    expected = {n: _mass(link.mass) for n, link in ref.links.items() if n != "world"}
+    total = sum(expected.values())
+    scale = max(total, 1e-12)
+    diffs = []
+    got_total = sum(_mass(m) for m in view.masses.values())
+    if abs(got_total - total) > tol * scale:
+        diffs.append(f"total mass {got_total:.12g} kg, the description's is {total:.12g} kg")
+    for name, m in sorted(view.masses.items()):
+        if name not in expected:
+            if _mass(m) > 0:
+                diffs.append(f"link '{name}' weighs {m:.12g} kg and is not in the description")
+            continue
+        if abs(_mass(m) - expected[name]) > tol * max(expected[name], 1e-12 * scale):
+            hint = " (SDF's default for a link without <inertial>)" if m == 1.0 and expected[name] == 0 else ""
+            diffs.append(f"link '{name}' weighs {m:.12g} kg{hint}, the description says {expected[name]:.12g} kg")
+    for name, m in sorted(expected.items()):
+        if m > 0 and name not in view.masses:
+            diffs.append(f"link '{name}' ({m:.6g} kg) is missing")
+    if view.poses is None:
+        return diffs
+    root = ref.root()
+    for q in configs:
+        want, got = ref.fk(q), view.poses(q)
+        if root not in got:
+            diffs.append(f"the root link '{root}' has no frame")
+            break
+        Rw, Rg = np.linalg.inv(want[root]), np.linalg.inv(got[root])
+        for name in sorted(set(want) & set(got)):
+            A, B = Rw @ want[name], Rg @ got[name]
+            size = max(1.0, float(np.abs(A[:3, 3]).max()))
+            ptol = max(tol, view.pose_tol)
+            if not (np.abs(A[:3, 3] - B[:3, 3]).max() <= ptol * size and np.abs(A[:3, :3] - B[:3, :3]).max() <= ptol):
+                diffs.append(f"link '{name}' is at {np.round(B[:3, 3], 9).tolist()}, the description puts it at "
+                             f"{np.round(A[:3, 3], 9).tolist()} (joint values {q})")
+                return diffs
+    return diffs
+
+
+def consumer_findings(build: Build, consumers=None, configs: int = 20) -> tuple[list[Finding], dict]:
+    """Each program's reading compared with the description: findings, and a summary per
+    program (what it loaded, its total mass, its notes) for report.json."""
+    from robotkit.check.kinematics import read_urdf
+
+    reference = read_urdf(build.urdf)
+    qs = configurations(reference, configs)
+    findings, summary = [], {}
+    subject = f"robot '{build.name}'"
+    for consumer in consumers or CONSUMERS:
+        try:
+            view = read(consumer, build)
+        except Missing as exc:
+            findings.append(Finding("error", "consumer", subject, f"{consumer}: not checked: {exc}"))
+            summary[consumer] = {"loaded": None, "reason": str(exc)}
+            continue
+        except Refused as exc:
+            findings.append(Finding("error", "consumer", subject, f"{consumer} refuses the robot: {exc}"))
+            summary[consumer] = {"loaded": False, "reason": str(exc)}
+            continue
+        diffs = compare(reference, view, qs)
+        findings += [Finding("error", "consumer", subject, f"{consumer}: {d}") for d in diffs]
+        findings += [Finding("warning", "consumer", subject, f"{consumer}: {n}") for n in view.notes]
+        summary[consumer] = {"loaded": True, "mass": sum(view.masses.values()), "links": len(view.masses),
+                             "agrees": not diffs, "notes": view.notes}
+    return findings, summary

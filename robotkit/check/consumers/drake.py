@@ -1,0 +1,61 @@
+"""Drake (PyPI ``drake``): the URDF and model.sdf parsed into a MultibodyPlant with its
+SceneGraph (so collision geometry is loaded too: Drake takes convex meshes as OBJ, VTK or glTF)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robotkit.check.consumers import Missing, Refused, View
+
+
+def _load(build, path) -> View:
+    try:
+        from pydrake.multibody.parsing import Parser
+        from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+        from pydrake.multibody.tree import PrismaticJoint, RevoluteJoint
+        from pydrake.systems.framework import DiagramBuilder
+    except ImportError:
+        raise Missing("Drake is not installed (pip install drake)") from None
+    import logging
+
+    logging.getLogger("drake").setLevel(logging.ERROR)  # its warnings (joint friction, sensors) are not failures
+    plant, _ = AddMultibodyPlantSceneGraph(DiagramBuilder(), 0.0)
+    parser = Parser(plant)
+    parser.package_map().Add(build.name, str(build.dir))
+    for pkg, d in build.package_paths.items():
+        if not parser.package_map().Contains(pkg):
+            parser.package_map().Add(pkg, d)
+    try:
+        (model,) = parser.AddModels(str(path))
+        plant.Finalize()
+    except Exception as exc:  # Drake raises RuntimeError with its parser's message
+        raise Refused(" ".join(str(exc).split())[:400]) from None
+    bodies = [plant.get_body(i) for i in plant.GetBodyIndices(model)]
+    masses = {b.name(): float(b.default_mass()) for b in bodies}
+    frames = [plant.get_frame(i) for i in plant.GetFrameIndices(model)]
+    frames = [f for f in frames if not f.name().startswith("__") and f.name() != ""]
+
+    def poses(q: dict[str, float]) -> dict[str, np.ndarray]:
+        context = plant.CreateDefaultContext()
+        for name, value in q.items():
+            for candidate in (name, f"{name}_joint"):  # model.sdf renames joints named like links
+                if plant.HasJointNamed(candidate, model):
+                    joint = plant.GetJointByName(candidate, model)
+                    if isinstance(joint, RevoluteJoint):
+                        joint.set_angle(context, value)
+                    elif isinstance(joint, PrismaticJoint):
+                        joint.set_translation(context, value)
+                    break
+        return {f.name(): f.CalcPoseInWorld(context).GetAsMatrix4() for f in frames}
+
+    return View(masses, poses)
+
+
+def from_urdf(build) -> View:
+    return _load(build, build.urdf)
+
+
+def from_sdf(build) -> View:
+    if build.sdf is None:
+        raise Missing("no model.sdf")
+    return _load(build, build.sdf)

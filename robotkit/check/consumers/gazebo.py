@@ -1,0 +1,41 @@
+"""Gazebo, both ways it reads a robot, through libsdformat (`ign sdf -p` prints what it read):
+a URDF converted for spawning (fixed joints lumped), and model.sdf from a model:// folder."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+
+from robotkit.check.consumers import Missing, Refused, View
+
+
+def _parsed(path) -> str:
+    if shutil.which("ign") is None:
+        raise Missing("`ign` is not installed (apt install ignition-tools libsdformat-dev)")
+    proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
+    errors = [line for line in (proc.stdout + proc.stderr).splitlines()
+              if "Error" in line and "libignition-tools-backward" not in line]
+    if proc.returncode != 0 or "<sdf" not in proc.stdout:
+        raise Refused(re.sub(r"\x1b\[[0-9;]*m", "", (errors or [f"exit status {proc.returncode}"])[0]).strip())
+    if "<link" not in proc.stdout:
+        raise Refused("libsdformat's reading has no link at all (an empty model)")
+    # namespaced elements (<ignition::corrected_offsets>) come without their namespace declaration
+    return re.sub(r"<(/?)(\w+)::", r"<\1\2__", proc.stdout)
+
+
+def _view(text: str, source: str, lumped: bool) -> View:
+    from robotkit.check.kinematics import read_sdf_text
+
+    model = read_sdf_text(text, source)
+    return View({n: link.mass for n, link in model.links.items() if n != "world"}, model.fk, lumped=lumped)
+
+
+def from_urdf(build) -> View:
+    return _view(_parsed(build.urdf), f"URDF {build.urdf} (libsdformat)", lumped=True)
+
+
+def from_sdf(build) -> View:
+    if build.sdf is None:
+        raise Missing("no model.sdf")
+    return _view(_parsed(build.sdf), f"SDF {build.sdf} (libsdformat)", lumped=False)

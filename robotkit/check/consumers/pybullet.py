@@ -1,0 +1,76 @@
+"""PyBullet (PyPI ``pybullet``, DIRECT mode): the URDF with the file's inertia
+(``URDF_USE_INERTIA_FROM_FILE``); a link without ``<inertial>`` gets 1 kg there."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+
+import numpy as np
+
+from robotkit.check.consumers import Missing, Refused, View
+
+
+PRECISION = 1e-6  # PyBullet's wheels compute kinematics in single precision
+
+
+@contextlib.contextmanager
+def _quiet():
+    """PyBullet prints to the C-level stdout and stderr (build time, warnings)."""
+    saved = [os.dup(1), os.dup(2)]
+    with open(os.devnull, "w") as null:
+        os.dup2(null.fileno(), 1)
+        os.dup2(null.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in saved:
+                os.close(fd)
+
+
+def _T(pos, orn) -> np.ndarray:
+    import pybullet as p
+
+    T = np.eye(4)
+    T[:3, :3] = np.array(p.getMatrixFromQuaternion(orn)).reshape(3, 3)
+    T[:3, 3] = pos
+    return T
+
+
+def from_urdf(build) -> View:
+    try:
+        with _quiet():
+            import pybullet as p
+    except ImportError:
+        raise Missing("PyBullet is not installed (pip install pybullet)") from None
+    with _quiet():
+        client = p.connect(p.DIRECT)
+        try:
+            # loaded free, so the base keeps its mass from the file (a fixed base is reported massless)
+            body = p.loadURDF(str(build.urdf), useFixedBase=False,
+                              flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
+        except p.error as exc:
+            p.disconnect(client)
+            raise Refused(f"loadURDF failed: {exc}") from None
+    n = p.getNumJoints(body, physicsClientId=client)
+    base = p.getBodyInfo(body, physicsClientId=client)[0].decode()
+    info = [p.getJointInfo(body, i, physicsClientId=client) for i in range(n)]
+    masses = {base: p.getDynamicsInfo(body, -1, physicsClientId=client)[0]}
+    masses.update({info[i][12].decode(): p.getDynamicsInfo(body, i, physicsClientId=client)[0] for i in range(n)})
+    local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+
+    def poses(q: dict[str, float]) -> dict[str, np.ndarray]:
+        for i in range(n):
+            name = info[i][1].decode()
+            if name in q:
+                p.resetJointState(body, i, q[name], physicsClientId=client)
+        com = _T(*p.getBasePositionAndOrientation(body, physicsClientId=client))
+        out = {base: com @ np.linalg.inv(_T(local[3], local[4]))}
+        for i in range(n):
+            s = p.getLinkState(body, i, computeForwardKinematics=1, physicsClientId=client)
+            out[info[i][12].decode()] = _T(s[4], s[5])
+        return out
+
+    return View(masses, poses, pose_tol=PRECISION)

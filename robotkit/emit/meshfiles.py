@@ -1,0 +1,51 @@
+"""Which mesh file each output references, and the conversions that make those files.
+
+Shared by the emitters (URDF, SDF, MJCF) and the tasks that write the files:
+
+- visual geometry references the copied (or processed) visual file, except in MJCF, which
+  reads no COLLADA: a DAE becomes ``meshes/mjcf/<stem>.stl``;
+- collision geometry references an OBJ in every format: Drake takes convex meshes only as
+  OBJ, VTK or glTF; MuJoCo, Gazebo and RViz read OBJ too.  Collision pieces are written as OBJ
+  by their task; any other mesh used for collision is converted to ``meshes/collision/<stem>.obj``.
+
+Conversions keep the coordinates the reference's ``out_scale`` applies to (file units for a
+copied mesh, metres for a processed one), so every format uses the same scale.
+"""
+
+from __future__ import annotations
+
+import os
+
+MJCF_VISUAL_EXT = (".stl", ".obj")
+
+
+def visual_file(mesh, fmt: str) -> str:
+    """Path below ``meshes/`` of the file a visual geom of format ``fmt`` references."""
+    stem, ext = os.path.splitext(mesh.file_name)
+    if fmt == "mjcf" and ext.lower() not in MJCF_VISUAL_EXT:
+        return f"mjcf/{stem}.stl"
+    return mesh.path
+
+
+def collision_file(mesh) -> str:
+    """Path below ``meshes/`` of the OBJ a collision geom references (every format)."""
+    if mesh.folder == "collision" and mesh.file_name.lower().endswith(".obj"):
+        return mesh.path
+    return f"collision/{os.path.splitext(mesh.file_name)[0]}.obj"
+
+
+def conversions(robot) -> dict[str, tuple[str, tuple[float, float, float]]]:
+    """Files to convert: path below ``meshes/`` -> (source file, scale to apply to it)."""
+    out: dict = {}
+    for link in robot.links:
+        for g in link.visuals:
+            m = g.shape.mesh
+            if g.shape.kind == "mesh" and not m.processed and visual_file(m, "mjcf") != m.path:
+                out.setdefault(visual_file(m, "mjcf"), (m.source, (1.0, 1.0, 1.0)))
+        for fmt in ("urdf", "sdf", "mjcf"):
+            for g in link.collisions_for(fmt):
+                m = g.shape.mesh
+                if g.shape.kind == "mesh" and collision_file(m) != m.path:  # not a proxy: its task writes OBJ
+                    # a processed visual is in metres: convert its source the same way
+                    out.setdefault(collision_file(m), (m.source, m.scale if m.processed else (1.0, 1.0, 1.0)))
+    return dict(sorted(out.items()))
