@@ -20,7 +20,6 @@ from robotkit.check.simulation import smoke_test
 from validators import check_urdf, ign_sdf_check, mujoco, require
 
 
-
 def _robots() -> list[str]:
     """The robot folders the example recipes build (a recipe with variants builds several)."""
     from robotkit.recipe.load import load_recipes

@@ -15,7 +15,7 @@ from conftest import REPO, RECIPES, run_cli, write_recipe
 from robotkit.build import build
 from robotkit.recipe.expand import units
 from robotkit.recipe.expand.expr import ExprError, evaluate
-from robotkit.verify.kinematics import compare, read_urdf
+from robotkit.check.kinematics import compare, read_urdf
 
 TOL = 1e-9
 
@@ -433,7 +433,7 @@ def test_expand_prints_a_flat_recipe_that_builds_the_same_robot(legs, tmp_path):
 
 
 def test_instance_origin_with_a_rotation_composes_with_the_joint_origin(tmp_path):
-    from robotkit.verify.kinematics import rpy_matrix
+    from robotkit.check.kinematics import rpy_matrix
 
     write_recipe(tmp_path, """
         robot: r

@@ -55,14 +55,26 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
     return findings
 
 
-def check_recipe(path: Path, out_dir: str) -> list[Finding]:
+def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None) -> list[Finding]:
     from robotkit.build import build
-    from robotkit.recipe.load import load_recipe
+    from robotkit.recipe.load import load_recipes
 
-    loaded = load_recipe(path)
-    result = build([path], out_dir)
-    findings = [Finding("warning", "build", f"robot '{loaded.recipe.robot}'", w) for w in result.warnings]
-    findings += check_build_dir(Path(out_dir) / loaded.recipe.robot, loaded.recipe.measured_mass)
+    located = []
+    result = build([path], out_dir, args=args)
+    for i, loaded in enumerate(load_recipes(path, args)):  # one per variant
+        name = loaded.recipe.robot
+        others = [r for r in result.robots if r != name]
+        # a warning naming another variant's robot belongs to that one; the rest to the first
+        warnings = [w for w in result.warnings if w.startswith(f"{name}:")
+                    or (i == 0 and not any(w.startswith(f"{o}:") for o in others))]
+        located += _check_variant(loaded, warnings, out_dir)
+    return located
+
+
+def _check_variant(loaded, warnings: list[str], out_dir: str) -> list[Finding]:
+    name = loaded.recipe.robot
+    findings = [Finding("warning", "build", f"robot '{name}'", w) for w in warnings]
+    findings += check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
     marks = loaded.marks
     located = []
     for f in findings:
@@ -76,7 +88,8 @@ def check_recipe(path: Path, out_dir: str) -> list[Finding]:
     return located
 
 
-def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None) -> list[Finding]:
+def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
+          args: dict[str, str] | None = None) -> list[Finding]:
     p = Path(path)
     package_paths = package_paths or {}
     if p.is_dir():
@@ -90,7 +103,7 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
         raise RobotkitError(Problem("no such file or folder", file=path))
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
-        return check_recipe(p, out_dir)
+        return check_recipe(p, out_dir, args)
     if suffix == ".urdf":
         return check_urdf_file(p, package_paths)
     if suffix in (".sdf", ".world"):
