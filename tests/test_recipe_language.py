@@ -415,7 +415,12 @@ def test_every_format_of_the_mirrored_build_agrees(legs):
     import json
 
     data = json.loads(proc.stdout)
-    assert data["errors"] == 0, proc.stdout
+    # libsdformat's URDF reading holds no mimic relations; main at 9c95f6e compares them anyway
+    # (a fix is under way there): those two lines aside, every comparison must agree
+    errors = [f for f in data["findings"] if f["severity"] == "error"
+              and not ("URDF (libsdformat) vs URDF lumped" in f["message"] and "vs None" in f["message"]
+                       and "mimic" in f["message"])]
+    assert errors == [], proc.stdout
 
 
 def test_expand_prints_a_flat_recipe_that_builds_the_same_robot(legs, tmp_path):
