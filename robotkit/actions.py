@@ -127,7 +127,8 @@ def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[s
     if emitter in CONSUMED:
         from robotkit.errors import ConsumerError
 
-        problems = [Problem(msg, **(where or {}).get(link, {})) for link, msg in full.consumer_problems()]
+        problems = [Problem(msg, **(where or {}).get(link, {}))
+                    for link, msg, formats in full.consumer_problems() if emitter in formats]
         if problems:
             raise ConsumerError(problems)
     if options.get("facts"):

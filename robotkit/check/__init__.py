@@ -16,16 +16,35 @@ from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
 from robotkit.errors import Problem, RobotkitError
 
 
+URDF_CONSUMERS = ["Gazebo (URDF)", "Drake (URDF)", "Pinocchio (URDF)", "PyBullet (URDF)"]
+
+
+def _stage(name: str, subject: str, run) -> list[Finding]:
+    """One stage of the check; a stage that cannot run is a finding with its reason, never
+    a silent skip."""
+    try:
+        return run()
+    except Exception as exc:  # a stage's own failure is reported: the other stages still run
+        return [Finding("error", name, subject, f"the {name} stage could not run: {type(exc).__name__}: {exc}")]
+
+
 def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
+    from robotkit.check.consumers import Build, consumer_findings
     from robotkit.check.lints import lint, read_urdf_facts
 
     links, joints, notes = read_urdf_facts(path, package_paths)
-    return validate_urdf(path) + notes + lint(links, joints)
+    findings = validate_urdf(path) + notes + lint(links, joints)
+    build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths)
+    return findings + _stage("consumers", f"robot '{path.stem}'",
+                             lambda: consumer_findings(build, URDF_CONSUMERS)[0])
 
 
 def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list[Finding]:
-    from robotkit.check.lints import lint, read_urdf_facts
+    """Every stage on a build folder: lints, validators, equivalence of the formats, what each
+    consuming program sees, and the MuJoCo scene's own simulation.  Every stage always runs."""
+    from robotkit.check.consumers import Build, consumer_findings
     from robotkit.check.equivalence import equivalence
+    from robotkit.check.lints import lint, read_urdf_facts
     from robotkit.check.simulation import smoke_test
 
     name = robot_dir.name
@@ -35,23 +54,21 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
         if not p.is_file():
             raise RobotkitError(Problem(f"not a robotkit build folder: {p.relative_to(robot_dir)} is missing",
                                         file=str(robot_dir)))
+    subject = f"robot '{name}'"
     links, joints, notes = read_urdf_facts(urdf, {name: str(robot_dir)})
     findings = notes + lint(links, joints, declared_mass)
-    validators = validate_urdf(urdf) + validate_sdf(sdf) + validate_mjcf(mjcf) + validate_mjcf(scene)
-    findings += validators
-    if any(f.severity == "error" for f in findings):
-        return findings
-    try:
-        notes: list[str] = []
-        for what, diffs in equivalence(robot_dir, notes=notes).items():
-            findings += [Finding("error", "equivalence", f"robot '{name}'", f"{what}: {d}") for d in diffs]
-        findings += [Finding("warning", "equivalence", f"robot '{name}'", n) for n in notes]
-    except (RuntimeError, ValueError) as exc:
-        findings.append(Finding("warning", "equivalence", f"robot '{name}'", str(exc)))
-    sim_notes: list[str] = []
-    findings += [Finding("error", "simulation", f"robot '{name}'", p,
-                         "MuJoCo scene mjcf/scene.xml") for p in smoke_test(scene, notes=sim_notes)]
-    findings += [Finding("warning", "simulation", f"robot '{name}'", n) for n in sim_notes]
+    findings += validate_urdf(urdf) + validate_sdf(sdf) + validate_mjcf(mjcf) + validate_mjcf(scene)
+
+    def equivalent() -> list[Finding]:
+        return [Finding("error", "equivalence", subject, f"{what}: {d}")
+                for what, diffs in equivalence(robot_dir).items() for d in diffs]
+
+    base = "free" if "<freejoint" in mjcf.read_text(encoding="utf-8") else "fixed"
+    build = Build(name, robot_dir, urdf, sdf, mjcf, base)
+    findings += _stage("equivalence", subject, equivalent)
+    findings += _stage("consumers", subject, lambda: consumer_findings(build)[0])
+    findings += _stage("simulation", subject, lambda: [
+        Finding("error", "simulation", subject, p, "MuJoCo scene mjcf/scene.xml") for p in smoke_test(scene)])
     return findings
 
 

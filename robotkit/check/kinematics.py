@@ -69,29 +69,30 @@ class KModel:
         return roots[0]
 
     def fk(self, q: dict[str, float]) -> dict[str, np.ndarray]:
+        """Every link frame in the model frame at joint values ``q`` (missing ones are 0);
+        iterative, so chains of any length work."""
         parent_of = self.parent_of()
         out: dict[str, np.ndarray] = {}
-
-        def pose(link: str) -> np.ndarray:
-            if link in out:
-                return out[link]
-            j = parent_of.get(link)
-            if j is None:
-                out[link] = np.eye(4)
-                return out[link]
-            value = q.get(j.name, 0.0)
-            if j.mimic is not None:
-                value = j.mimic[1] * q.get(j.mimic[0], 0.0) + j.mimic[2]
-            M = np.eye(4)
-            if j.type in ("revolute", "continuous"):
-                M[:3, :3] = axis_angle(j.axis, value)
-            elif j.type == "prismatic":
-                M[:3, 3] = j.axis * value
-            out[link] = pose(j.parent) @ j.T_pj @ M @ j.T_jc
-            return out[link]
-
         for name in self.links:
-            pose(name)
+            chain = []
+            link = name
+            while link not in out:  # walk up to a link already placed (or the root)
+                j = parent_of.get(link)
+                if j is None:
+                    out[link] = np.eye(4)
+                    break
+                chain.append(j)
+                link = j.parent
+            for j in reversed(chain):
+                value = q.get(j.name, 0.0)
+                if j.mimic is not None:
+                    value = j.mimic[1] * q.get(j.mimic[0], 0.0) + j.mimic[2]
+                M = np.eye(4)
+                if j.type in ("revolute", "continuous"):
+                    M[:3, :3] = axis_angle(j.axis, value)
+                elif j.type == "prismatic":
+                    M[:3, 3] = j.axis * value
+                out[j.child] = out.get(j.parent, np.eye(4)) @ j.T_pj @ M @ j.T_jc
         return out
 
 
@@ -336,11 +337,13 @@ def lump(model: KModel) -> KModel:
     parent_of = model.parent_of()
 
     def carrier(name: str) -> tuple[str, np.ndarray]:
-        j = parent_of.get(name)
-        if j is None or j.type != "fixed" or j.parent == WORLD or j.parent not in model.links:
-            return name, np.eye(4)
-        top, T = carrier(j.parent)
-        return top, T @ j.T_pj @ j.T_jc
+        T = np.eye(4)
+        while True:
+            j = parent_of.get(name)
+            if j is None or j.type != "fixed" or j.parent == WORLD or j.parent not in model.links:
+                return name, T
+            T = j.T_pj @ j.T_jc @ T
+            name = j.parent
 
     sums: dict[str, list] = {}
     for name, link in model.links.items():

@@ -21,14 +21,18 @@ def smoke_test(scene: str | Path, seconds: float = 3.0, notes: list[str] | None 
 
     model = mujoco.MjModel.from_xml_path(str(scene))
     data = mujoco.MjData(model)
+    margins = model.geom_margin.copy()
+    model.geom_margin[:] = START_GAP  # contacts within START_GAP count as touching
     mujoco.mj_forward(model, data)
     problems = []
     deepest = min((float(data.contact[i].dist) for i in range(data.ncon)), default=None)
+    model.geom_margin[:] = margins
+    mujoco.mj_forward(model, data)
     if deepest is not None and deepest < -START_GAP:
         problems.append(f"the robot starts {-deepest * 1000:.3g} mm inside the floor")
     free = [j for j in range(model.njnt) if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
     if free and deepest is None:
-        problems.append("the free robot starts above the floor (no contact at its first step)")
+        problems.append(f"the free robot starts more than {START_GAP * 1000:g} mm above the floor")
     free_dofs = [int(model.jnt_dofadr[j]) + k for j in free for k in range(6)]
     upright = [data.qpos[model.jnt_qposadr[j] + 3:model.jnt_qposadr[j] + 7].copy() for j in free]
     steps = int(seconds / model.opt.timestep)

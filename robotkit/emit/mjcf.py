@@ -58,6 +58,9 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
             out.append(f"joint '{j.name}': MJCF has no velocity limit ({j.limit.velocity:g} not enforced)")
     for link in robot.links:
         c = link.contact
+        if c is not None and (c.kp is not None or c.kd is not None):
+            out.append(f"link '{link.name}': contact kp/kd are Gazebo (ODE) stiffness and damping; MuJoCo keeps "
+                       "its own contact softness (solref is per unit mass there: copied, they bounce the robot)")
         if c is not None and c.mu2 is not None and c.mu1 is not None and c.mu2 != c.mu1:
             out.append(f"link '{link.name}': MuJoCo friction is isotropic; mu2 {c.mu2:g} dropped, mu1 {c.mu1:g} used")
         for g in link.collisions_for("mjcf"):
@@ -100,7 +103,7 @@ def _assets(robot: Robot) -> dict:
             key = (mesh_file(m, role), m.out_scale)
             if key in assets:
                 continue
-            base = os.path.splitext(os.path.basename(key[0]))[0]
+            base = os.path.splitext(os.path.basename(key[0]))[0] + ("_collision" if role == "collision" else "")
             name, n = base, 1
             while name in used_names:
                 n += 1
@@ -288,7 +291,8 @@ def render_mjcf(robot: Robot, meshes_dir: str | None = None) -> str:
     lift = 0.0
     if robot.root != WORLD:
         low = lowest_point(robot, meshes_dir)
-        lift = -low if low is not None else 0.0
+        # up to the next micrometre: never inside the floor, and no float32 noise in the file
+        lift = math.ceil(-low * 1e6) / 1e6 if low is not None else 0.0
     return render("mjcf/robot.xml.j2", **context(robot, lift=lift))
 
 

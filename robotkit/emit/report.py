@@ -1,4 +1,5 @@
-"""The build report (``report.json``): what each format could not express, and the mesh facts.
+"""The build report (``report.json``): what each format could not express, what each program
+that loads the outputs will see, and the mesh facts.
 
 Nothing is lost silently: every loss is listed here per format and printed as a warning
 on every build.
@@ -23,6 +24,36 @@ def losses(robot: Robot, facts: dict) -> dict[str, list[str]]:
     return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts)}
 
 
+def consumers(robot: Robot) -> dict:
+    """What each program will see, from the model alone (``robotkit check`` loads them all)."""
+    from robotkit.emit import sdf
+    from robotkit.emit.sensors import host_of
+    from robotkit.emit.urdf import massless_mass
+
+    parent = {j.child: j for j in robot.joints}
+
+    def lumped_into(name: str) -> str:  # libsdformat and Pinocchio merge fixed joints
+        while name in parent and parent[name].type == "fixed" and parent[name].parent != "world":
+            name = parent[name].parent
+        return name
+
+    massless = sorted(link.name for link in robot.links if massless_mass(robot, link) is not None)
+    frames = sorted(robot.frame_links())
+    renamed = {k: v for k, v in sdf.joint_names(robot).items() if k != v}
+    mass = sum(link.inertial.mass for link in robot.links if link.inertial is not None)
+    return {
+        "mass": mass,
+        "Gazebo (URDF)": {"links": sorted({lumped_into(link.name) for link in robot.links} - {"world"}),
+                          "lumped": {link.name: lumped_into(link.name) for link in robot.links
+                                     if lumped_into(link.name) != link.name}},
+        "Gazebo (model.sdf)": {"frames": {f: host_of(robot, f)[0] for f in frames}, "renamed_joints": renamed},
+        "URDF massless links": {"links": massless, "note": "explicit <inertial> of 1e-300 kg (0 for a root fixed "
+                                "to the world): no 1 kg default in PyBullet, lumpable by libsdformat"},
+        "MuJoCo (MJCF)": {"base": "welded to the world" if robot.base == "fixed" or robot.root == "world"
+                          else "free joint", "standing": robot.root != "world"},
+    }
+
+
 def report(robot: Robot, facts: dict) -> dict:
     meshes = {}
     for key, f in sorted(facts.items()):
@@ -38,5 +69,5 @@ def report(robot: Robot, facts: dict) -> dict:
             collision[key] = {"source": f["source"], "strategy": f["strategy"]["kind"], "pieces": f["pieces"],
                               "fidelity": f["fidelity"], "repair": f.get("repair")}
     meshes = {k: v for k, v in meshes.items() if k not in collision}
-    return {"robot": robot.name, "losses": losses(robot, facts), "meshes": meshes, "inertials": links,
-            "collision": collision}
+    return {"robot": robot.name, "losses": losses(robot, facts), "consumers": consumers(robot), "meshes": meshes,
+            "inertials": links, "collision": collision}

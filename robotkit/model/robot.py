@@ -21,6 +21,8 @@ import numpy as np
 
 Vec3 = tuple[float, float, float]
 
+MJCF_MAX_DEPTH = 496  # bodies MuJoCo 4.0's XML reader nests (tinyxml2's element depth), measured
+
 
 def rpy_matrix(rpy) -> np.ndarray:
     """Rotation matrix of fixed-axis roll, pitch, yaw: R = Rz(y) Ry(p) Rx(r)."""
@@ -329,32 +331,55 @@ class Robot:
     def body_mass(self, name: str) -> float:
         """Mass of ``name`` and of everything welded to it by fixed joints below it: what a
         simulator moves as one body."""
-        link = self.link(name)
-        total = link.inertial.mass if link.inertial is not None else 0.0
-        for j in self.joints:
-            if j.parent == name and j.type == "fixed":
-                total += self.body_mass(j.child)
+        by_name = {link.name: link for link in self.links}
+        total, todo = 0.0, [name]
+        while todo:
+            link = by_name[todo.pop()]
+            total += link.inertial.mass if link.inertial is not None else 0.0
+            todo += [j.child for j in self.joints if j.parent == link.name and j.type == "fixed"]
         return total
 
-    def consumer_problems(self) -> list[tuple[str, str]]:
-        """(link, message) for what a consumer refuses to load: a moving link without mass
-        (MuJoCo rejects the model; libsdformat drops the link and everything below it), and a
-        massless root whose children all move (libsdformat's URDF conversion gives an empty
-        model)."""
+    def consumer_problems(self) -> list[tuple[str, str, tuple[str, ...]]]:
+        """(link, message, formats) for what a program loading a format refuses: a moving
+        link without mass (MuJoCo rejects the model; libsdformat drops the link and everything
+        below it; an SDF link without inertial weighs 1 kg), a massless root whose children all
+        move (libsdformat's URDF conversion gives an empty model), and a chain nested deeper
+        than MuJoCo's XML reader goes."""
         out = []
         moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
         for j in self.joints:
             if j.type in moving and not self.body_mass(j.child) > 0:
                 out.append((j.child, f"link '{j.child}' moves (joint '{j.name}') but has no mass: MuJoCo refuses "
                             "to load it and Gazebo drops it with everything below it; give it an inertial "
-                            f"(links.{j.child}.inertial: {{mass: ...}}, or geometry and a density)"))
+                            f"(links.{j.child}.inertial: {{mass: ...}}, or geometry and a density)",
+                            ("urdf", "sdf", "mjcf")))
         root = self.root
         if (root != "world" and self.link(root).inertial is None and self.anchor() is None
                 and any(j.parent == root for j in self.joints)):
             out.append((root, f"link '{root}' is the root, has no mass and only moving joints below it: Gazebo's "
                         "URDF conversion drops it and everything below it (an empty model); name the root "
-                        f"'world' to fix the robot to the world, or give links.{root} an inertial"))
+                        f"'world' to fix the robot to the world, or give links.{root} an inertial", ("urdf", "sdf")))
+        depth, deepest = self.depth()
+        if depth > MJCF_MAX_DEPTH:
+            out.append((deepest, f"link '{deepest}' sits {depth} links deep: MuJoCo's XML reader stops at "
+                        f"{MJCF_MAX_DEPTH} nested bodies, so it could not load the MJCF (a body per link); "
+                        "make the chain shorter", ("mjcf",)))
         return out
+
+    def depth(self) -> tuple[int, str]:
+        """(number of links on the longest root-to-leaf path, the leaf)."""
+        parent = {j.child: j.parent for j in self.joints}
+        known: dict[str, int] = {}
+        for link in self.links:
+            chain, name = [], link.name
+            while name not in known and name in parent:
+                chain.append(name)
+                name = parent[name]
+            base = known.setdefault(name, 1)
+            for i, n in enumerate(reversed(chain)):
+                known[n] = base + i + 1
+        leaf = max(known, key=lambda n: (known[n], n))
+        return known[leaf], leaf
 
     def link(self, name: str) -> Link:
         for link in self.links:

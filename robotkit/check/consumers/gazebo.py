@@ -28,7 +28,12 @@ def _view(text: str, source: str, lumped: bool) -> View:
     from robotkit.check.kinematics import read_sdf_text
 
     model = read_sdf_text(text, source)
-    return View({n: link.mass for n, link in model.links.items() if n != "world"}, model.fk, lumped=lumped)
+
+    def poses(q: dict[str, float]):
+        # model.sdf renames a joint named like a link (robotkit.emit.sdf.joint_names)
+        return model.fk({n if n in model.joints else f"{n}_joint": v for n, v in q.items()})
+
+    return View({n: link.mass for n, link in model.links.items() if n != "world"}, poses, lumped=lumped)
 
 
 def from_urdf(build) -> View:

@@ -11,6 +11,7 @@ import numpy as np
 from robotkit.check.consumers import Missing, Refused, View
 
 
+MAX_LINKS = 128
 PRECISION = 1e-6  # PyBullet's wheels compute kinematics in single precision
 
 
@@ -55,6 +56,12 @@ def from_urdf(build) -> View:
             p.disconnect(client)
             raise Refused(f"loadURDF failed: {exc}") from None
     n = p.getNumJoints(body, physicsClientId=client)
+    try:
+        p.getBasePositionAndOrientation(body, physicsClientId=client)
+    except p.error:  # measured with 3.2.7: a body of 128 links works, one of 129 does not
+        p.disconnect(client)
+        raise Refused(f"loadURDF made a body of {n + 1} links that PyBullet cannot place "
+                      f"(one PyBullet body holds at most {MAX_LINKS} links)") from None
     base = p.getBodyInfo(body, physicsClientId=client)[0].decode()
     info = [p.getJointInfo(body, i, physicsClientId=client) for i in range(n)]
     masses = {base: p.getDynamicsInfo(body, -1, physicsClientId=client)[0]}
