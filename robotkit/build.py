@@ -134,8 +134,9 @@ def to_doit(task: dict) -> dict:
 
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
-          echo=None, progress=None, args: dict[str, str] | None = None) -> BuildResult:
-    """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem."""
+          echo=None, progress=None, ros: str | None = None, args: dict[str, str] | None = None) -> BuildResult:
+    """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
+    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key; ``args`` sets recipe arguments (``--arg``)."""
     from doit.cmd_base import TaskLoader2
     from doit.doit_cmd import DoitMain
     from doit.task import dict_to_task
@@ -143,7 +144,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     from robotkit.tasks import load_robots, mesh_locations, robot_tasks
 
     out = Path(out_dir).absolute()
-    robots = load_robots(recipes, args)  # raises before anything is written
+    robots = load_robots(recipes, ros, args)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
     tasks = []
     for loaded, robot in robots:
@@ -185,7 +186,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
 def collect_losses(out: Path, robots: list[str]) -> list[str]:
     """What each output format could not express (from each robot's report.json)."""
     lines = []
-    names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF"}
+    names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF", "package": "ROS package"}
     for name in robots:
         try:
             data = json.loads((out / name / "report.json").read_text(encoding="utf-8"))

@@ -31,6 +31,8 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
     b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="run N tasks in parallel processes")
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
+    b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
+                                                           "recipes' `ros` key)")
     _add_arg_option(b)
 
     w = sub.add_parser("world", help="turn a ROS map_server occupancy map into a Gazebo world and MuJoCo scene",
@@ -116,7 +118,8 @@ def _build(args) -> int:
         return 2
     start = time.perf_counter()
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
-    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, args=dict(args.arg))
+    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, ros=args.ros,
+                   args=dict(args.arg))
     if result.ran or args.verbose:
         for w in result.warnings:
             print(f"warning: {w}", file=sys.stderr)

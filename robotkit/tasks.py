@@ -21,7 +21,7 @@ from pathlib import Path
 from doit.tools import config_changed
 
 from robotkit import actions
-from robotkit.emit import TEMPLATES
+from robotkit.emit import TEMPLATES, ros
 from robotkit.emit.env import template_dirs
 from robotkit.model.robot import Robot
 
@@ -38,12 +38,18 @@ OUTPUTS = {
     "model.config": lambda r: "model.config",
     "package.xml": lambda r: "package.xml",
     "CMakeLists.txt": lambda r: "CMakeLists.txt",
+    "env-hook": lambda r: ros.env_hook_path(r),
+    "display-launch": lambda r: ros.launch_path(r, "display"),
+    "gazebo-launch": lambda r: ros.launch_path(r, "gazebo"),
+    "rviz": lambda r: f"rviz/{r.name}.rviz",
     "controllers": lambda r: "config/controllers.yaml",
 }
 # emitters that read only the robot's name and metadata (no geometry, no inertials)
-METADATA_ONLY = {"model.config", "package.xml", "CMakeLists.txt", "mjcf-scene"}
+METADATA_ONLY = {"model.config", "mjcf-scene"}
 # emitters that read the robot's structure but no inertial or mesh fact
 STRUCTURE_ONLY = {"controllers"}
+# the ROS package files: the unfinalized robot (which folders, sensors, actuators, worlds, metadata)
+ROS_PACKAGE = {"package.xml", "CMakeLists.txt", "env-hook", "display-launch", "gazebo-launch"}
 
 
 def _template_files(emitter: str) -> list[str]:
@@ -130,9 +136,14 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                                          "version": actions.FACTS_VERSION})],
             "clean": True,
         })
+    from robotkit.mesh.io import companions
+
+    extras: dict[str, str] = {}  # textures and material files the copied meshes reference
     for file_name, (source, checked) in sorted(copies.items()):
         target = str(root / "meshes" / "visual" / file_name)
         mesh_outputs.append(target)
+        for rel in companions(source):
+            extras.setdefault(rel, os.path.join(os.path.dirname(source), rel))
         tasks.append({
             "name": f"{robot.name}:copy:{file_name}",
             "doc": f"visual mesh {file_name}",
@@ -140,6 +151,16 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             # after its mesh tasks: a file that cannot be used is never copied
             "file_dep": [source, *checked],
             "targets": [target],
+            "clean": True,
+        })
+
+    for rel, source in sorted(extras.items()):
+        tasks.append({
+            "name": f"{robot.name}:copy:{rel}",
+            "doc": f"texture or material file {rel}",
+            "actions": [(actions.copy_file, [source, str(root / "meshes" / "visual" / rel)])],
+            "file_dep": [source],
+            "targets": [str(root / "meshes" / "visual" / rel)],
             "clean": True,
         })
 
@@ -183,7 +204,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     out_facts = {**{k: facts[k] for k in recentered}, **proxies}
     structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
     options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True},
-               "mjcf": {"meshes": True}}
+               "mjcf": {"meshes": True}, "rviz": {"raw": True, "facts": True},
+               **{e: {"raw": True} for e in ROS_PACKAGE}}
     for emitter, rel in OUTPUTS.items():
         if emitter == "controllers" and not robot.actuators:
             continue
@@ -191,9 +213,18 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
         opts = options.get(emitter, {})
         if emitter == "report":
             subject, reads, facts_in, inertials_in = robot, structure, {**facts, **proxies}, inertials
+        elif emitter == "rviz":  # the visual geometry's extent, the sensors' topics: no inertial
+            subject, facts_in, inertials_in = robot, {k: facts[k] for k in shown if k in facts}, {}
+            reads = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
+                                            for link in structure["links"]]}
+        elif emitter in ROS_PACKAGE:
+            subject, facts_in, inertials_in = robot, {}, {}
+            reads = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators")}
+            reads.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds],
+                         meshes=bool(robot.meshes()))
         elif emitter in STRUCTURE_ONLY:
             subject, facts_in, inertials_in = robot, {}, {}
-            reads = {"name": robot.name, "ros_control": robot.ros_control,
+            reads = {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,
                      "actuators": [asdict(a) for a in robot.actuators]}
         elif emitter in METADATA_ONLY:
             subject = replace(robot, links=(), joints=(), materials=())
@@ -239,6 +270,18 @@ def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
             "targets": [str(t) for t in targets],
             "uptodate": [config_changed({"height": w.height, "unknown_as_wall": w.unknown_as_wall,
                                          "spawn": spawn, "templates": _world_templates()})],
+            "clean": True,
+        })
+        # the same world, without the robot (launch/gazebo spawns it), in the ROS package's worlds/
+        pkg = out_dir / robot.name / "worlds"
+        tasks.append({
+            "name": f"{robot.name}:world:{w.name}",
+            "doc": f"worlds/{w.name}/ of package {robot.name}",
+            "actions": [(actions.world, [w.map, str(pkg), w.name, w.height, w.unknown_as_wall, None])],
+            "file_dep": [w.map] + _map_image(w.map),
+            "targets": [str(pkg / t.relative_to(root.parent)) for t in targets],
+            "uptodate": [config_changed({"height": w.height, "unknown_as_wall": w.unknown_as_wall,
+                                         "templates": _world_templates()})],
             "clean": True,
         })
     return tasks
@@ -300,9 +343,10 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
     return out
 
 
-def load_robots(recipe_files, args: dict[str, str] | None = None,
+def load_robots(recipe_files, ros: str | None = None, args: dict[str, str] | None = None,
                 ignore_unknown_args: bool = False) -> list[tuple[object, Robot]]:
-    """Load and resolve every recipe (every variant of each); all problems of all recipes together.
+    """Load and resolve every recipe (every variant of each; ``ros`` overrides their ``ros`` key);
+    all problems of all recipes together.
 
     ``args``: ``--arg`` overrides (name -> text); with ``ignore_unknown_args`` a recipe ignores the
     ones it does not declare (doit builds many recipes with one set of arguments)."""
@@ -318,7 +362,7 @@ def load_robots(recipe_files, args: dict[str, str] | None = None,
         for loaded in read_recipes(f, args, ignore_unknown_args):
             declared.update(loaded.arg_names)
             try:
-                robot = resolve_checked(loaded)
+                robot = resolve_checked(loaded, ros)
             except RobotkitError as exc:
                 problems.extend(p for p in exc.problems if p not in problems)
                 continue
@@ -343,6 +387,6 @@ def load_robots(recipe_files, args: dict[str, str] | None = None,
 def all_tasks(recipe_files, out_dir, args: dict[str, str] | None = None,
               ignore_unknown_args: bool = False) -> list[dict]:
     tasks = []
-    for loaded, robot in load_robots(recipe_files, args, ignore_unknown_args):
+    for loaded, robot in load_robots(recipe_files, None, args, ignore_unknown_args):
         tasks.extend(robot_tasks(robot, out_dir, mesh_locations(loaded, robot)))
     return tasks

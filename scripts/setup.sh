@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs robotkit into ./.venv (Debian 12 / Python >= 3.11). With --test, also what the
 # tests need: pytest and MuJoCo from PyPI, and the validators check_urdf (liburdfdom-tools)
-# and `ign sdf` (libsdformat-dev, ignition-tools) from Debian's packages.
+# and `ign sdf` (libsdformat-dev, ignition-tools) from Debian's packages, and Debian's ROS 1
+# (catkin, roslaunch, RViz, tf2, Xvfb) that the generated ROS packages are launched with.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -10,6 +11,12 @@ python3 -c "import ensurepip, venv" 2>/dev/null || apt_need+=(python3-venv)
 if [ "${1:-}" = "--test" ]; then
   command -v check_urdf >/dev/null || apt_need+=(liburdfdom-tools)
   command -v ign >/dev/null || apt_need+=(libsdformat-dev ignition-tools)
+  # ROS 1 from Debian 12, for the generated catkin packages: build, launch, RViz under Xvfb, tf2
+  ros1=(ros-core rosbash rospack-tools catkin python3-catkin-pkg python3-empy cmake g++ make
+        ros-robot-state-publisher joint-state-publisher joint-state-publisher-gui rviz python3-rospy
+        python3-tf2-ros tf2-tools xvfb)
+  { command -v catkin_make && command -v roslaunch && command -v rviz && command -v Xvfb \
+    && /usr/bin/python3 -c "import rospy, tf2_ros"; } >/dev/null 2>&1 || apt_need+=("${ros1[@]}")
 fi
 if [ ${#apt_need[@]} -gt 0 ]; then
   sudo=""; [ "$(id -u)" = 0 ] || sudo="sudo"

@@ -194,7 +194,8 @@ def test_exit_codes_and_formats(tmp_path):
 
 def test_recipe_check_annotates_the_recipe_line(tmp_path):
     recipe = tmp_path / "r.yaml"
-    recipe.write_text("robot: heavy\nmeasured_mass: 10\nlinks:\n  a:\n    visual: {box: {size: [0.1, 0.1, 0.1]}}\n")
+    recipe.write_text("robot: heavy\nmeasured_mass: 10\nlinks:\n  a:\n    visual: {box: {size: [0.1, 0.1, 0.1]}}\n"
+                      "metadata: {maintainers: [{name: A, email: a@example.org}]}\n")  # no package warning
     proc = run_cli("check", recipe, "--out", tmp_path / "out", "--format", "github")
     assert proc.returncode == 1, proc.stdout + proc.stderr
     assert proc.stdout == (f"::error file={recipe},line=1,title=robotkit total-mass::robot: the links weigh 1 kg "

@@ -243,6 +243,14 @@ def test_public_robot_imported_built_and_loaded_everywhere(tmp_path, name, entry
     findings, summary = consumer_findings(b)
     assert [str(f) for f in findings] == []
     assert smoke_test(b.dir / "mjcf" / "scene.xml") == []
+    if name == "aliengo":
+        # the trunk's texture travels with its DAE; calf.dae is in inches (<unit meter="0.0254">):
+        # MuJoCo's STL copy is in metres, as RViz and Gazebo show the DAE
+        assert (b.dir / "meshes" / "visual" / "trunk_uv_base_final.png").is_file()
+        import trimesh
+
+        calf = trimesh.load(b.dir / "meshes" / "mjcf" / "calf.stl")
+        assert 0.3 < max(calf.extents) < 0.35, calf.extents
 
 
 def test_check_names_what_each_consumer_sees_on_a_foreign_urdf(assets):
@@ -261,3 +269,18 @@ def test_check_names_what_each_consumer_sees_on_a_foreign_urdf(assets):
     assert ("Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"
             in messages)  # ... and so did the consumers
     assert any(m.startswith("Drake (URDF) refuses the robot: MakeConvexHull only applies to .obj") for m in messages)
+
+
+def test_check_names_the_1_kg_default_of_an_sdf_link(tmp_path):
+    sdf = tmp_path / "m.sdf"
+    sdf.write_text('<?xml version="1.0"?>\n<sdf version="1.9"><model name="m"><link name="a"/>'
+                   "<link name=\"b\"><inertial><mass>2</mass><inertia><ixx>1</ixx><iyy>1</iyy><izz>1</izz>"
+                   "</inertia></inertial></link><joint name=\"j\" type=\"fixed\"><parent>a</parent><child>b</child>"
+                   "</joint></model></sdf>\n")
+    proc = run_cli("check", sdf, cwd=tmp_path)
+    assert proc.returncode == 1
+    assert proc.stdout.splitlines() == [
+        "link 'a' (m.sdf)",
+        "  error: has no <inertial>: Gazebo and Drake give it a mass of 1 kg and a unit inertia [consumer]",
+        "    hint: give it an <inertial>, or make a massless thing a <frame>",
+        "m.sdf: 1 error, 0 warnings"]

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import shutil
 import textwrap
 import xml.etree.ElementTree as ET
 from dataclasses import replace
@@ -776,3 +777,27 @@ def test_missing_xacro_argument_and_bad_package_path(tmp_path, monkeypatch):
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "a.yaml", {"p": str(tmp_path / "nowhere")}, {"link_name": "b"})
     assert info.value.lines() == [f"--package-path p={tmp_path / 'nowhere'}: no such folder"]
+
+
+def test_metadata_comes_from_the_package_xml(tmp_path):
+    """kinova_description's package.xml (format 1, catkin): the recipe gets its metadata and ros: ros1."""
+    pkg = tmp_path / "kinova_description"
+    (pkg / "urdf").mkdir(parents=True)
+    shutil.copyfile(ASSETS / "robots" / "kinova_description" / "package.xml", pkg / "package.xml")
+    (pkg / "urdf" / "box.urdf").write_text(
+        '<robot name="box"><link name="base"><visual><geometry><box size="1 1 1"/></geometry></visual></link></robot>')
+    result = import_file(pkg / "urdf" / "box.urdf", tmp_path / "box.yaml", {}, {})
+    assert f"metadata from {pkg / 'package.xml'}" in result.warnings
+    data = yaml.safe_load((tmp_path / "box.yaml").read_text())
+    assert data["ros"] == "ros1"
+    assert data["metadata"] == {
+        "version": "0.0.1",
+        "description": "3D model of various Kinova robotic arms. Includes the model and URDF files for working "
+                       "with an arm in RViz or Gazebo.",
+        "authors": [{"name": "Kinova Support"}],
+        "maintainers": [{"name": "Kinova Support", "email": "support@kinova.ca"}],
+        "license": "BSD",
+        "urls": {"website": "http://ros.org/wiki/kinova_description"}}
+    build([tmp_path / "box.yaml"], tmp_path / "out")
+    assert '<maintainer email="support@kinova.ca">Kinova Support</maintainer>' in (
+        tmp_path / "out" / "box" / "package.xml").read_text()

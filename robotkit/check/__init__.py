@@ -140,6 +140,14 @@ def _inertial_lints(path: Path, kind: str) -> list[Finding]:
     except Exception as exc:  # an invalid file is reported by its validator
         return [Finding("warning", "inertia", str(path), f"could not read inertials: {exc}")]
     out = []
+    if kind == "sdf":  # what Gazebo and Drake will see: SDF's default for a link without <inertial>
+        import xml.etree.ElementTree as ET
+
+        for el in ET.parse(path).getroot().iter("link"):
+            if el.find("inertial") is None:
+                out.append(Finding("error", "consumer", f"link '{el.get('name')}'",
+                                   "has no <inertial>: Gazebo and Drake give it a mass of 1 kg and a unit inertia",
+                                   "give it an <inertial>, or make a massless thing a <frame>", file=str(path)))
     for link in model.links.values():
         if link.mass == 0 and not link.inertia.any():
             continue

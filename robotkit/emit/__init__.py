@@ -20,15 +20,39 @@ def _model_config(robot, sdf: str, **_):
 
 
 def _package_xml(robot, **_):
-    from robotkit.emit.gazebo import render_package_xml
+    from robotkit.emit.ros import render_package_xml
 
     return render_package_xml(robot)
 
 
 def _cmakelists(robot, **_):
-    from robotkit.emit.gazebo import render_cmakelists
+    from robotkit.emit.ros import render_cmakelists
 
     return render_cmakelists(robot)
+
+
+def _env_hook(robot, **_):
+    from robotkit.emit.ros import render_env_hook
+
+    return render_env_hook(robot)
+
+
+def _display_launch(robot, **_):
+    from robotkit.emit.ros import render_display_launch
+
+    return render_display_launch(robot)
+
+
+def _gazebo_launch(robot, **_):
+    from robotkit.emit.ros import render_gazebo_launch
+
+    return render_gazebo_launch(robot)
+
+
+def _rviz(robot, facts=None, **_):
+    from robotkit.emit.ros import render_rviz
+
+    return render_rviz(robot, facts or {})
 
 
 def _sdf(robot, **_):
@@ -77,6 +101,10 @@ EMITTERS = {
     "model.config": _model_config,
     "package.xml": _package_xml,
     "CMakeLists.txt": _cmakelists,
+    "env-hook": _env_hook,
+    "display-launch": _display_launch,
+    "gazebo-launch": _gazebo_launch,
+    "rviz": _rviz,
     "report": _report,
     "controllers": _controllers,
     "xacro": _xacro,
@@ -94,6 +122,10 @@ TEMPLATES = {
     "model.config": ["gazebo/model.config.j2"],
     "package.xml": ["ros/package.xml.j2"],
     "CMakeLists.txt": ["ros/CMakeLists.txt.j2"],
+    "env-hook": ["ros/env-hook.sh.in.j2", "ros/env-hook.dsv.in.j2"],
+    "display-launch": ["ros/display.launch.j2", "ros/display.launch.py.j2"],
+    "gazebo-launch": ["ros/gazebo.launch.j2", "ros/gazebo.launch.py.j2"],
+    "rviz": [],
     "report": [],
     "controllers": [],
     "xacro": ["urdf/robot.urdf.xacro.j2", "urdf/robot.urdf.j2", "sensors/sdf.j2", "sensors/classic.j2"],

@@ -1,8 +1,8 @@
 """Robot -> config/controllers.yaml: the ros_control controllers for the recipe's actuators.
 
-ROS 2 (``ros_control: ros2``): a controller_manager file with a joint state broadcaster and one
+ROS 2 (``ros: ros2``): a controller_manager file with a joint state broadcaster and one
 group controller per command interface; effort joints get a joint_trajectory_controller with
-their PID gains.  ROS 1 (``ros_control: ros1``): one controller per joint and
+their PID gains.  ROS 1 (``ros: ros1``): one controller per joint and
 gazebo_ros_control's ``pid_gains``, the layout the turret_bot tutorial uses.
 """
 
@@ -20,7 +20,7 @@ ROS1_TYPES = {"position": "position_controllers/JointPositionController",
 
 
 def controllers(robot: Robot) -> dict:
-    if robot.ros_control == "ros1":
+    if robot.ros == "ros1":
         data: dict = {"joint_state_controller": {"type": "joint_state_controller/JointStateController",
                                                  "publish_rate": 50}}
         for a in robot.actuators:

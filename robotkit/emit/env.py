@@ -44,6 +44,7 @@ def vec(values) -> str:
 @functools.lru_cache(maxsize=8)
 def environment(extra: tuple[str, ...] = ()):
     import jinja2
+    import markupsafe
 
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(template_dirs(extra)),
@@ -55,6 +56,7 @@ def environment(extra: tuple[str, ...] = ()):
     )
     env.filters["fmt"] = fmt
     env.filters["vec"] = vec
+    env.filters["py"] = lambda v: markupsafe.Markup(repr(v))  # a Python literal, for launch/*.launch.py
     return env
 
 

@@ -69,9 +69,10 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
                 if f is not None and not f.get("convex", True):
                     out.append(f"link '{link.name}': collision mesh '{g.shape.mesh.file_name}' is not convex; "
                                "MuJoCo collides with its convex hull")
+    from robotkit.emit.sdf import extras_losses
     from robotkit.emit.sensors import losses as sensor_losses
 
-    return out + sensor_losses(robot)["mjcf"]
+    return out + extras_losses(robot, "the MJCF") + sensor_losses(robot)["mjcf"]
 
 
 def _geom(robot: Robot, geom: Geom, name: str, assets: dict, role: str = "visual") -> dict:

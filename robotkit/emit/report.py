@@ -19,9 +19,10 @@ def urdf_losses(robot: Robot) -> list[str]:
 
 
 def losses(robot: Robot, facts: dict) -> dict[str, list[str]]:
-    from robotkit.emit import mjcf, sdf
+    from robotkit.emit import mjcf, ros, sdf
 
-    return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts)}
+    return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts),
+            "package": ros.losses(robot)}
 
 
 def consumers(robot: Robot) -> dict:

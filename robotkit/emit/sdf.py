@@ -43,7 +43,22 @@ def losses(robot: Robot) -> list[str]:
                        f"it moves independently of '{j.mimic.joint}' in Gazebo")
         if j.dynamics is not None and j.dynamics.armature:
             out.append(f"joint '{j.name}': armature is not written (SDF has no such joint property)")
+    out += extras_losses(robot, "model.sdf")
     return out + sensor_losses(robot)["sdf"]
+
+
+def extras_losses(robot: Robot, where: str) -> list[str]:
+    """``urdf_extras`` go into the URDF only: say what another format does not get."""
+    import re
+
+    if not robot.urdf_extras:
+        return []
+    heads = [re.match(r"\s*(<[^>]*>)", x).group(1) if re.match(r"\s*(<[^>]*>)", x) else x[:40]
+             for x in robot.urdf_extras]
+    sensors = sum("<sensor" in x for x in robot.urdf_extras)
+    what = f" ({sensors} sensor{'s' * (sensors != 1)} among them)" if sensors else ""
+    return [f"{len(heads)} urdf_extras element{'s' * (len(heads) != 1)}{what} are in the URDF only, not in "
+            f"{where}: {', '.join(heads[:5])}{', ...' if len(heads) > 5 else ''}"]
 
 
 def joint_names(robot: Robot) -> dict[str, str]:

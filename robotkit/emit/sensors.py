@@ -54,7 +54,7 @@ def sensor_context(robot: Robot, s: Sensor) -> dict:
     host, pose = host_of(robot, s.link)
     ctx = {"name": s.name, "type": s.type, "link": s.link, "update_rate": s.update_rate, "topic": s.topic,
            "params": s.params, "optical_frame": s.optical_frame or s.link, "host": host, "host_pose": pose,
-           "sdf_type": SDF_TYPES[s.type], "classic_type": CLASSIC_TYPES[s.type]}
+           "sdf_type": SDF_TYPES[s.type], "classic_type": CLASSIC_TYPES[s.type], "ros": robot.ros}
     if s.type in ("lidar", "sonar"):
         ctx["scan"] = scan(s)
     if s.type == "contact":
@@ -146,3 +146,38 @@ def losses(robot: Robot) -> dict[str, list[str]]:
         if a.i:
             mjcf.append(f"actuator '{a.joint}': MuJoCo servos have no integral term (i = {a.i:g} dropped)")
     return {"sdf": sdf, "mjcf": mjcf}
+
+
+# ---------------------------------------------------------------- ROS topics
+
+
+# sensor type -> (RViz display, ROS message, Gazebo Sim message) of the topic it publishes
+ROS_MESSAGES = {
+    "camera": ("Image", "sensor_msgs/msg/Image", "gz.msgs.Image"),
+    "depth": ("Image", "sensor_msgs/msg/Image", "gz.msgs.Image"),
+    "lidar": ("LaserScan", "sensor_msgs/msg/LaserScan", "gz.msgs.LaserScan"),
+    "sonar": ("Range", "sensor_msgs/msg/Range", None),
+    "imu": (None, "sensor_msgs/msg/Imu", "gz.msgs.IMU"),
+    "contact": (None, "ros_gz_interfaces/msg/Contacts", "gz.msgs.Contacts"),
+}
+
+
+def ros_topics(robot: Robot) -> list[dict]:
+    """The ROS topic each sensor publishes on, as the URDF's Gazebo plugins (or, for Gazebo Sim,
+    the ros_gz bridge of launch/gazebo.launch.py) name it: sensor, topic, RViz display (or None),
+    ROS message type, Gazebo Sim message type (bridged topics only)."""
+    out = []
+    for s in robot.sensors:
+        display, ros_type, gz_type = ROS_MESSAGES[s.type]
+        topic = "/" + s.topic.strip("/")
+        if robot.gazebo == "classic" and s.type in ("camera", "depth"):
+            topic += "/image_raw"  # gazebo_ros_camera / openni_kinect: <camera name>/image_raw
+        if robot.gazebo == "sim" and s.type == "sonar":
+            display, ros_type, gz_type = "LaserScan", "sensor_msgs/msg/LaserScan", "gz.msgs.LaserScan"  # a gpu_lidar cone
+        if robot.gazebo == "classic" and s.type == "contact":
+            ros_type = "gazebo_msgs/msg/ContactsState"  # gazebo_ros_bumper
+        if robot.ros == "ros1":
+            ros_type = ros_type.replace("/msg/", "/")
+        out.append({"sensor": s.name, "type": s.type, "topic": topic, "display": display, "ros_type": ros_type,
+                    "gz_type": gz_type if robot.gazebo == "sim" else None, "frame": s.optical_frame or s.link})
+    return out

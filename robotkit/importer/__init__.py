@@ -52,6 +52,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     ``copy_meshes`` copies the meshes below the recipe's folder (``meshes/``) instead of
     referencing them where they are.
     """
+    from robotkit.importer.package_xml import package_metadata
     from robotkit.importer.urdf_to_recipe import dump_recipe, urdf_to_recipe
     from robotkit.importer.xacro_expand import check_package_paths, expand
 
@@ -83,6 +84,12 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     warnings.extend(conv.warnings)
     inputs.extend(sorted({m.source for m in conv.meshes.values()}))
     recipe = conv.recipe
+    metadata, ros, md_warnings = package_metadata(source)
+    warnings.extend(md_warnings)
+    if metadata:
+        recipe["metadata"] = metadata
+    if ros == "ros1":  # ros2 is the default
+        recipe["ros"] = ros
     _open_meshes(conv, recipe, warnings, recompute_inertials)
     _validate(recipe, source)
 

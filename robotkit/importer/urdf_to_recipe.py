@@ -33,7 +33,7 @@ from robotkit.errors import Problem, RobotkitError, display_path
 from robotkit.recipe.schema import NAME_RE, UNITS
 
 GREY = [0.5, 0.5, 0.5, 1.0]
-TOP_KEYS = ("robot", "units", "density", "materials", "links", "joints", "urdf_extras")
+TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "materials", "links", "joints", "urdf_extras")
 MESH_FORMATS = (".stl", ".obj", ".dae")
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
 

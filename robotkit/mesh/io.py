@@ -70,6 +70,41 @@ def _dae_in_metres(path: str):
     return geometry
 
 
+def companions(path: str) -> list[str]:
+    """Files a mesh file references and its viewers load beside it, as relative paths: a
+    COLLADA file's images (``<init_from>``), an OBJ's material library and that library's
+    texture maps.  Only existing files below the mesh's own folder (no ``..``, no absolute
+    paths): what a copy of the mesh needs next to it.  Reads text only (cheap)."""
+    import re
+
+    folder = os.path.dirname(os.path.abspath(path))
+    ext = os.path.splitext(path)[1].lower()
+
+    def text(p: str) -> str:
+        try:
+            with open(p, encoding="utf-8", errors="replace") as f:
+                return f.read(4_000_000)
+        except OSError:
+            return ""
+
+    names: list[str] = []
+    if ext == ".dae":
+        names = re.findall(r"<init_from>\s*([^<]+?)\s*</init_from>", text(path))
+    elif ext == ".obj":
+        for lib in re.findall(r"^mtllib\s+(.+?)\s*$", text(path), re.M):
+            names.append(lib)
+            names += re.findall(r"^\s*(?:map_\w+|bump|disp|decal|refl)\s+(?:-\S+\s+\S+\s+)*(\S+)\s*$",
+                                text(os.path.join(folder, lib)), re.M)
+    out = []
+    for name in names:
+        name = name.strip().removeprefix("file://").removeprefix("./")
+        if not name or os.path.isabs(name) or ".." in name.replace("\\", "/").split("/"):
+            continue
+        if os.path.isfile(os.path.join(folder, name)) and name not in out:
+            out.append(name)
+    return out
+
+
 def read_vertices(path: str) -> np.ndarray:
     """The vertices of a mesh file, in the file's coordinates (metres for COLLADA)."""
     return np.asarray(load_mesh(path).vertices, dtype=np.float64)

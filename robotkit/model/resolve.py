@@ -35,22 +35,23 @@ def _t(v) -> tuple[float, ...]:
     return tuple(float(x) for x in v)
 
 
-def resolve_checked(loaded: LoadedRecipe) -> Robot:
+def resolve_checked(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
     """The resolved robot; RecipeError with the loading problems and resolution's own, all together."""
     from robotkit.recipe.load import sort_problems
 
     if not loaded.problems:
-        return resolve(loaded)
+        return resolve(loaded, ros)
     problems = list(loaded.problems)
     if loaded.recipe is not None:
         try:
-            resolve(loaded)
+            resolve(loaded, ros)
         except RecipeError as exc:
             problems.extend(p for p in exc.problems if p not in problems)
     raise RecipeError(sort_problems(problems, loaded.file))
 
 
-def resolve(loaded: LoadedRecipe) -> Robot:
+def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
+    """The structural robot of a loaded recipe; ``ros`` overrides the recipe's ``ros``."""
     r = loaded.recipe
     marks = loaded.marks
     base_dir = os.path.dirname(str(loaded.file))
@@ -261,6 +262,11 @@ def resolve(loaded: LoadedRecipe) -> Robot:
             problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' does not exist"))
         spawn = Pose(_t(w.spawn.xyz), _t(w.spawn.rpy)) if w.spawn is not None else None
         worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall, spawn))
+    ros = ros or r.ros
+    gazebo = r.gazebo or ("classic" if ros == "ros1" else "sim")
+    if ros == "ros1" and gazebo == "sim":
+        problems.append(marks.problem(("gazebo",), "ROS 1 has no Gazebo Sim plugins (gz_ros2_control, ros_gz): "
+                                                   "use gazebo: classic, or ros: ros2"))
     links = _share_mesh_tasks(links)
     if loaded.partial != "tree":  # joints dropped as invalid would show as false tree problems
         problems.extend(_check_tree(link_names, joints, marks))
@@ -268,9 +274,12 @@ def resolve(loaded: LoadedRecipe) -> Robot:
         raise RecipeError(problems)
 
     md = r.metadata
-    metadata = Metadata(md.version, md.description, tuple(Author(a.name, a.email) for a in md.authors), md.license)
+    authors = tuple(Author(a.name, a.email) for a in md.authors)
+    maintainers = tuple(Author(m.name, m.email) for m in md.maintainers) or tuple(a for a in authors if a.email)
+    urls = tuple((k, v) for k, v in md.urls.model_dump().items() if v)
+    metadata = Metadata(md.version, md.description, authors, md.license, maintainers, urls)
     return Robot(r.robot, tuple(links), tuple(joints), materials, metadata, r.self_collide, tuple(r.urdf_extras),
-                 tuple(worlds), tuple(sensors), tuple(actuators), r.gazebo, r.ros_control, r.base)
+                 tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base)
 
 
 OPTICAL = (-math.pi / 2, 0.0, -math.pi / 2)

@@ -251,6 +251,10 @@ class Metadata:
     description: str = ""
     authors: tuple[Author, ...] = ()
     license: str | None = None
+    maintainers: tuple[Author, ...] = ()
+    """Given ones, else the authors with an e-mail address; may be empty (the build warns)."""
+    urls: tuple[tuple[str, str], ...] = ()
+    """(type, address) pairs: website, repository, bugtracker."""
 
 
 @dataclass(frozen=True)
@@ -296,8 +300,8 @@ class Robot:
     worlds: tuple[World, ...] = ()
     sensors: tuple[Sensor, ...] = ()
     actuators: tuple[Actuator, ...] = ()
-    gazebo: str = "sim"
-    ros_control: str = "ros2"
+    gazebo: str = "sim"  # sim | classic
+    ros: str = "ros2"  # ros2 | ros1: the package type, ros_control flavour, launch files
     base: str = "fixed"
 
     def frame_links(self) -> set[str]:

@@ -359,12 +359,16 @@ def _message(err: dict) -> str:
 
 
 def schema_problems(exc, marks: Marks, model) -> list[Problem]:
+    from robotkit.recipe.schema import RENAMED
+
     out: list[Problem] = []
     seen = set()
     for err in exc.errors(include_url=False):
         loc = tuple(p for p in err["loc"] if p not in _TAGS)
         msg = _message(err)
-        if err["type"] == "extra_forbidden" and loc:
+        if err["type"] == "extra_forbidden" and len(loc) == 1 and loc[0] in RENAMED:
+            msg = f"renamed to '{RENAMED[loc[0]]}' (same values)"
+        elif err["type"] == "extra_forbidden" and loc:
             choices = _fields_at(model, [p for p in err["loc"][:-1]])
             close = difflib.get_close_matches(str(loc[-1]), choices, n=1)
             if close:

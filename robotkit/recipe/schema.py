@@ -393,17 +393,57 @@ class Material(Strict):
     """Gazebo classic material name, e.g. ``Gazebo/Green`` (written to the URDF's gazebo block)."""
 
 
+# the address form catkin_pkg accepts for package.xml (catkin_pkg.package.Person.validate)
+EMAIL_RE = re.compile(r"^[-a-zA-Z0-9_%+]+(\.[-a-zA-Z0-9_%+]+)*@[-a-zA-Z0-9%]+(\.[-a-zA-Z0-9%]+)*\.[a-zA-Z]{2,}$")
+
+
+def _check_email(v):
+    if v is not None and not EMAIL_RE.match(v):
+        raise ValueError(f"not an e-mail address: {v!r}")
+    return v
+
+
 class Author(Strict):
     name: str
     email: str | None = None
 
+    _email = field_validator("email")(_check_email)
+
+
+class Maintainer(Strict):
+    name: str
+    email: str
+    """Required: package.xml's ``<maintainer>`` needs an address."""
+
+    _email = field_validator("email")(_check_email)
+
+
+class Urls(Strict):
+    """Addresses written to package.xml as ``<url type="...">``."""
+
+    website: str | None = None
+    repository: str | None = None
+    bugtracker: str | None = None
+
 
 class Metadata(Strict):
     version: str = "1.0"
+    """Version (``X``, ``X.Y`` or ``X.Y.Z``; package.xml gets ``X.Y.Z``)."""
     description: str = ""
     authors: list[Author] = []
+    """Authors (model.config, package.xml ``<author>``)."""
+    maintainers: list[Maintainer] = []
+    """Who maintains the ROS package (package.xml ``<maintainer>``). Default: the authors that have an e-mail address; with none, the build warns and package.xml names no maintainer (catkin and colcon then refuse the package)."""
     license: str | None = None
     """Licence of the robot description (SPDX identifier), written to package.xml."""
+    urls: Urls = Urls()
+
+    @field_validator("version")
+    @classmethod
+    def _version(cls, v):
+        if not re.fullmatch(r"\d+(\.\d+){0,2}", v):
+            raise ValueError(f"version must be X, X.Y or X.Y.Z with whole numbers (got {v!r})")
+        return v
 
 
 class Defaults(Strict):
@@ -537,6 +577,10 @@ class World(Strict):
     """Place this recipe's robot in the world (Gazebo world and MuJoCo scene) at this pose in the map frame."""
 
 
+# keys that were renamed: old name -> new name (an old recipe gets told, not "unknown key")
+RENAMED = {"ros_control": "ros"}
+
+
 Scalar = bool | float | str
 
 
@@ -620,10 +664,10 @@ class Recipe(Strict):
     """Actuators by joint name: transmissions / ros2_control in the URDF, actuators in the MJCF, controllers YAML."""
     base: Literal["fixed", "free"] = "fixed"
     """How the root link sits in MuJoCo: ``fixed`` (welded to the world, as MuJoCo imports a URDF) or ``free`` (a free joint: a mobile robot). In Gazebo a model without a ``world`` link is always free."""
-    gazebo: Literal["sim", "classic"] = "sim"
-    """Which Gazebo the URDF's sensor blocks target: ``sim`` (Gazebo Sim, gz-sim systems) or ``classic`` (gazebo_ros plugins)."""
-    ros_control: Literal["ros2", "ros1"] = "ros2"
-    """Which ros_control the URDF declares: ``ros2`` (``<ros2_control>`` tags) or ``ros1`` (``<transmission>`` + gazebo_ros_control)."""
+    ros: Literal["ros2", "ros1"] = "ros2"
+    """Which ROS the package is for, and so everything that depends on it: ``ros2`` (ament_cmake package, ``<ros2_control>`` tags, launch/*.launch.py, ros_gz) or ``ros1`` (catkin package, ``<transmission>`` + gazebo_ros_control, roslaunch XML, gazebo_ros). ``robotkit build --ros`` overrides it."""
+    gazebo: Literal["sim", "classic"] | None = None
+    """Which Gazebo the URDF's sensor and control plugins and launch/gazebo target: ``sim`` (Gazebo Sim, gz-sim systems; ROS 2 only) or ``classic`` (gazebo_ros plugins). Default: ``sim`` for ROS 2, ``classic`` for ROS 1."""
     worlds: dict[str, World] = {}
     """Worlds made from occupancy maps, by name (``robotkit world`` does the same from the command line)."""
     args: dict[str, Arg | Scalar] = {}
