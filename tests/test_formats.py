@@ -13,21 +13,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import GOLDEN, assert_golden, RECIPES, run_cli, write_recipe
+from conftest import GOLDEN, assert_golden, RECIPES, example_robots, run_cli, write_recipe
 from robotkit.build import build
 from robotkit.check.equivalence import equivalence
 from robotkit.check.simulation import smoke_test
 from validators import check_urdf, ign_sdf_check, mujoco, require
 
 
-def _robots() -> list[str]:
-    """The robot folders the example recipes build (a recipe with variants builds several)."""
-    from robotkit.recipe.load import load_recipes
-
-    return sorted(one.recipe.robot for p in RECIPES.glob("*.yaml") for one in load_recipes(p))
-
-
-EXAMPLES = _robots()
+EXAMPLES = example_robots()
 
 
 def assert_equivalent(robot_dir: Path, configs: int = 100):

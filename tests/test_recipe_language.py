@@ -551,3 +551,12 @@ def test_turtlebot3_burger_written_with_parts_is_the_imported_robot(tmp_path):
     assert compare(read_urdf(tmp_path / "new" / name), read_urdf(tmp_path / "old" / name), TOL, configs=100) == []
     a, b = (tmp_path / "new" / name).read_text(), (tmp_path / "old" / name).read_text()
     assert sorted(a.splitlines()) == sorted(b.splitlines())  # the same URDF, links in another order
+    # and its flat expansion (Gazebo XML as blocks) builds the very same bytes
+    proc = run_cli("expand", RECIPES / "turtlebot3_burger.yaml")
+    assert proc.returncode == 0, proc.stderr
+    assert "urdf_extras:\n- |-\n  <gazebo reference=\"wheel_left_link\">\n" in proc.stdout
+    (tmp_path / "meshes").symlink_to(RECIPES / "meshes")  # the flat recipe names them relative to itself
+    flat = tmp_path / "flat.yaml"
+    flat.write_text(proc.stdout, encoding="utf-8")
+    assert not build([flat], tmp_path / "flat").errors
+    assert (tmp_path / "flat" / name).read_text() == a

@@ -27,6 +27,7 @@ def flat_data(loaded) -> dict:
 
     data = rel(data)
     data.pop("defaults", None)  # already merged into every link and joint
+    data.pop("include", None)  # already merged too
     return {"robot": data.pop("robot"), **data}
 
 
@@ -43,8 +44,21 @@ def flat_yaml(file: str, args: dict[str, str] | None = None, variant: str | None
             raise RecipeError(Problem(f"no variant named '{variant}' (variants: {names})", file=file,
                                       key="--variant"))
         loaded = chosen
+    class Dumper(yaml.SafeDumper):
+        pass
+
+    def text(dumper, value):  # raw XML as a block, as a person writes it
+        return dumper.represent_scalar("tag:yaml.org,2002:str", value, style="|" if "\n" in value else None)
+
+    Dumper.add_representer(str, text)
     docs = []
     for one in loaded:
         head = f"# variant {one.variant}\n" if one.variant is not None else ""
-        docs.append(head + yaml.safe_dump(flat_data(one), sort_keys=False, default_flow_style=None, width=100))
+        data = flat_data(one)
+        extras = data.pop("urdf_extras", None)
+        body = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
+        if extras:
+            body += yaml.dump({"urdf_extras": extras}, Dumper=Dumper, sort_keys=False, default_flow_style=False,
+                              width=100)
+        docs.append(head + body)
     return "---\n".join(docs)
