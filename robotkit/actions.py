@@ -185,7 +185,8 @@ def _cache():
 @_user_errors_fail
 def process_visual(source: str, scale, decimate, repair: bool, where: dict, target: str, report: str):
     """A processed visual mesh: repaired and decimated, written as a binary STL in metres."""
-    from robotkit.mesh.decimate import decimate as run_decimate
+    from robotkit.mesh.decimate import decimate as run_decimate, library
+    from robotkit.mesh.export import stl_bytes
     from robotkit.mesh.io import load_mesh
     from robotkit.mesh.repair import repair as run_repair
 
@@ -211,7 +212,7 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
         out, rep = run_decimate(mesh, target_faces=target_faces)
         return out, rep
 
-    out, rep = _cache().get_or_compute("decimate/1", {"faces": target_faces, "aggression": 7, "samples": 4000,
+    out, rep = _cache().get_or_compute("decimate/2", {"faces": target_faces, **library(), "samples": 4000,
                                                       "seed": 0, "report": True}, [mesh], compute)
     info["decimate"] = rep
     from robotkit.mesh.export import stl_bytes
@@ -286,9 +287,9 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
         faces = int(value) if how == "faces" else max(4, int(round(len(mesh.faces) * float(value))))
         if faces > len(mesh.faces):
             raise ValueError(f"decimation target {faces} faces is above the mesh's {len(mesh.faces)} faces")
-        from robotkit.mesh.decimate import decimate
+        from robotkit.mesh.decimate import decimate, library
 
-        op, args, make = "collision-decimate/1", {"faces": faces, "aggression": 7, "seed": 0}, \
+        op, args, make = "collision-decimate/2", {"faces": faces, **library(), "seed": 0}, \
             (lambda: [decimate(mesh, target_faces=faces, samples=0)[0]])
     elif kind == "hull":
         from robotkit.mesh.hull import convex_hull

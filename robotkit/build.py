@@ -78,12 +78,11 @@ class _Recorder:
         import time
 
         start = self.started.pop(task.name, None)
-        if start is None or self.progress is None:
-            return
+        if start is None or self.progress is None or not self.progress.isatty():
+            return  # quiet when not a terminal: logs and CI output stay deterministic
         elapsed = time.perf_counter() - start
         if elapsed >= SLOW:  # long tasks (CoACD, decimation) are named with their time
-            clear = "\r\033[K" if self.progress.isatty() else ""
-            self.progress.write(f"{clear}  {task.name}: {elapsed:.1f} s\n")
+            self.progress.write(f"\r\033[K  {task.name}: {elapsed:.1f} s\n")
             self.progress.flush()
 
     def skip_uptodate(self, task):
@@ -134,12 +133,24 @@ def to_doit(task: dict) -> dict:
 
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
-          echo=None, progress=None, ros: str | None = None, args: dict[str, str] | None = None) -> BuildResult:
+          echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None,
+          args: dict[str, str] | None = None) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
-    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key; ``args`` sets recipe arguments (``--arg``)."""
+    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key; ``args`` sets recipe arguments (``--arg``).
+
+    The stamp of the no-op fast path (:mod:`robotkit.stamp`) is removed first and written
+    again when the build succeeds; ``stamp_options`` are the options it is kept under
+    (default :func:`robotkit.stamp.options` of the recipes and the output folder).
+    """
     from doit.cmd_base import TaskLoader2
     from doit.doit_cmd import DoitMain
     from doit.task import dict_to_task
+
+    from robotkit import stamp
+
+    if stamp_options is None:
+        stamp_options = stamp.options(recipes, out_dir)
+    stamp.remove(out_dir, stamp_options)
 
     from robotkit.tasks import load_robots, mesh_locations, robot_tasks
 
@@ -151,6 +162,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot)))
     (out / ".robotkit").mkdir(parents=True, exist_ok=True)
     recorder = _Recorder(result, echo, progress)
+    inputs = _input_stats(robots, tasks)  # before running: an edit during the build is a change
 
     class Loader(TaskLoader2):
         def setup(self, opt_values):
@@ -180,7 +192,28 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     if rc not in (0,) and not result.errors:
         result.errors.append(("doit", f"doit exited with status {rc}"))
     result.warnings = collect_warnings(tasks) + collect_losses(out, result.robots)
+    if rc == 0 and not result.errors:
+        outputs = sorted({str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])})
+        try:
+            stamp.write(out, stamp_options, inputs, outputs,
+                        {"robots": result.robots, "tasks": len(tasks), "warnings": result.warnings})
+        except OSError:
+            pass  # no stamp: the next build runs doit's checks
     return result
+
+
+def _input_stats(robots, tasks) -> dict:
+    """Every file the build reads that no task writes, with its (size, mtime) now."""
+    from robotkit import stamp
+    from robotkit.emit.env import template_dirs
+
+    targets = {str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])}
+    files = {str(Path(f).absolute()) for loaded, _ in robots for f in loaded.files}
+    files |= {str(Path(f).absolute()) for task in tasks for f in task.get("file_dep", [])}
+    for d in template_dirs():
+        for root, _dirs, names in os.walk(d):
+            files |= {os.path.join(root, n) for n in names}
+    return stamp.stats(sorted(files - targets))
 
 
 def collect_losses(out: Path, robots: list[str]) -> list[str]:

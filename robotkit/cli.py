@@ -25,15 +25,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="store_true", help="print the version and exit")
     sub = p.add_subparsers(dest="command", parser_class=_Parser)
 
-    b = sub.add_parser("build", help="build recipes into URDF, Gazebo model folders and meshes",
-                       description="Build each RECIPE into OUT/<robot>/ (incremental: only what changed reruns).")
-    b.add_argument("recipes", nargs="+", metavar="RECIPE", help="recipe YAML file(s)")
-    b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
-    b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="run N tasks in parallel processes")
-    b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
-    b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
-                                                           "recipes' `ros` key)")
-    _add_arg_option(b)
+    _add_build(sub)
 
     w = sub.add_parser("world", help="turn a ROS map_server occupancy map into a Gazebo world and MuJoCo scene",
                        description="Write OUT/<name>/ with model.config, model.sdf, meshes/<name>.stl, "
@@ -86,8 +78,37 @@ def _add_arg_option(p: argparse.ArgumentParser) -> None:
                    help="set a recipe argument (repeatable; see the recipe's args:)")
 
 
+def _add_build(sub) -> None:
+    b = sub.add_parser("build", help="build recipes into URDF, Gazebo model folders and meshes",
+                       description="Build each RECIPE into OUT/<robot>/ (incremental: only what changed reruns).")
+    b.add_argument("recipes", nargs="+", metavar="RECIPE", help="recipe YAML file(s)")
+    b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
+    b.add_argument("-j", "--jobs", type=int, default=_cores(), metavar="N",
+                   help=f"run N tasks in parallel processes (default: the {_cores()} cores this process may use)")
+    b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
+    b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
+                                                           "recipes' `ros` key)")
+    _add_arg_option(b)
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    """Only ``build``: a no-op build does not import the other commands' modules."""
+    p = _Parser(prog="robotkit", description="Declarative build system for robot description assets.")
+    p.add_argument("--version", action="store_true", help="print the version and exit")
+    _add_build(p.add_subparsers(dest="command", parser_class=_Parser))
+    return p
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = (_build_parser() if argv[:1] == ["build"] else _parser()).parse_args(argv)
     if args.version:
         from robotkit import __version__
 
@@ -96,12 +117,14 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         _parser().print_help()
         return 2
-    from robotkit.errors import RobotkitError
-
     try:
         return {"build": _build, "world": _world, "schema": _schema, "check": _check,
                 "import": _import, "expand": _expand}[args.command](args)
-    except RobotkitError as exc:
+    except Exception as exc:
+        from robotkit.errors import RobotkitError  # imported late: dataclasses costs a no-op build 10 ms
+
+        if not isinstance(exc, RobotkitError):
+            raise
         for line in exc.lines():
             print(line, file=sys.stderr)
         return exc.exit_status
@@ -111,15 +134,22 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _build(args) -> int:
-    from robotkit.build import build
+    from robotkit import stamp
 
     if args.jobs < 1:
         print("robotkit: error: -j must be at least 1", file=sys.stderr)
         return 2
     start = time.perf_counter()
+    extra = {**({"ros": args.ros} if args.ros else {}), **({"args": dict(args.arg)} if args.arg else {})}
+    opts = stamp.options(args.recipes, args.out, extra or None)
+    done = stamp.up_to_date(args.out, opts)  # nothing changed since the last successful build?
+    if done is not None:
+        return _report_up_to_date(args, done, start)
+    from robotkit.build import build
+
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
     result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, ros=args.ros,
-                   args=dict(args.arg))
+                   stamp_options=opts, args=dict(args.arg))
     if result.ran or args.verbose:
         for w in result.warnings:
             print(f"warning: {w}", file=sys.stderr)
@@ -139,6 +169,21 @@ def _build(args) -> int:
         print(f"built {names}: {len(result.ran)} tasks run, {len(result.uptodate)} up to date ({elapsed:.2f} s)")
     else:
         print(f"{names}: up to date ({len(result.uptodate)} tasks, {elapsed:.2f} s)")
+    return 0
+
+
+def _report_up_to_date(args, done: dict, start: float) -> int:
+    """What a build that runs no task prints, from the stamp (:mod:`robotkit.stamp`)."""
+    warnings = done.get("warnings", [])
+    if args.verbose:
+        for w in warnings:
+            print(f"warning: {w}", file=sys.stderr)
+    elif warnings:
+        print(f"{len(warnings)} warnings, unchanged since the last build (-v shows them; "
+              "report.json lists what each format could not express)", file=sys.stderr)
+    out = os.path.relpath(os.path.abspath(args.out))
+    names = ", ".join(f"{out}/{r}" for r in done["robots"])
+    print(f"{names}: up to date ({done['tasks']} tasks, {time.perf_counter() - start:.2f} s)")
     return 0
 
 

@@ -212,7 +212,9 @@ def test_examples_check_clean(tmp_path, name):
     # and an arm whose zero pose reaches below its base (UR5: it stands on a pedestal);
     # ur_description's hand-made (cylinder) tensors and its base COM at the origin draw
     # inertia-box and com-offset warnings, rightly
-    allowed = {"ur5": {"inertia-box", "com-offset"}}.get(name, set())
+    # turtlebot3's upstream collision box is 5.25x the volume of the base's plates, rightly warned
+    # about since its decimated visual is a closed volume (MeshLib drops the non-manifold faces)
+    allowed = {"ur5": {"inertia-box", "com-offset"}, "turtlebot3_burger": {"collision-volume"}}.get(name, set())
     assert [f for f in data["findings"] if f["check"] != "build"
             and not (f["check"] == "equivalence" and "not compared" in f["message"])
             and not (f["check"] == "simulation" and "inside the floor" in f["message"])

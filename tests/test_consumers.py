@@ -277,7 +277,7 @@ def test_check_names_the_1_kg_default_of_an_sdf_link(tmp_path):
                    "<link name=\"b\"><inertial><mass>2</mass><inertia><ixx>1</ixx><iyy>1</iyy><izz>1</izz>"
                    "</inertia></inertial></link><joint name=\"j\" type=\"fixed\"><parent>a</parent><child>b</child>"
                    "</joint></model></sdf>\n")
-    proc = run_cli("check", sdf, cwd=tmp_path)
+    proc = run_cli("check", "m.sdf", cwd=tmp_path)
     assert proc.returncode == 1
     assert proc.stdout.splitlines() == [
         "link 'a' (m.sdf)",

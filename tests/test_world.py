@@ -584,3 +584,12 @@ def test_importing_the_package_stays_light():
     code = "import sys, robotkit.world; print(sorted(m for m in ('numpy', 'PIL', 'trimesh') if m in sys.modules))"
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
     assert proc.stdout.strip() == "[]", proc.stderr
+
+
+def test_building_a_world_does_not_import_trimesh(tmp_path):
+    """The STL is written by robotkit.mesh.export from the arrays: trimesh (0.8 s to import) stays out."""
+    code = ("import sys; from robotkit.world import build_world; "
+            f"build_world({str(MAPS / 'nav2_warehouse' / 'warehouse.yaml')!r}, {str(tmp_path)!r}); "
+            "print(sorted(m for m in ('trimesh', 'scipy') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
+    assert proc.stdout.strip() == "[]", proc.stderr

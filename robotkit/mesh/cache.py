@@ -2,7 +2,7 @@
 
 **Key.**  sha256 over canonical JSON of: the cache format version, the
 operation name, the effective parameters, the versions of the libraries that
-can change a result (trimesh, coacd, fast-simplification, manifold3d, numpy,
+can change a result (trimesh, coacd, meshlib (decimation), manifold3d, numpy,
 scipy) and robotkit's version, followed by the digest of every input (raw
 bytes, or :func:`mesh_digest` of a mesh).  Changing any of them is a miss.
 
@@ -49,7 +49,7 @@ from typing import Callable
 import numpy as np
 
 CACHE_FORMAT = 1
-LIBRARIES = ("trimesh", "coacd", "fast-simplification", "manifold3d", "numpy", "scipy")
+LIBRARIES = ("trimesh", "coacd", "meshlib", "manifold3d", "numpy", "scipy")
 
 
 def default_root() -> Path:

@@ -14,7 +14,11 @@ decomposition pieces, repaired meshes) or a fitted
 - **Surface distance**: between the surface of the union and the visual
   surface, both directions, with
   :func:`robotkit.mesh.decimate.surface_distance` (exact distances from
-  area-uniform samples, fixed seed).
+  area-uniform samples, fixed seed).  A proxy of one primitive is measured
+  against its exact surface instead (``Primitive.sample`` and
+  ``Primitive.distance``), so no tessellation error enters: the figures are
+  exact for the sampled points (tested to 1e-9 of the mesh size against
+  analytic shapes).
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from robotkit.mesh.decimate import DEFAULT_SAMPLES, closed_volume, surface_distance
+from robotkit.mesh.decimate import DEFAULT_SAMPLES, _samples, closed_volume, point_surface_distance, surface_distance
 
 
 def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed: int = 0) -> dict:
@@ -64,7 +68,10 @@ def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed:
     elif union_volume is None:
         union_volume, method = (volume_sum, "sum") if closed else (None, "unavailable")
     visual_volume = closed_volume(visual_mesh)
-    dist = surface_distance(surface, visual_mesh, samples, seed)
+    if len(pieces) == 1 and n_prim == 1:
+        dist = _primitive_distance(pieces[0], visual_mesh, samples, seed)
+    else:
+        dist = surface_distance(surface, visual_mesh, samples, seed)
     diag = float(np.linalg.norm(np.ptp(np.asarray(visual_mesh.vertices), axis=0)))
     return {
         "pieces": len(pieces),
@@ -80,6 +87,21 @@ def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed:
         "volume_ratio": union_volume / visual_volume if visual_volume and union_volume is not None else None,
         "distance": dist,
         "distance_relative": float(dist["max"] / diag) if diag > 0 else None,
+    }
+
+
+def _primitive_distance(prim, visual_mesh, samples: int, seed: int) -> dict:
+    """:func:`surface_distance`'s figures between one primitive's exact surface and ``visual_mesh``."""
+    dab = point_surface_distance(prim.sample(samples, seed), visual_mesh)
+    dba = prim.distance(_samples(visual_mesh, samples, seed + 1))
+    both = np.concatenate([dab, dba])
+    return {
+        "max": float(both.max()), "mean": float(both.mean()),
+        "a_to_b_max": float(dab.max()), "a_to_b_mean": float(dab.mean()),
+        "b_to_a_max": float(dba.max()), "b_to_a_mean": float(dba.mean()),
+        "samples": int(samples),
+        "method": "exact distances between area-uniform samples of the primitive's exact surface and of "
+                  "the mesh (fixed seed) and the other surface, both directions",
     }
 
 

@@ -80,6 +80,60 @@ class Primitive:
         m.apply_transform(self.pose)
         return trimesh.Trimesh(np.asarray(m.vertices), np.asarray(m.faces), process=True)
 
+    def distance(self, points) -> np.ndarray:
+        """Exact distance from each point (mesh frame) to the primitive's surface (inside or out)."""
+        P = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        R, t = np.asarray(self.pose[:3, :3], dtype=np.float64), np.asarray(self.pose[:3, 3], dtype=np.float64)
+        q = (P - t) @ R
+        p = self.params
+        if self.kind == "sphere":
+            return np.abs(np.linalg.norm(q, axis=1) - p["radius"])
+        if self.kind == "capsule":
+            axis = np.zeros_like(q)
+            axis[:, 2] = np.clip(q[:, 2], -0.5 * p["length"], 0.5 * p["length"])
+            return np.abs(np.linalg.norm(q - axis, axis=1) - p["radius"])
+        if self.kind == "box":
+            d = np.abs(q) - 0.5 * np.asarray(p["size"], dtype=np.float64)
+        elif self.kind == "cylinder":
+            d = np.stack([np.hypot(q[:, 0], q[:, 1]) - p["radius"], np.abs(q[:, 2]) - 0.5 * p["length"]], axis=1)
+        else:
+            raise ValueError(f"unknown primitive kind {self.kind!r}")
+        outside = np.linalg.norm(np.maximum(d, 0.0), axis=1)
+        return np.where(outside > 0, outside, -d.max(axis=1))
+
+    def sample(self, count: int, seed: int = 0) -> np.ndarray:
+        """``count`` points drawn uniformly by area on the exact surface, in the mesh frame."""
+        rng = np.random.default_rng(seed)
+        p, n = self.params, int(count)
+        if self.kind in ("sphere", "capsule"):
+            r, half = p["radius"], 0.5 * p.get("length", 0.0)
+            side = 2 * np.pi * r * 2 * half
+            u = rng.normal(size=(n, 3))
+            q = r * u / np.linalg.norm(u, axis=1)[:, None]
+            on_side = rng.random(n) < side / (side + 4 * np.pi * r * r)
+            z = rng.uniform(-half, half, n)
+            q[on_side, 2] = 0.0
+            q[on_side] *= r / np.maximum(np.linalg.norm(q[on_side], axis=1), 1e-300)[:, None]
+            q[on_side, 2] = z[on_side]
+            q[~on_side, 2] += np.sign(q[~on_side, 2]) * half
+        elif self.kind == "cylinder":
+            r, half = p["radius"], 0.5 * p["length"]
+            side, cap = 2 * np.pi * r * 2 * half, np.pi * r * r
+            pick = rng.choice(3, size=n, p=np.array([side, cap, cap]) / (side + 2 * cap))
+            ang = rng.uniform(0.0, 2 * np.pi, n)
+            rad = np.where(pick == 0, r, r * np.sqrt(rng.random(n)))
+            z = np.where(pick == 0, rng.uniform(-half, half, n), np.where(pick == 1, half, -half))
+            q = np.stack([rad * np.cos(ang), rad * np.sin(ang), z], axis=1)
+        elif self.kind == "box":
+            h = 0.5 * np.asarray(p["size"], dtype=np.float64)
+            areas = np.array([h[1] * h[2], h[0] * h[2], h[0] * h[1]])
+            axis = rng.choice(3, size=n, p=areas / areas.sum())
+            q = rng.uniform(-1.0, 1.0, (n, 3)) * h
+            q[np.arange(n), axis] = np.where(rng.random(n) < 0.5, -1.0, 1.0) * h[axis]
+        else:
+            raise ValueError(f"unknown primitive kind {self.kind!r}")
+        return q @ np.asarray(self.pose[:3, :3], dtype=np.float64).T + np.asarray(self.pose[:3, 3])
+
 
 def fit_box(mesh) -> Primitive:
     """Oriented bounding box of ``mesh``."""

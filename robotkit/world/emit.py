@@ -109,16 +109,21 @@ def render_world(name: str, occupancy_map, height: float = 2.0, unknown_as_wall:
 
     ``robot`` (name, root, xyz, rpy, quat) places a robot built into the same output folder
     in the world and the scene."""
+    from types import SimpleNamespace
+
     from robotkit.emit.env import render
-    from robotkit.world.walls import mask_mesh, rectangles, wall_cells
+    from robotkit.mesh.export import stl_bytes
+    from robotkit.world.walls import extrude, rectangles, to_map, wall_cells
 
     mask = wall_cells(occupancy_map, unknown_as_wall)
-    mesh = mask_mesh(mask, height, occupancy_map.grid_to_map())
+    vertices, faces = extrude(mask, height)  # as walls.mask_mesh, without importing trimesh (0.8 s)
+    vertices[:, :2] = to_map(vertices[:, :2], occupancy_map.grid_to_map())
+    mesh = SimpleNamespace(vertices=vertices, faces=faces)
     w = world_context(name, occupancy_map, height, rectangles(mask))
     return {
         "model.config": render("world/model.config.j2", w=w).encode("utf-8"),
         "model.sdf": render("world/model.sdf.j2", w=w).encode("utf-8"),
-        f"meshes/{name}.stl": mesh.export(file_type="stl"),
+        f"meshes/{name}.stl": stl_bytes(mesh),
         f"{name}.world": render("world/world.sdf.j2", w=w, robot=robot).encode("utf-8"),
         "scene.xml": render("world/scene.xml.j2", w=w, robot=robot).encode("utf-8"),
     }

@@ -72,6 +72,7 @@ class Expanded:
     # (section, name) of a flat item -> (Source of the item, its key path in that source)
     items: dict = field(default_factory=dict)
     arg_names: tuple = ()
+    files: tuple = ()  # part files read (dependencies even when no item of theirs is kept)
 
 
 class Context:
@@ -348,6 +349,8 @@ def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_y
         if variant is not None and isinstance(flat.get("robot"), str):
             flat["robot"] = f"{flat['robot']}_{variant}"
         out.append(result)
+    for result in out:
+        result.files = tuple(sorted(p for p, (d, _) in ctx.part_files.items() if d is not None))
     return out
 
 

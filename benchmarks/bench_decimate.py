@@ -1,0 +1,278 @@
+"""Decimation side by side: robotkit (MeshLib) against meshlib called plainly, meshoptimizer,
+fast-simplification (robotkit's library before) and pymeshlab (MeshLab, the tool a user
+would otherwise use), on every visual mesh of the examples (recipes/meshes) and of the
+robots in ../shared/assets.
+
+Per mesh, in a child process of its own (pymeshlab crashes on some inputs): load it once
+(robotkit.mesh.io.load_mesh: metres, coincident vertices merged), decimate it with every
+tool to the same target (a fraction of its faces), take the best of ``--repeat`` times
+per tool, interleaved, and measure the result independently of robotkit's code:
+
+- faces: the result's face count against the target (within 2 %?);
+- closed: closed before -> closed after (every edge used twice in opposite directions);
+- Hausdorff: two-sided, sampled: ``--samples`` area-uniform points on each surface, their
+  distance to the other surface by ``trimesh.proximity.closest_point`` (R-tree), on copies
+  scaled to a 1000-unit bounding-box diagonal (trimesh's closest-point test has an absolute
+  tolerance of 1e-12 on squared lengths: wrong by up to the triangle size for triangles
+  under ~1e-2 units), reported over the diagonal.
+
+Prints one row per mesh and a summary: targets reached, closed meshes kept closed,
+robotkit's Hausdorff over plain meshlib's, pymeshlab's time over robotkit's (median and over
+the sum of times).  ``python benchmarks/bench_decimate.py [--keep 0.1] [--repeat 3]
+[--samples 5000] [--json out.json] [--only SUBSTRING]``.  Needs ``pip install pymeshlab
+meshoptimizer fast-simplification`` (benchmark only).
+"""
+
+from __future__ import annotations
+
+import argparse
+import glob
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+ASSETS = REPO.parent / "shared" / "assets"
+if not ASSETS.is_dir():
+    ASSETS = Path("/work/shared/assets")
+
+
+def visual_meshes() -> list[str]:
+    out = []
+    for root in (REPO / "recipes" / "meshes", ASSETS):
+        for p in sorted(glob.glob(str(root) + "/**/*", recursive=True)):
+            low = p.lower()
+            if low.endswith((".stl", ".dae", ".obj")) and "collision" not in low and "/maps/" not in low:
+                out.append(p)
+    return out
+
+
+# --- the tools: (V float64, F int64, target) -> (V, F) ---------------------------------------
+
+def t_robotkit(V, F, target):
+    import trimesh
+
+    from robotkit.mesh.decimate import decimate
+
+    out, _ = decimate(trimesh.Trimesh(V, F, process=False), target_faces=target, samples=0)
+    return out.vertices, out.faces
+
+
+def t_meshlib(V, F, target):
+    import meshlib.mrmeshnumpy as mn
+    import meshlib.mrmeshpy as mm
+    import numpy as np
+
+    m = mn.meshFromFacesVerts(F.astype(np.int32), V.astype(np.float32))
+    s = mm.DecimateSettings()
+    s.strategy = mm.DecimateStrategy.MinimizeError
+    s.maxError = float("inf")
+    s.maxDeletedFaces = max(m.topology.numValidFaces() - target, 0)
+    s.packMesh = True  # MeshLib's defaults otherwise, as a user would call it
+    mm.decimateMesh(m, s)
+    return mn.getNumpyVerts(m).astype(np.float64), mn.getNumpyFaces(m.topology)
+
+
+def t_meshoptimizer(V, F, target):
+    import meshoptimizer
+    import numpy as np
+
+    idx = F.astype(np.uint32).ravel()
+    dest = np.zeros_like(idx)
+    n = meshoptimizer.simplify(dest, idx, V.astype(np.float32), target_index_count=3 * target, target_error=1.0)
+    f = dest[:n].reshape(-1, 3).astype(np.int64)
+    used = np.unique(f)
+    remap = np.zeros(len(V), np.int64)
+    remap[used] = np.arange(len(used))
+    return V[used], remap[f]
+
+
+def t_fast_simplification(V, F, target):
+    import fast_simplification
+    import numpy as np
+
+    c = 0.5 * (V.min(0) + V.max(0))
+    k = 1000.0 / (np.linalg.norm(np.ptp(V, 0)) or 1.0)  # what robotkit did before
+    v, f = fast_simplification.simplify((V - c) * k, F.astype(np.int32), target_count=target, agg=7.0)
+    return v / k + c, f
+
+
+def t_pymeshlab(V, F, target):
+    import pymeshlab
+
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F))
+    ms.meshing_decimation_quadric_edge_collapse(targetfacenum=target)
+    m = ms.current_mesh()
+    return m.vertex_matrix(), m.face_matrix()
+
+
+TOOLS = {"robotkit": t_robotkit, "meshlib": t_meshlib, "meshoptimizer": t_meshoptimizer,
+         "fast-simplification": t_fast_simplification, "pymeshlab": t_pymeshlab}
+
+
+def is_closed(F) -> bool:
+    import numpy as np
+
+    F = np.asarray(F, dtype=np.int64)
+    if len(F) < 4:
+        return False
+    a, b = F.ravel(), np.roll(F, -1, axis=1).ravel()
+    if (a == b).any():
+        return False
+    n = int(max(a.max(), b.max())) + 1
+    directed = np.unique(a * n + b, return_counts=True)
+    if (directed[1] > 1).any():
+        return False
+    und = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_counts=True)[1]
+    return bool((und == 2).all())
+
+
+def hausdorff(V0, F0, V1, F1, samples: int) -> float:
+    """Two-sided sampled Hausdorff distance over the first mesh's bounding-box diagonal."""
+    import numpy as np
+    import trimesh
+
+    lo = V0.min(0)
+    d = float(np.linalg.norm(np.ptp(V0, 0))) / 1000.0
+    a = trimesh.Trimesh((V0 - lo) / d, F0, process=False)
+    b = trimesh.Trimesh((np.asarray(V1) - lo) / d, F1, process=False)
+    pa = trimesh.sample.sample_surface(a, samples, seed=11)[0]
+    pb = trimesh.sample.sample_surface(b, samples, seed=12)[0]
+    return float(max(trimesh.proximity.closest_point(b, pa)[1].max(),
+                     trimesh.proximity.closest_point(a, pb)[1].max())) / 1000.0
+
+
+def one(path: str, keep: float, repeat: int, samples: int, tools: list[str]) -> dict:
+    import numpy as np
+
+    from robotkit.mesh.io import load_mesh
+
+    mesh = load_mesh(path)
+    V, F = np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
+    target = max(4, round(keep * len(F)))
+    row = {"mesh": path, "faces": len(F), "target": target, "closed": is_closed(F), "tools": {}}
+    for name in tools:  # warm-up: imports, first-call costs
+        try:
+            TOOLS[name](V, F, target)
+        except Exception as exc:  # noqa: BLE001 - a tool's failure is a result
+            row["tools"][name] = {"error": f"{type(exc).__name__}: {exc}"[:120]}
+    times = {n: [] for n in tools if n not in row["tools"]}
+    results = {}
+    for _ in range(repeat):
+        for name in times:
+            t0 = time.perf_counter()
+            results[name] = TOOLS[name](V, F, target)
+            times[name].append(time.perf_counter() - t0)
+    for name, (v, f) in results.items():
+        f = np.asarray(f, np.int64)
+        row["tools"][name] = {"faces": int(len(f)), "time": min(times[name]), "closed": is_closed(f),
+                              "hausdorff": hausdorff(V, F, np.asarray(v, np.float64), f, samples)}
+    return row
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--keep", type=float, default=0.1, help="fraction of the faces to keep (default 0.1)")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--samples", type=int, default=5000)
+    ap.add_argument("--min-faces", type=int, default=1000, help="leave out meshes with fewer faces")
+    ap.add_argument("--only", default="")
+    ap.add_argument("--json")
+    ap.add_argument("--one", help=argparse.SUPPRESS)
+    ap.add_argument("--tools", default=",".join(TOOLS))
+    args = ap.parse_args()
+    tools = args.tools.split(",")
+    if args.one:
+        print(json.dumps(one(args.one, args.keep, args.repeat, args.samples, tools)))
+        return 0
+    rows = []
+    print(f"keep {args.keep} of the faces; best of {args.repeat}; Hausdorff / diagonal from {args.samples} "
+          f"samples each way; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    print(f"{'mesh':44} {'faces':>7} {'target':>6} C | " + " | ".join(f"{t[:10]:>27}" for t in tools))
+    for path in visual_meshes():
+        if args.only not in path:
+            continue
+        from robotkit.mesh.io import load_mesh
+
+        try:
+            n = len(load_mesh(path).faces)
+        except Exception as exc:  # noqa: BLE001
+            print(f"{os.path.relpath(path, REPO.parent)[-44:]:44} not loaded: {exc}"[:140])
+            continue
+        if n < args.min_faces:
+            continue
+        row = None
+        todo = list(tools)
+        for _attempt in range(len(tools)):
+            proc = subprocess.run([sys.executable, __file__, "--one", path, "--keep", str(args.keep),
+                                   "--repeat", str(args.repeat), "--samples", str(args.samples),
+                                   "--tools", ",".join(todo)], capture_output=True, text=True, timeout=900)
+            if proc.returncode == 0:
+                got = json.loads(proc.stdout.strip().splitlines()[-1])
+                row = got if row is None else {**row, "tools": {**row["tools"], **got["tools"]}}
+                break
+            # a tool crashed the process (pymeshlab does): find it by running the tools one by one
+            crashed = None
+            for name in todo:
+                p = subprocess.run([sys.executable, __file__, "--one", path, "--keep", str(args.keep),
+                                    "--repeat", "1", "--samples", "10", "--tools", name],
+                                   capture_output=True, text=True, timeout=900)
+                if p.returncode != 0:
+                    crashed = name
+                    break
+            if crashed is None:
+                break
+            todo.remove(crashed)
+            row = row or {"mesh": path, "faces": n, "target": max(4, round(args.keep * n)), "closed": None, "tools": {}}
+            row["tools"][crashed] = {"error": f"crashed (exit {p.returncode})"}
+        if row is None:
+            continue
+        row["tools"] = {t: row["tools"].get(t, {"error": "not run"}) for t in tools}
+        rows.append(row)
+        cells = []
+        for t in tools:
+            r = row["tools"][t]
+            cells.append(f"{r['error'][:27]:>27}" if "error" in r else
+                         f"{r['faces']:>6} {r['time'] * 1000:7.1f}ms {r['hausdorff']:.1e} {'C' if r['closed'] else 'o'}")
+        print(f"{os.path.relpath(path, REPO.parent)[-44:]:44} {row['faces']:>7} {row['target']:>6} "
+              f"{'C' if row['closed'] else 'o'} | " + " | ".join(cells), flush=True)
+    summary(rows, tools)
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+def summary(rows, tools):
+    import numpy as np
+
+    print(f"\n{len(rows)} meshes")
+    for t in tools:
+        ok = [r for r in rows if "error" not in r["tools"][t]]
+        within = sum(abs(r["tools"][t]["faces"] - r["target"]) <= 0.02 * r["target"] for r in ok)
+        closed_in = [r for r in ok if r["closed"]]
+        kept = sum(r["tools"][t]["closed"] for r in closed_in)
+        print(f"  {t:20} ran {len(ok):3}; within 2 % of the target {within:3}; closed kept closed "
+              f"{kept}/{len(closed_in)}")
+    both = [r for r in rows if all("error" not in r["tools"][t] for t in ("robotkit", "meshlib"))]
+    if both:
+        h = np.array([r["tools"]["robotkit"]["hausdorff"] / max(r["tools"]["meshlib"]["hausdorff"], 1e-300)
+                      for r in both])
+        print(f"  Hausdorff robotkit / meshlib: median {np.median(h):.2f}, max {h.max():.2f}, "
+              f"<= 1.0 on {int((h <= 1.0 + 1e-9).sum())}/{len(h)}")
+    for other in ("pymeshlab", "meshlib", "meshoptimizer", "fast-simplification"):
+        both = [r for r in rows if "error" not in r["tools"].get("robotkit", {"error": 1})
+                and "error" not in r["tools"].get(other, {"error": 1})]
+        if not both or other not in tools:
+            continue
+        ratio = np.array([r["tools"][other]["time"] / r["tools"]["robotkit"]["time"] for r in both])
+        total = sum(r["tools"][other]["time"] for r in both) / sum(r["tools"]["robotkit"]["time"] for r in both)
+        print(f"  time {other} / robotkit: median {np.median(ratio):.2f}, over the sum {total:.2f}, "
+              f"min {ratio.min():.2f} ({len(both)} meshes)")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
