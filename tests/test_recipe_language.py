@@ -522,6 +522,36 @@ def test_changing_an_argument_reruns_only_what_reads_it(tmp_path):
     assert not build([recipe], tmp_path / "out", args={"arm_mass": "2"}).ran
 
 
+def test_the_no_op_fast_path_sees_arguments_and_part_files(tmp_path):
+    (tmp_path / "parts").mkdir()
+    part = write_recipe(tmp_path, """
+        args: {r: 0.05}
+        links: {ball: {visual: {sphere: {radius: "${r}"}}}}
+        joints: {fix: {type: fixed, parent: "${parent}", child: ball}}
+        """, name="parts/ball.yaml")
+    write_recipe(tmp_path, """
+        robot: r
+        args: {size: 0.1}
+        parts: {ball: parts/ball.yaml}
+        links: {base: {visual: {box: {size: ["${size}", 0.1, 0.1]}}}}
+        instances: {top: {part: ball, parent: base}}
+        """)
+
+    def build_says(*extra):
+        proc = run_cli("build", "robot.yaml", "--out", "out", *extra, cwd=tmp_path)
+        assert proc.returncode == 0, proc.stderr
+        return proc.stdout.split(":")[0].split()[0]
+
+    assert build_says() == "built"
+    assert build_says() == "out/r"  # "out/r: up to date"
+    assert build_says("--arg", "size:=0.2") == "built"
+    assert build_says("--arg", "size:=0.2") == "out/r"
+    part.write_text(part.read_text().replace("0.05", "0.06"))
+    assert build_says("--arg", "size:=0.2") == "built"
+    assert read_urdf(tmp_path / "out/r/urdf/r.urdf").links["top_ball"].mass == pytest.approx(
+        1000 * 4 / 3 * math.pi * 0.06 ** 3, rel=1e-9)
+
+
 def test_doit_takes_arguments_for_the_recipes_that_declare_them(tmp_path):
     from robotkit.errors import RobotkitError
     from robotkit.tasks import all_tasks
