@@ -32,7 +32,7 @@ def test_ur5_collision_pieces_are_closed_convex_and_cached(tmp_path):
     cmd = [sys.executable, "-m", "robotkit", "build", str(RECIPES / "ur5.yaml"), "-j", "2", "--out"]
     proc = subprocess.run(cmd + [str(out1)], capture_output=True, text=True, env=env)
     assert proc.returncode == 0, proc.stderr
-    pieces = sorted((out1 / "ur5" / "meshes" / "collision").glob("*.stl"))
+    pieces = sorted((out1 / "ur5" / "meshes" / "collision").glob("*.obj"))  # OBJ: Drake's convex meshes
     assert len(pieces) >= 7
     for path in pieces:
         m = trimesh.load(path)
@@ -92,9 +92,9 @@ def test_collision_strategy_per_format(tmp_path):
     build([recipe], tmp_path / "out")
     robot = tmp_path / "out" / "perfmt"
     urdf = ET.parse(robot / "urdf" / "perfmt.urdf").getroot()
-    assert urdf.find("link/collision/geometry/mesh").get("filename") == "package://perfmt/meshes/collision/rod.stl"
+    assert urdf.find("link/collision/geometry/mesh").get("filename") == "package://perfmt/meshes/collision/rod_mesh.obj"
     sdf = ET.parse(robot / "model.sdf").getroot()
-    assert sdf.find(".//collision/geometry/mesh/uri").text == "model://perfmt/meshes/collision/rod.stl"
+    assert sdf.find(".//collision/geometry/mesh/uri").text == "model://perfmt/meshes/collision/rod_mesh.obj"
     mj = mujoco()
     model = mj.MjModel.from_xml_path(str(robot / "mjcf" / "scene.xml"))
     geom = mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, "a_collision_0")

@@ -67,8 +67,13 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
     build = Build(name, robot_dir, urdf, sdf, mjcf, base)
     findings += _stage("equivalence", subject, equivalent)
     findings += _stage("consumers", subject, lambda: consumer_findings(build)[0])
-    findings += _stage("simulation", subject, lambda: [
-        Finding("error", "simulation", subject, p, "MuJoCo scene mjcf/scene.xml") for p in smoke_test(scene)])
+    def simulate() -> list[Finding]:
+        notes: list[str] = []
+        problems = smoke_test(scene, notes=notes)
+        return ([Finding("error", "simulation", subject, p, "MuJoCo scene mjcf/scene.xml") for p in problems]
+                + [Finding("warning", "simulation", subject, n, "MuJoCo scene mjcf/scene.xml") for n in notes])
+
+    findings += _stage("simulation", subject, simulate)
     return findings
 
 
