@@ -196,6 +196,12 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
     if repair:
         mesh, info["repair"] = run_repair(mesh)
     kind, value = decimate
+    if kind == "none":  # only mirrored (load_mesh flipped the faces of a mirroring scale)
+        from robotkit.mesh.export import stl_bytes
+
+        write_if_changed(target, stl_bytes(mesh))
+        write_if_changed(report, dump_json(_plain(info)))
+        return
     faces = len(mesh.faces)
     target_faces = int(value) if kind == "faces" else max(4, int(round(faces * float(value))))
     if target_faces > faces:

@@ -134,11 +134,11 @@ def to_doit(task: dict) -> dict:
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
           echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None,
-          report: bool = False) -> BuildResult:
+          report: bool = False, args: dict[str, str] | None = None) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
-    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key.  ``report`` also writes each
-    robot's picture report (``<robot>/report/report.html``); the command line does unless
-    ``--no-report``.
+    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key; ``args`` sets recipe arguments (``--arg``).
+    ``report`` also writes each robot's picture report (``<robot>/report/report.html``); the
+    command line does unless ``--no-report``.
 
     The stamp of the no-op fast path (:mod:`robotkit.stamp`) is removed first and written
     again when the build succeeds; ``stamp_options`` are the options it is kept under
@@ -157,7 +157,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     from robotkit.tasks import load_robots, mesh_locations, robot_tasks
 
     out = Path(out_dir).absolute()
-    robots = load_robots(recipes, ros)  # raises before anything is written
+    robots = load_robots(recipes, ros, args)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
     tasks = []
     for loaded, robot in robots:

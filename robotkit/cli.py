@@ -47,6 +47,14 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--fail-on", choices=["error", "warning"], default="error",
                    help="lowest severity that makes the exit status 1 (default: error)")
     c.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    _add_arg_option(c)
+
+    e = sub.add_parser("expand", help="print the flat recipe that a recipe's arguments, expressions, units, "
+                                      "parts, conditions and variants expand to",
+                       description="Print RECIPE expanded (one YAML document per variant).")
+    e.add_argument("recipe", metavar="RECIPE", help="recipe YAML file")
+    e.add_argument("--variant", metavar="NAME", help="print only this variant")
+    _add_arg_option(e)
 
     from robotkit.importer.cli import add_parser as add_import
 
@@ -73,7 +81,20 @@ def _parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
     s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
+    s.add_argument("--part", action="store_true", help="print the JSON Schema of a part file instead")
     return p
+
+
+def _recipe_arg(text: str) -> tuple[str, str]:
+    name, sep, value = text.partition(":=")
+    if not sep or not name:
+        raise argparse.ArgumentTypeError(f"'{text}' is not NAME:=VALUE")
+    return name, value
+
+
+def _add_arg_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--arg", action="append", type=_recipe_arg, default=[], metavar="NAME:=VALUE",
+                   help="set a recipe argument (repeatable; see the recipe's args:)")
 
 
 def _add_build(sub) -> None:
@@ -88,6 +109,7 @@ def _add_build(sub) -> None:
                                                            "recipes' `ros` key)")
     b.add_argument("--no-report", action="store_true",
                    help="do not write the picture report (<robot>/report/report.html)")
+    _add_arg_option(b)
 
 
 def _cores() -> int:
@@ -118,7 +140,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return {"build": _build, "world": _world, "schema": _schema, "check": _check,
-                "import": _import, "report": _report, "view": _view}[args.command](args)
+                "import": _import, "report": _report, "view": _view, "expand": _expand}[args.command](args)
     except Exception as exc:
         from robotkit.errors import RobotkitError  # imported late: dataclasses costs a no-op build 10 ms
 
@@ -139,7 +161,8 @@ def _build(args) -> int:
         print("robotkit: error: -j must be at least 1", file=sys.stderr)
         return 2
     start = time.perf_counter()
-    extra = {**({"ros": args.ros} if args.ros else {}), **({"no_report": True} if args.no_report else {})}
+    extra = {**({"ros": args.ros} if args.ros else {}), **({"no_report": True} if args.no_report else {}),
+             **({"args": dict(args.arg)} if args.arg else {})}
     opts = stamp.options(args.recipes, args.out, extra or None)
     done = stamp.up_to_date(args.out, opts)  # nothing changed since the last successful build?
     if done is not None:
@@ -148,7 +171,7 @@ def _build(args) -> int:
 
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
     result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, ros=args.ros,
-                   report=not args.no_report, stamp_options=opts)
+                   report=not args.no_report, stamp_options=opts, args=dict(args.arg))
     if result.ran or args.verbose:
         for w in result.warnings:
             print(f"warning: {w}", file=sys.stderr)
@@ -229,7 +252,7 @@ def _check(args) -> int:
             return 2
         packages[pkg] = folder
     # github: the job summary points at the picture report, so a recipe's build writes it
-    findings = check(args.path, args.out, packages, report=args.format == "github")
+    findings = check(args.path, args.out, packages, args=dict(args.arg), report=args.format == "github")
     sys.stdout.write(render(findings, args.format, args.path))
     if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
         _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.path, args.out)
@@ -293,10 +316,17 @@ def _import(args) -> int:
     return run(args)
 
 
+def _expand(args) -> int:
+    from robotkit.recipe.flat import flat_yaml
+
+    sys.stdout.write(flat_yaml(args.recipe, dict(args.arg), args.variant))
+    return 0
+
+
 def _schema(args) -> int:
     from robotkit.recipe.reference import json_schema, markdown
 
-    print(markdown() if args.markdown else json_schema(), end="")
+    print(markdown() if args.markdown else json_schema(part=args.part), end="")
     return 0
 
 

@@ -374,39 +374,50 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
     return out
 
 
-def load_robots(recipe_files, ros: str | None = None) -> list[tuple[object, Robot]]:
-    """Load and resolve every recipe (``ros`` overrides their ``ros`` key); all problems together."""
+def load_robots(recipe_files, ros: str | None = None, args: dict[str, str] | None = None,
+                ignore_unknown_args: bool = False) -> list[tuple[object, Robot]]:
+    """Load and resolve every recipe (every variant of each; ``ros`` overrides their ``ros`` key);
+    all problems of all recipes together.
+
+    ``args``: ``--arg`` overrides (name -> text); with ``ignore_unknown_args`` a recipe ignores the
+    ones it does not declare (doit builds many recipes with one set of arguments)."""
     from robotkit.errors import Problem, RobotkitError, display_path
-    from robotkit.model.resolve import resolve
-    from robotkit.recipe.load import load_recipe
+    from robotkit.model.resolve import resolve_checked
+    from robotkit.recipe.load import read_recipes
 
     problems: list[Problem] = []
     robots = []
     names: dict[str, str] = {}
+    declared: set[str] = set()
     for f in recipe_files:
-        try:
-            loaded = load_recipe(f)
-            robot = resolve(loaded, ros)
-        except RobotkitError as exc:
-            problems.extend(exc.problems)
-            continue
-        outputs = [("robot",), *[("worlds", w.name) for w in robot.worlds]]
-        taken = [key for key in outputs if key[-1] in names or (key[0] == "worlds" and key[-1] == robot.name)]
-        if taken:
-            key = taken[0]
-            other = names.get(key[-1], display_path(str(f)))
-            problems.append(loaded.marks.problem(key, f"output folder '{key[-1]}' is also written by {other}"))
-            continue
-        names[robot.name] = display_path(str(f))
-        names.update({w.name: display_path(str(f)) for w in robot.worlds})
-        robots.append((loaded, robot))
+        for loaded in read_recipes(f, args, ignore_unknown_args):
+            declared.update(loaded.arg_names)
+            try:
+                robot = resolve_checked(loaded, ros)
+            except RobotkitError as exc:
+                problems.extend(p for p in exc.problems if p not in problems)
+                continue
+            outputs = [("robot",), *[("worlds", w.name) for w in robot.worlds]]
+            taken = [key for key in outputs if key[-1] in names or (key[0] == "worlds" and key[-1] == robot.name)]
+            if taken:
+                key = taken[0]
+                other = names.get(key[-1], display_path(str(f)))
+                problems.append(loaded.marks.problem(key, f"output folder '{key[-1]}' is also written by {other}"))
+                continue
+            names[robot.name] = display_path(str(f))
+            names.update({w.name: display_path(str(f)) for w in robot.worlds})
+            robots.append((loaded, robot))
+    if ignore_unknown_args:
+        problems += [Problem(f"unknown argument '{name}': no recipe declares it", key=f"--arg {name}")
+                     for name in sorted(set(args or {}) - declared)]
     if problems:
         raise RobotkitError(problems)
     return robots
 
 
-def all_tasks(recipe_files, out_dir, report: bool = True) -> list[dict]:
+def all_tasks(recipe_files, out_dir, report: bool = True, args: dict[str, str] | None = None,
+              ignore_unknown_args: bool = False) -> list[dict]:
     tasks = []
-    for loaded, robot in load_robots(recipe_files):
+    for loaded, robot in load_robots(recipe_files, None, args, ignore_unknown_args):
         tasks.extend(robot_tasks(robot, out_dir, mesh_locations(loaded, robot), report=report))
     return tasks

@@ -14,6 +14,13 @@ RECIPES = REPO / "recipes"
 GOLDEN = Path(__file__).resolve().parent / "golden"
 
 
+def example_robots() -> list[str]:
+    """The robot folders the example recipes build (a recipe with variants builds several)."""
+    from robotkit.recipe.load import load_recipes
+
+    return sorted(one.recipe.robot for p in RECIPES.glob("*.yaml") for one in load_recipes(p))
+
+
 @pytest.fixture(scope="session", autouse=True)
 def mesh_cache(tmp_path_factory):
     """One mesh cache for the test session (builds in subprocesses inherit it): CoACD and

@@ -13,13 +13,13 @@ from pathlib import Path
 
 import pytest
 
-from conftest import RECIPES, run_cli, write_recipe
+from conftest import RECIPES, example_robots, run_cli, write_recipe
 from robotkit.build import build
 from robotkit.check.consumers import CONSUMERS, Build, consumer_findings, read
 from robotkit.check.simulation import smoke_test
 from validators import IN_CI, ign_sdf_check, require
 
-EXAMPLES = sorted(p.stem for p in RECIPES.glob("*.yaml"))
+EXAMPLES = example_robots()
 CORPUS = Path(__file__).resolve().parents[2] / "shared" / "assets" / "robots"
 
 
@@ -45,7 +45,7 @@ def build_of(out: Path, name: str, base: str = "fixed") -> Build:
 @pytest.fixture(scope="module")
 def examples(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("examples")
-    assert not build([RECIPES / f"{n}.yaml" for n in EXAMPLES], out).errors
+    assert not build(sorted(RECIPES.glob("*.yaml")), out).errors
     return out
 
 

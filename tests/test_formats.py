@@ -13,13 +13,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import GOLDEN, assert_golden, RECIPES, run_cli, write_recipe
+from conftest import GOLDEN, assert_golden, RECIPES, example_robots, run_cli, write_recipe
 from robotkit.build import build
 from robotkit.check.equivalence import equivalence
 from robotkit.check.simulation import smoke_test
 from validators import check_urdf, ign_sdf_check, mujoco, require
 
-EXAMPLES = sorted(p.stem for p in RECIPES.glob("*.yaml"))
+
+EXAMPLES = example_robots()
 
 
 def assert_equivalent(robot_dir: Path, configs: int = 100):
@@ -32,7 +33,7 @@ def assert_equivalent(robot_dir: Path, configs: int = 100):
 @pytest.fixture(scope="module")
 def examples(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("examples")
-    result = build([RECIPES / f"{name}.yaml" for name in EXAMPLES], out)
+    result = build(sorted(RECIPES.glob("*.yaml")), out)
     assert not result.errors
     return out
 

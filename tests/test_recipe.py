@@ -259,6 +259,8 @@ def test_reference_docs_are_current():
     docs = Path(__file__).resolve().parents[1] / "docs"
     assert (docs / "recipe.schema.json").read_text() == json_schema(), "run: robotkit schema > docs/recipe.schema.json"
     assert (docs / "recipe.md").read_text() == markdown(), "run: robotkit schema --markdown > docs/recipe.md"
+    assert (docs / "part.schema.json").read_text() == json_schema(part=True), \
+        "run: robotkit schema --part > docs/part.schema.json"
 
 
 def test_urdf_extras_are_copied_verbatim(tmp_path):

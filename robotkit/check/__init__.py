@@ -77,14 +77,26 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
     return findings
 
 
-def check_recipe(path: Path, out_dir: str, report: bool = False) -> list[Finding]:
+def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
     from robotkit.build import build
-    from robotkit.recipe.load import load_recipe
+    from robotkit.recipe.load import load_recipes
 
-    loaded = load_recipe(path)
-    result = build([path], out_dir, report=report)
-    findings = [Finding("warning", "build", f"robot '{loaded.recipe.robot}'", w) for w in result.warnings]
-    findings += check_build_dir(Path(out_dir) / loaded.recipe.robot, loaded.recipe.measured_mass)
+    located = []
+    result = build([path], out_dir, args=args, report=report)
+    for i, loaded in enumerate(load_recipes(path, args)):  # one per variant
+        name = loaded.recipe.robot
+        others = [r for r in result.robots if r != name]
+        # a warning naming another variant's robot belongs to that one; the rest to the first
+        warnings = [w for w in result.warnings if w.startswith(f"{name}:")
+                    or (i == 0 and not any(w.startswith(f"{o}:") for o in others))]
+        located += _check_variant(loaded, warnings, out_dir)
+    return located
+
+
+def _check_variant(loaded, warnings: list[str], out_dir: str) -> list[Finding]:
+    name = loaded.recipe.robot
+    findings = [Finding("warning", "build", f"robot '{name}'", w) for w in warnings]
+    findings += check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
     marks = loaded.marks
     located = []
     for f in findings:
@@ -99,7 +111,7 @@ def check_recipe(path: Path, out_dir: str, report: bool = False) -> list[Finding
 
 
 def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
-          report: bool = False) -> list[Finding]:
+          args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
     """``report``: a recipe's build also writes its picture report (as ``robotkit build`` does)."""
     p = Path(path)
     package_paths = package_paths or {}
@@ -114,7 +126,7 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
         raise RobotkitError(Problem("no such file or folder", file=path))
     suffix = p.suffix.lower()
     if suffix in (".yaml", ".yml"):
-        return check_recipe(p, out_dir, report)
+        return check_recipe(p, out_dir, args, report)
     if suffix == ".urdf":
         return check_urdf_file(p, package_paths)
     if suffix in (".sdf", ".world"):

@@ -35,6 +35,21 @@ def _t(v) -> tuple[float, ...]:
     return tuple(float(x) for x in v)
 
 
+def resolve_checked(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
+    """The resolved robot; RecipeError with the loading problems and resolution's own, all together."""
+    from robotkit.recipe.load import sort_problems
+
+    if not loaded.problems:
+        return resolve(loaded, ros)
+    problems = list(loaded.problems)
+    if loaded.recipe is not None:
+        try:
+            resolve(loaded, ros)
+        except RecipeError as exc:
+            problems.extend(p for p in exc.problems if p not in problems)
+    raise RecipeError(sort_problems(problems, loaded.file))
+
+
 def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
     """The structural robot of a loaded recipe; ``ros`` overrides the recipe's ``ros``."""
     r = loaded.recipe
@@ -90,10 +105,16 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                 scale = (f, f, f)
             dec = (g.decimate or r.meshes.decimate) if role == "visual" else g.decimate
             dec = (("faces", dec.faces) if dec.faces is not None else ("ratio", dec.ratio)) if dec else None
+            # a mirroring scale (a mirrored part): consumers render negative scales inside out, so
+            # the outputs get a mirrored copy in metres with its faces flipped (robotkit.actions)
+            mirrored = scale[0] * scale[1] * scale[2] < 0
+            if mirrored and dec is None:
+                dec = ("none", 0)
             key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((g.mesh, scale, policy, dec)))}"
-            file_name = sources[g.mesh] if dec is None else os.path.splitext(sources[g.mesh])[0] + ".stl"
+            file_name = sources[g.mesh] if dec is None else (
+                os.path.splitext(sources[g.mesh])[0] + ("_mirrored" if mirrored else "") + ".stl")
             shape = Shape("mesh", mesh=MeshRef(g.mesh, scale, file_name, key, policy, decimate=dec,
-                                               repair=dec is not None and r.meshes.repair))
+                                               repair=dec is not None and dec[0] != "none" and r.meshes.repair))
         return Geom(shape, origin, (0.0, 0.0, 0.0), g.material, g.recenter)
 
     links: list[Link] = []

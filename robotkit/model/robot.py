@@ -100,7 +100,7 @@ class MeshRef:
     folder: str = "visual"
     """``visual``, ``collision``; the output is ``meshes/<folder>/<file_name>``."""
     decimate: tuple | None = None
-    """A processed visual: ("faces", n) or ("ratio", r); written as a binary STL in metres."""
+    """A processed visual: ("faces", n), ("ratio", r) or ("none", 0) (only mirrored); written as a binary STL in metres."""
     repair: bool = False
 
     @property

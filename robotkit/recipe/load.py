@@ -27,6 +27,8 @@ class Marks:
     where: dict[Path_, tuple[str, int]] = field(default_factory=dict)
     # key paths whose value came from ``defaults`` -> the defaults path
     from_defaults: dict[Path_, Path_] = field(default_factory=dict)
+    # flat items made by a part instance -> (key path where the part wrote them, instance text)
+    origins: dict[Path_, tuple[Path_, str]] = field(default_factory=dict)
 
     def locate(self, path: Path_) -> tuple[str | None, int | None]:
         for n in range(len(path), -1, -1):
@@ -40,8 +42,12 @@ class Marks:
             if path[:n] in self.from_defaults:
                 key_path = self.from_defaults[path[:n]] + path[n:]
                 break
+        via = ""
+        if self.origins and len(path) >= 2 and path[:2] in self.origins and key_path is path:
+            source, via = self.origins[path[:2]]
+            key_path = source + path[2:]
         file, line = self.locate(path)
-        return Problem(message, file=file, line=line, key=dotted(key_path))
+        return Problem(message + via, file=file, line=line, key=dotted(key_path))
 
 
 def dotted(path: Path_) -> str:
@@ -154,10 +160,19 @@ def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = ()):
         if sub is None:
             continue
         for key in sub:
-            if key not in MERGED_SECTIONS + ("include",):
+            if key not in MERGED_SECTIONS + ("include", "urdf_extras"):
                 f, line = sub_marks[(key,)]
                 problems.append(Problem(
-                    f"an included file may only hold {', '.join(MERGED_SECTIONS)}", file=f, line=line, key=key))
+                    f"an included file may only hold {', '.join(MERGED_SECTIONS)}, urdf_extras", file=f, line=line,
+                    key=key))
+        extras = sub.get("urdf_extras")
+        if isinstance(extras, list) and isinstance(data.setdefault("urdf_extras", []), list):
+            offset = len(data["urdf_extras"])  # appended after the including file's own
+            data["urdf_extras"] = data["urdf_extras"] + extras
+            for p, m in sub_marks.items():
+                if p[:1] == ("urdf_extras",) and len(p) > 1 and isinstance(p[1], int):
+                    marks[("urdf_extras", p[1] + offset) + p[2:]] = m
+            marks.setdefault(("urdf_extras",), sub_marks[("urdf_extras",)])
         for section in MERGED_SECTIONS:
             items = sub.get(section)
             if not isinstance(items, dict):
@@ -384,42 +399,91 @@ class LoadedRecipe:
     marks: Marks
     files: list[str]  # every YAML file read (for dependency tracking)
     partial: bool | str = False  # True: invalid parts were neutralised; "tree": joints dropped too
+    problems: list[Problem] = field(default_factory=list)  # found while loading (the recipe is then partial)
+    variant: str | None = None  # the variant of the recipe this is (robotkit.recipe.expand)
+    arg_names: tuple[str, ...] = ()  # the arguments the recipe declares
 
 
-def load_recipe(file: str | os.PathLike) -> LoadedRecipe:
-    from pydantic import ValidationError
+def read_recipes(file: str | os.PathLike, args: dict[str, str] | None = None,
+                 ignore_unknown_args: bool = False) -> list[LoadedRecipe]:
+    """Read, expand and validate a recipe: one LoadedRecipe per variant (one when it has none).
 
-    from robotkit.recipe.schema import Recipe
+    Never raises for bad input: each result carries its ``problems`` and, when it can, a
+    recipe with the invalid parts neutralised, so later stages can add their own problems
+    (robotkit.model.resolve.resolve_checked).  ``args``: ``--arg`` overrides, name -> text.
+    """
+    from robotkit.recipe.expand import copy_marks, expand
 
     file = Path(file).absolute()
     problems: list[Problem] = []
     data, where = _gather(file, problems)
-    marks = Marks(where=where)
     if data is None:
-        raise RecipeError(problems)
+        return [LoadedRecipe(file=file, recipe=None, marks=Marks(where=where), files=[str(file)],
+                             partial=True, problems=problems)]
+    expanded = expand(data, where, str(file), dict(args or {}), _read_yaml, problems,
+                      ignore_unknown_args=ignore_unknown_args)
+    out = []
+    for exp in expanded:
+        shared = list(problems)
+        if exp.items:
+            flat_where, origins = copy_marks(exp, where)
+            marks = Marks(where=flat_where, origins=origins)
+        else:
+            marks = Marks(where=dict(where) if len(expanded) > 1 else where)
+        loaded = _validate(file, exp.data, marks, shared, exp.variant)
+        loaded.arg_names = exp.arg_names
+        loaded.files = sorted(set(loaded.files) | set(exp.files))
+        out.append(loaded)
+    return out
+
+
+def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], variant) -> LoadedRecipe:
+    from pydantic import ValidationError
+
+    from robotkit.recipe.expand import convert_units
+    from robotkit.recipe.schema import Recipe
+
     _apply_defaults(data, marks)
+    convert_units(data, lambda path, msg: problems.append(marks.problem(path, msg)))
     _absolute_meshes(data, marks)
     recipe = None
     partial = False
     try:
         recipe = Recipe.model_validate(data)
     except ValidationError as exc:
-        problems.extend(schema_problems(exc, marks, Recipe))
+        taken = {(p.file, p.line, p.key) for p in problems}
+        problems.extend(p for p in schema_problems(exc, marks, Recipe) if (p.file, p.line, p.key) not in taken)
         recipe, partial = _salvage(data, exc)
-    files = sorted({f for f, _ in where.values()})
-    loaded = LoadedRecipe(file=file, recipe=recipe, marks=marks, files=files, partial=partial)
-    if problems:
-        # Check what is valid too, so the user sees every problem in one go.
-        if recipe is not None:
-            from robotkit.model.resolve import resolve
+    unique = []
+    for p in problems:
+        if p not in unique:
+            unique.append(p)
+    files = sorted({f for f, _ in marks.where.values() if f})
+    return LoadedRecipe(file=file, recipe=recipe, marks=marks, files=files, partial=partial, problems=unique,
+                        variant=variant)
 
-            try:
-                resolve(loaded)
-            except RecipeError as exc:
-                problems.extend(exc.problems)
-        problems.sort(key=lambda p: (p.file != str(file), p.file or "", p.line or 0))
-        raise RecipeError(problems)
+
+def sort_problems(problems: list[Problem], file) -> list[Problem]:
+    """The recipe's own file first, then by file and line."""
+    return sorted(problems, key=lambda p: (p.file != str(file), p.file or "", p.line or 0))
+
+
+def load_recipes(file: str | os.PathLike, args: dict[str, str] | None = None) -> list[LoadedRecipe]:
+    """:func:`read_recipes`, raising RecipeError with every loading problem."""
+    loaded = read_recipes(file, args)
+    problems = [p for one in loaded for p in one.problems]
+    if problems:
+        unique = []
+        for p in problems:
+            if p not in unique:
+                unique.append(p)
+        raise RecipeError(sort_problems(unique, loaded[0].file))
     return loaded
+
+
+def load_recipe(file: str | os.PathLike, args: dict[str, str] | None = None) -> LoadedRecipe:
+    """The recipe (its first variant), raising RecipeError with every loading problem."""
+    return load_recipes(file, args)[0]
 
 
 def _salvage(data: dict, exc):

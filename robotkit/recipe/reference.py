@@ -20,13 +20,43 @@ SECTIONS = [
     (s.Cylinder, "cylinder"), (s.Sphere, "sphere"), (s.Inertial, "links.<name>.inertial"),
     (s.Inertia, "inertial.inertia"), (s.Joint, "joints.<name>"), (s.Limit, "joints.<name>.limit"),
     (s.Dynamics, "joints.<name>.dynamics"), (s.Mimic, "joints.<name>.mimic"),
+    (s.Arg, "args.<name>"), (s.Part, "parts.<name> (or a part file)"), (s.Instance, "instances.<name>"),
 ]
 
+EXPRESSION = r"\$\{[^{}]*\}"
 
-def json_schema() -> str:
-    data = s.Recipe.model_json_schema()
+
+def _quantity_pattern(kind: str) -> str:
+    from robotkit.recipe.expand.units import UNITS
+
+    units = "|".join(sorted((u for u, (dim, _) in UNITS.items() if kind == "position" or dim == kind),
+                            key=lambda u: (-len(u), u)))
+    return rf"^\s*([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|{EXPRESSION})\s*({units})\s*$"
+
+
+def _expressions(node):
+    """Let every number and true/false also be an expression (and a length, angle or mass a
+    quantity with its unit), so editors accept what the expansion stage understands."""
+    if isinstance(node, list):
+        return [_expressions(v) for v in node]
+    if not isinstance(node, dict):
+        return node
+    node = {k: _expressions(v) for k, v in node.items()}
+    if node.get("type") in ("number", "integer", "boolean"):
+        meta = {k: node.pop(k) for k in ("default", "description", "title") if k in node}
+        alts = [node, {"type": "string", "pattern": rf"^\s*{EXPRESSION}\s*$"}]
+        if "x-unit" in node:
+            alts.append({"type": "string", "pattern": _quantity_pattern(node["x-unit"])})
+        return {"anyOf": alts, **meta}
+    return node
+
+
+
+def json_schema(part: bool = False) -> str:
+    """The JSON Schema of a recipe (or, ``part``, of a part file)."""
+    data = _expressions((s.Part if part else s.Recipe).model_json_schema())
     data["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    data["title"] = "robotkit recipe"
+    data["title"] = "robotkit part" if part else "robotkit recipe"
     return json.dumps(data, indent=2, sort_keys=True) + "\n"
 
 
@@ -64,6 +94,6 @@ def markdown() -> str:
                     field.default.model_dump() if hasattr(field.default, "model_dump") else field.default))
             desc = (field.description or "").replace("\n", " ").replace("|", "\\|")
             tp = _type(field.annotation).replace("|", "\\|")
-            lines.append(f"| `{name}` | {tp} | {default} | {desc} |")
+            lines.append(f"| `{field.alias or name}` | {tp} | {default} | {desc} |")
         lines.append("")
     return "\n".join(lines)

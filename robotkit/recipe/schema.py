@@ -7,6 +7,19 @@ description in the JSON Schema that editors use.
 Conventions: lengths written in the recipe are metres, angles radians, masses
 kilograms, densities kg/m^3.  Mesh files carry their own units (``units`` or
 ``scale``), converted exactly when the recipe is resolved.
+
+The recipe language (robotkit.recipe.expand; a guide with examples is
+docs/recipe-language.md): any length, angle or mass may carry a unit (``5 cm``,
+``2 in``, ``90 deg``, ``300 g``; lengths m, cm, mm, um, km, in, ft; angles rad,
+deg; masses kg, g, mg, lb; joint limits take the unit of their joint's type);
+any value may be an expression ``${...}`` of ``args``, ``values``, ``pi``, ``e``,
+``tau``, arithmetic (``+ - * / // % **``), comparisons, ``and``/``or``/``not``,
+``a if c else b`` and the functions sqrt, sin, cos, tan, asin, acos, atan, atan2,
+sinh, cosh, tanh, exp, log, log10, log2, hypot, radians, degrees, floor, ceil,
+fabs, abs, round, min, max, int, float; text may embed them (``${side}_wheel``).
+``parts`` are instantiated by ``instances``, ``if`` keeps or drops an entry, and
+``variants`` build several robots from one recipe.  ``robotkit expand RECIPE``
+prints the flat recipe all of this expands to.
 """
 
 from __future__ import annotations
@@ -20,6 +33,29 @@ NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*$")
 NAME_HINT = "a name starts with a letter or '_' and holds only letters, digits, '_', '-' and '.'"
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+
+
+class Dim:
+    """Marks a number as a length, angle, mass or joint position (``position``: a length for
+    prismatic joints, an angle for revolute ones): the recipe may write it with a unit
+    (``5 cm``, ``90 deg``, ``300 g``), converted to SI before validation (robotkit.recipe.expand)."""
+
+    def __init__(self, kind: str):
+        self.kind = kind
+
+    def __repr__(self):
+        return f"Dim({self.kind!r})"
+
+    def __get_pydantic_json_schema__(self, core_schema, handler):
+        out = handler(core_schema)
+        out["x-unit"] = self.kind
+        return out
+
+
+LENGTH, ANGLE, MASS, POSITION = Dim("length"), Dim("angle"), Dim("mass"), Dim("position")
+LengthVec3 = Annotated[list[Annotated[float, LENGTH]], Field(min_length=3, max_length=3)]
+AngleVec3 = Annotated[list[Annotated[float, ANGLE]], Field(min_length=3, max_length=3)]
+PositiveLength = Annotated[float, Field(gt=0), LENGTH]
 Rgba = Annotated[list[Annotated[float, Field(ge=0, le=1)]], Field(min_length=4, max_length=4)]
 Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]
@@ -59,26 +95,26 @@ class Strict(BaseModel):
 class Origin(Strict):
     """A pose: translation then fixed-axis roll, pitch, yaw (URDF convention)."""
 
-    xyz: Vec3 = [0.0, 0.0, 0.0]
+    xyz: LengthVec3 = [0.0, 0.0, 0.0]
     """Translation in metres."""
-    rpy: Vec3 = [0.0, 0.0, 0.0]
+    rpy: AngleVec3 = [0.0, 0.0, 0.0]
     """Roll, pitch, yaw in radians, applied about the fixed x, y, z axes in that order."""
 
 
 class Box(Strict):
-    size: Annotated[list[Positive], Field(min_length=3, max_length=3)]
+    size: Annotated[list[PositiveLength], Field(min_length=3, max_length=3)]
     """Edge lengths along x, y, z in metres; the box is centred on its origin."""
 
 
 class Cylinder(Strict):
-    radius: Positive
+    radius: PositiveLength
     """Radius in metres."""
-    length: Positive
+    length: PositiveLength
     """Length along the z axis in metres; the cylinder is centred on its origin."""
 
 
 class Sphere(Strict):
-    radius: Positive
+    radius: PositiveLength
     """Radius in metres."""
 
 
@@ -218,9 +254,9 @@ class Inertial(Strict):
 
     density: Positive | None = None
     """Density in kg/m^3. Default: the recipe's ``density``."""
-    mass: Positive | None = None
+    mass: Annotated[Positive, MASS] | None = None
     """Total mass in kg."""
-    com: Vec3 | None = None
+    com: LengthVec3 | None = None
     """Centre of mass in the link frame, metres (explicit inertials only)."""
     inertia: Inertia | None = None
     """Explicit inertia tensor about the centre of mass, link axes."""
@@ -286,12 +322,14 @@ class Link(Strict):
     """Mass properties. Default: computed from the geometry at the recipe's density; a link with no geometry gets none. ``none``: the link has no inertial even though it has geometry (a frame with a marker shape)."""
     contact: Contact | None = None
     """Friction and contact parameters of the link's collision geometry."""
+    if_: bool | None = Field(None, alias="if")
+    """Keep this entry only when true (usually an expression of arguments: ``${with_camera}``)."""
 
 
 class Limit(Strict):
-    lower: float | None = None
+    lower: Annotated[float, POSITION] | None = None
     """Lower position limit (rad or m). Required for revolute and prismatic joints."""
-    upper: float | None = None
+    upper: Annotated[float, POSITION] | None = None
     """Upper position limit (rad or m). Required for revolute and prismatic joints."""
     effort: NonNegative | None = None
     """Maximum effort (N m or N). Required for revolute and prismatic joints."""
@@ -312,7 +350,7 @@ class Mimic(Strict):
     joint: str
     """The joint this joint follows: position = multiplier * joint + offset."""
     multiplier: float = 1.0
-    offset: float = 0.0
+    offset: Annotated[float, POSITION] = 0.0
 
 
 JOINT_TYPES = ("fixed", "revolute", "continuous", "prismatic", "floating", "planar")
@@ -331,6 +369,8 @@ class Joint(Strict):
     limit: Limit | None = None
     dynamics: Dynamics | None = None
     mimic: Mimic | None = None
+    if_: bool | None = Field(None, alias="if")
+    """Keep this entry only when true (usually an expression of arguments: ``${with_camera}``)."""
 
     @model_validator(mode="after")
     def _checks(self):
@@ -420,11 +460,11 @@ class CameraParams(Strict):
     """Image width in pixels."""
     height: Annotated[int, Field(gt=0)] = 480
     """Image height in pixels."""
-    hfov: Annotated[float, Field(gt=0, lt=3.1416)] = 1.047
+    hfov: Annotated[float, Field(gt=0, lt=3.1416), ANGLE] = 1.047
     """Horizontal field of view in radians."""
-    near: Positive = 0.05
+    near: PositiveLength = 0.05
     """Near clip distance in metres."""
-    far: Positive = 50.0
+    far: PositiveLength = 50.0
     """Far clip distance in metres."""
     format: str = "R8G8B8"
     """Image format (SDF names: R8G8B8, L8, ...)."""
@@ -433,29 +473,29 @@ class CameraParams(Strict):
 class LidarParams(Strict):
     samples: Annotated[int, Field(gt=0)] = 360
     """Horizontal rays per scan."""
-    min_angle: float = -3.141592653589793
+    min_angle: Annotated[float, ANGLE] = -3.141592653589793
     """Start of the horizontal scan, radians."""
-    max_angle: float = 3.141592653589793
+    max_angle: Annotated[float, ANGLE] = 3.141592653589793
     """End of the horizontal scan, radians."""
     vertical_samples: Annotated[int, Field(gt=0)] = 1
     """Vertical rays (1: a 2D lidar)."""
-    vertical_min_angle: float = 0.0
-    vertical_max_angle: float = 0.0
-    min_range: Positive = 0.1
+    vertical_min_angle: Annotated[float, ANGLE] = 0.0
+    vertical_max_angle: Annotated[float, ANGLE] = 0.0
+    min_range: PositiveLength = 0.1
     """Minimum range in metres."""
-    max_range: Positive = 12.0
+    max_range: PositiveLength = 12.0
     """Maximum range in metres."""
-    resolution: Positive = 0.01
+    resolution: PositiveLength = 0.01
     """Range resolution in metres."""
-    noise: NonNegative = 0.0
+    noise: Annotated[float, Field(ge=0), LENGTH] = 0.0
     """Standard deviation of Gaussian range noise, metres."""
 
 
 class SonarParams(Strict):
-    fov: Annotated[float, Field(gt=0, lt=3.1416)] = 0.26
+    fov: Annotated[float, Field(gt=0, lt=3.1416), ANGLE] = 0.26
     """Cone opening angle in radians."""
-    min_range: Positive = 0.02
-    max_range: Positive = 4.0
+    min_range: PositiveLength = 0.02
+    max_range: PositiveLength = 4.0
 
 
 class ImuParams(Strict):
@@ -470,7 +510,7 @@ class SensorBody(Strict):
 
     visual: Shapes
     """The sensor's shape (also its collision geometry)."""
-    mass: Positive
+    mass: Annotated[Positive, MASS]
     """Mass in kg; the inertia is computed from the shape at uniform density."""
 
 
@@ -494,6 +534,8 @@ class Sensor(Strict):
     sonar: SonarParams | None = None
     imu: ImuParams | None = None
     body: SensorBody | None = None
+    if_: bool | None = Field(None, alias="if")
+    """Keep this entry only when true (usually an expression of arguments: ``${with_camera}``)."""
 
     @model_validator(mode="after")
     def _params(self):
@@ -518,6 +560,8 @@ class Actuator(Strict):
     """Integral gain (ros_control only; MJCF actuators have none)."""
     d: NonNegative = 0.0
     """Derivative gain (MJCF position: kv)."""
+    if_: bool | None = Field(None, alias="if")
+    """Keep this entry only when true (usually an expression of arguments: ``${with_camera}``)."""
 
 
 class World(Strict):
@@ -525,7 +569,7 @@ class World(Strict):
 
     map: str
     """The map_server YAML file (relative to the recipe file that names it)."""
-    height: Positive = 2.0
+    height: PositiveLength = 2.0
     """Wall height in metres."""
     unknown_as_wall: bool = False
     """Treat unknown cells as walls (default: free space)."""
@@ -537,13 +581,64 @@ class World(Strict):
 RENAMED = {"ros_control": "ros"}
 
 
+Scalar = bool | float | str
+
+
+class Arg(Strict):
+    """A recipe or part argument (the short form ``NAME: DEFAULT`` gives the default only)."""
+
+    default: Scalar
+    """The value when neither ``--arg NAME:=VALUE``, a variant nor an instance sets it; its type (number, true/false, text, or a quantity such as ``5 cm``) is the type the argument takes."""
+    description: str = ""
+    choices: list[Scalar] | None = None
+    """The values allowed."""
+
+
+class Instance(Strict):
+    """One use of a part: its links, joints, sensors and actuators, named ``<prefix><name>``, placed on ``parent``."""
+
+    part: str
+    """Name of a part from ``parts``."""
+    parent: str
+    """The link the part is mounted on (``${parent}`` inside the part)."""
+    origin: Origin = Origin()
+    """Pose of the part's frame in the parent link: the part's joints and sensors whose parent is ``${parent}`` are placed relative to it."""
+    args: dict[str, Scalar] = {}
+    """Values of the part's arguments."""
+    prefix: str | None = None
+    """Prefix of every name the part defines (``${prefix}`` inside the part). Default: ``<instance name>_``."""
+    mirror: Literal["xz", "yz", "xy"] | None = None
+    """Reflect the placed part across this plane of the parent link (``xz``: left <-> right): poses, joint axes and limits, geometry (mesh scale), centres of mass and inertia tensors. A revolute axis becomes the mirror image of the motion; where that would reverse the axis (axes in the plane), the axis is kept and the joint value negated (limits [-upper, -lower])."""
+    if_: bool | None = Field(None, alias="if")
+    """Keep this entry only when true (usually an expression of arguments: ``${with_camera}``)."""
+
+
+class Part(Strict):
+    """A named, parametrised group of links, joints, sensors and actuators, defined once and used by ``instances``; inline or in a file of its own (the same keys)."""
+
+    description: str = ""
+    args: "dict[str, Arg | Scalar]" = {}
+    """The part's arguments with their defaults."""
+    values: dict[str, Scalar] = {}
+    """Named values (may use the arguments, ``${parent}`` and ``${prefix}``)."""
+    parts: "dict[str, Part | str]" = {}
+    """Parts used inside this one: definitions or files (relative to the file that names them)."""
+    links: "dict[str, Link]" = {}
+    joints: "dict[str, Joint]" = {}
+    """Joints; the ones whose parent is ``${parent}`` attach the part at the instance's origin."""
+    sensors: "dict[str, Sensor]" = {}
+    actuators: "dict[str, Actuator]" = {}
+    instances: "dict[str, Instance]" = {}
+    """Nested instances of parts, placed in this part's links."""
+
+
 class Recipe(Strict):
     """A robot recipe: the one source of truth for a robot description."""
 
     robot: str
     """Robot name: the ROS package, Gazebo model and output folder name."""
     include: list[str] = []
-    """Other YAML files (relative to this one) whose materials, links and joints are merged into this recipe."""
+    """Other YAML files (relative to this one) whose materials, links and joints are merged into this recipe (and whose urdf_extras are appended)."""
     units: Units = "m"
     """Default units of mesh files (m, cm, mm, in)."""
     density: Positive = 1000.0
@@ -552,12 +647,12 @@ class Recipe(Strict):
     """Default policy for meshes that are not closed volumes after safe repair."""
     meshes: MeshDefaults = MeshDefaults()
     """Mesh processing defaults: repair, visual decimation, collision strategy."""
-    measured_mass: Positive | None = None
+    measured_mass: Annotated[Positive, MASS] | None = None
     """The robot's total mass as weighed, in kg; `robotkit check` compares it with the sum of the links' masses."""
     self_collide: bool = False
     """Whether the robot's links collide with each other (Gazebo's ``self_collide``; MJCF contact filtering). Links joined by a joint never collide."""
     urdf_extras: list[str] = []
-    """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML."""
+    """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
     metadata: Metadata = Metadata()
     materials: dict[str, Material] = {}
     defaults: Defaults = Defaults()
@@ -575,6 +670,16 @@ class Recipe(Strict):
     """Which Gazebo the URDF's sensor and control plugins and launch/gazebo target: ``sim`` (Gazebo Sim, gz-sim systems; ROS 2 only) or ``classic`` (gazebo_ros plugins). Default: ``sim`` for ROS 2, ``classic`` for ROS 1."""
     worlds: dict[str, World] = {}
     """Worlds made from occupancy maps, by name (``robotkit world`` does the same from the command line)."""
+    args: dict[str, Arg | Scalar] = {}
+    """Arguments with their defaults, set with ``--arg NAME:=VALUE`` (``robotkit build``, ``check``, ``expand``; ``doit args='NAME:=VALUE ...'``) or by ``variants``; used as ``${NAME}``."""
+    values: dict[str, Scalar] = {}
+    """Named values, in order, each may use the arguments and the values before it: ``${NAME}``."""
+    parts: dict[str, Part | str] = {}
+    """Part definitions by name: a mapping (args, values, links, joints, sensors, actuators, instances) or the file holding one."""
+    instances: dict[str, Instance] = {}
+    """Uses of parts, by instance name."""
+    variants: dict[str, dict[str, Scalar]] = {}
+    """Named sets of argument values; each builds its own robot folder ``<robot>_<variant>`` (the recipe's defaults alone are then not built)."""
 
     @field_validator("robot")
     @classmethod

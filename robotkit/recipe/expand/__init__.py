@@ -1,0 +1,403 @@
+"""Expansion: the recipe language on top of the flat recipe.
+
+Between reading YAML (robotkit.recipe.load, line marks per key path) and
+validating against the schema, this stage turns
+
+- ``args:`` (defaults, overridden by ``--arg NAME:=VALUE`` and by ``variants:``),
+- ``values:`` (named values),
+- ``${...}`` expressions in any scalar (robotkit.recipe.expand.expr),
+- quantities with units, ``5 cm``, ``90 deg``, ``300 g`` (robotkit.recipe.expand.units),
+- ``parts:`` and ``instances:`` (prefixed, placed, optionally mirrored; robotkit.recipe.expand.parts),
+- ``if:`` on links, joints, sensors, actuators and instances
+
+into one flat recipe per variant, with line marks for every key: a problem in
+an instance of a part names the part's file:line and key, and the instance.
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import re
+from dataclasses import dataclass, field
+
+from robotkit.errors import Problem, display_path
+from robotkit.recipe.expand import expr as _expr
+from robotkit.recipe.expand import units as _units
+
+CONTROL = ("args", "values", "parts", "instances", "variants")
+ITEM_SECTIONS = ("links", "joints", "sensors", "actuators")
+VERBATIM = ("urdf_extras",)  # raw XML, copied as written (it may hold ${...} of its own)
+IDENT_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+WHOLE_RE = re.compile(r"^\$\{([^{}]*)\}$")
+PART_RE = re.compile(r"\$\$\{|\$\{([^{}]*)\}")
+
+
+def dotted(path) -> str:
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else ("." if out else "") + str(part)
+    return out
+
+
+@dataclass
+class Source:
+    """Where a tree was written: a file's marks and the key path of the tree in that file."""
+
+    where: dict  # key path -> (file, line), of the file (or merged recipe) the tree comes from
+    prefix: tuple = ()
+    via: str = ""  # " (in instance ...)" for trees expanded inside a part instance
+
+    def sub(self, *keys) -> "Source":
+        return Source(self.where, self.prefix + keys, self.via)
+
+    def locate(self, rel=()):
+        path = self.prefix + tuple(rel)
+        for n in range(len(path), -1, -1):
+            if path[:n] in self.where:
+                return self.where[path[:n]]
+        return None, None
+
+    def problem(self, rel, message: str) -> Problem:
+        file, line = self.locate(rel)
+        return Problem(message + self.via, file=file, line=line, key=dotted(self.prefix + tuple(rel)) or None)
+
+
+@dataclass
+class Expanded:
+    """One flat recipe (one variant): the data, and where each flat item was written."""
+
+    variant: str | None
+    data: dict
+    # (section, name) of a flat item -> (Source of the item, its key path in that source)
+    items: dict = field(default_factory=dict)
+    arg_names: tuple = ()
+    files: tuple = ()  # part files read (dependencies even when no item of theirs is kept)
+
+
+class Context:
+    """Problems and the part definitions visible while expanding."""
+
+    def __init__(self, read_yaml, problems: list[Problem]):
+        self.read_yaml = read_yaml  # file -> (data, marks) (robotkit.recipe.load._read_yaml)
+        self.problems = problems
+        self.part_files: dict = {}  # resolved path -> (data, marks)
+
+    def report(self, src: Source, rel, message: str):
+        self.problems.append(src.problem(rel, message))
+
+
+# ---------------------------------------------------------------- expressions
+
+
+def evaluate_tree(node, scope: dict, ctx: Context, src: Source, rel=()):
+    """A copy of ``node`` with every ``${...}`` replaced by its value."""
+    if isinstance(node, dict):
+        return {k: evaluate_tree(v, scope, ctx, src, rel + (k,)) for k, v in node.items()}
+    if isinstance(node, list):
+        return [evaluate_tree(v, scope, ctx, src, rel + (i,)) for i, v in enumerate(node)]
+    if isinstance(node, str) and "${" in node:
+        return evaluate_string(node, scope, ctx, src, rel)
+    return node
+
+
+def evaluate_string(text: str, scope: dict, ctx: Context, src: Source, rel):
+    m = WHOLE_RE.match(text.strip())
+    try:
+        if m and text.strip() == text:
+            return _expr.evaluate(m.group(1), scope)
+        out, pos = [], 0
+        for part in PART_RE.finditer(text):
+            out.append(text[pos:part.start()])
+            if part.group(0) == "$${":
+                out.append("${")
+            else:
+                current = part.group(1)
+                out.append(_expr.show(_expr.evaluate(current, scope)))
+            pos = part.end()
+        out.append(text[pos:])
+        result = "".join(out)
+        if "${" in result.replace("$${", "") and "${" in text[pos:]:
+            raise _expr.ExprError("'${' without its closing '}'")
+        return result
+    except _expr.ExprError as exc:
+        ctx.report(src, rel, f"in {text.strip()}: {exc}")
+        return text
+
+
+# ---------------------------------------------------------------- arguments
+
+
+def _kind(default):
+    """The type an argument takes, from its default: bool, number, text, or a quantity's dimension."""
+    if isinstance(default, bool):
+        return "bool"
+    if isinstance(default, (int, float)):
+        return "number"
+    if isinstance(default, str):
+        try:
+            q = _units.parse(default)
+        except ValueError:
+            q = None
+        if q is not None:
+            return q[1]
+    return "text"
+
+
+def coerce(value, kind: str, from_text: bool):
+    """``value`` as an argument of ``kind``; raises ValueError with the reason."""
+    if from_text and kind != "text":
+        import yaml
+
+        try:
+            value = yaml.safe_load(value) if value.strip() else value
+        except yaml.YAMLError:
+            pass
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise ValueError(f"must be true or false (got {value!r})")
+        return value
+    if kind == "text":
+        return value if isinstance(value, str) else _expr.show(value)
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return value
+    if isinstance(value, str) and kind != "number":
+        try:
+            q = _units.parse(value)
+        except ValueError as exc:
+            raise ValueError(str(exc)) from None
+        if q is not None:
+            if q[1] != kind:
+                raise ValueError(f"must be {_units.ARTICLE[kind]} (got '{value}')")
+            return q[0]
+    want = "a number" if kind == "number" else f"{_units.ARTICLE[kind]} (a number in SI units or with a unit)"
+    raise ValueError(f"must be {want} (got {value!r})")
+
+
+def _si(value):
+    """A quantity string (``5 cm``) as its SI number; anything else unchanged."""
+    if isinstance(value, str):
+        try:
+            q = _units.parse(value)
+        except ValueError:
+            return value
+        if q is not None:
+            return q[0]
+    return value
+
+
+def declare_args(block, scope: dict, ctx: Context, src: Source):
+    """{name: (kind, default value, choices)} of an ``args:`` block (defaults may use earlier args)."""
+    out = {}
+    if block is None:
+        return out
+    if not isinstance(block, dict):
+        ctx.report(src, (), f"must be a mapping of argument names to defaults (got {block!r})")
+        return out
+    local = dict(scope)
+    for name, spec in block.items():
+        if not IDENT_RE.match(name) or name in _expr.FUNCTIONS or name in _expr.CONSTANTS:
+            ctx.report(src, (name,), "an argument name must be a plain identifier (letters, digits, '_'), "
+                                     "not a function or constant name")
+            continue
+        choices = None
+        if isinstance(spec, dict):
+            extra = [k for k in spec if k not in ("default", "description", "choices")]
+            if extra:
+                ctx.report(src, (name, extra[0]), "unknown key (expected one of: default, description, choices)")
+            if "default" not in spec:
+                ctx.report(src, (name,), "an argument needs a 'default'")
+                continue
+            default = spec["default"]
+            choices = spec.get("choices")
+            where = (name, "default")
+            if choices is not None and not isinstance(choices, list):
+                ctx.report(src, (name, "choices"), f"must be a list (got {choices!r})")
+                choices = None
+        else:
+            default, where = spec, (name,)
+        if isinstance(default, (dict, list)) or default is None:
+            ctx.report(src, where, f"a default must be a number, true/false or text (got {default!r})")
+            continue
+        default = evaluate_tree(default, local, ctx, src, where)
+        kind = _kind(default)
+        value = _si(default) if kind not in ("bool", "number", "text") else default
+        if choices is not None and default not in choices and value not in choices:
+            ctx.report(src, where, f"the default {default!r} is not one of the choices")
+        out[name] = (kind, value, choices)
+        local[name] = value
+    return out
+
+
+def bind_args(declared: dict, given: dict, ctx: Context, what: str, locate, from_text: bool,
+              base: dict | None = None) -> dict:
+    """Argument values: the defaults with ``given`` ({name: value}) applied and checked.
+
+    ``locate(name)`` -> (Source, rel) where the given value was written; unknown names and wrong
+    types are problems."""
+    values = dict(base) if base is not None else {name: v for name, (kind, v, choices) in declared.items()}
+    for name, value in given.items():
+        src, rel = locate(name)
+        if name not in declared:
+            close = difflib.get_close_matches(name, list(declared), n=1)
+            hint = f" (did you mean '{close[0]}'?)" if close else (
+                f" (arguments: {', '.join(declared)})" if declared else f" ({what} declares no arguments)")
+            ctx.report(src, rel, f"unknown argument '{name}' of {what}{hint}")
+            continue
+        kind, _, choices = declared[name]
+        try:
+            v = coerce(value, kind, from_text)
+        except ValueError as exc:
+            ctx.report(src, rel, f"argument '{name}' {exc}")
+            continue
+        if choices is not None and v not in choices and value not in choices:
+            ctx.report(src, rel, f"argument '{name}' must be one of {', '.join(map(repr, choices))} (got {value!r})")
+            continue
+        values[name] = v
+    return values
+
+
+def declare_values(block, scope: dict, ctx: Context, src: Source) -> dict:
+    """The named values of a ``values:`` block, in order (each may use the ones before it)."""
+    if block is None:
+        return scope
+    if not isinstance(block, dict):
+        ctx.report(src, (), f"must be a mapping of names to values (got {block!r})")
+        return scope
+    scope = dict(scope)
+    for name, v in block.items():
+        if not IDENT_RE.match(name) or name in _expr.FUNCTIONS or name in _expr.CONSTANTS:
+            ctx.report(src, (name,), "a value name must be a plain identifier (letters, digits, '_'), "
+                                     "not a function or constant name")
+            continue
+        scope[name] = _si(evaluate_tree(v, scope, ctx, src, (name,)))
+    return scope
+
+
+# ---------------------------------------------------------------- conditions
+
+
+def keep(item, ctx: Context, src: Source, rel) -> bool:
+    """False when the item's ``if:`` is false; the key is removed from the item."""
+    if not isinstance(item, dict) or "if" not in item:
+        return True
+    cond = item.pop("if")
+    if isinstance(cond, bool):
+        return cond
+    if isinstance(cond, str) and "${" in cond:
+        return True  # the expression's own problem is already reported
+    ctx.report(src, rel + ("if",), f"must be true or false (got {cond!r})")
+    return True
+
+
+# ---------------------------------------------------------------- the stage
+
+
+def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_yaml, problems: list[Problem],
+           ignore_unknown_args: bool = False) -> list[Expanded]:
+    """The flat recipe(s) of ``data``: one per variant (one when there are none)."""
+    from robotkit.recipe.expand.parts import expand_instances
+
+    ctx = Context(read_yaml, problems)
+    top = Source(where)
+    if not any(k in data for k in CONTROL) and not overrides and not _has_if(data) and not _has_dollar(
+            {k: v for k, v in data.items() if k not in VERBATIM}):
+        return [Expanded(None, data)]
+    declared = declare_args(data.get("args"), {}, ctx, top.sub("args"))
+    arg_line = top.locate(("args",)) if "args" in data else (file, None)
+    cli = Source({(): arg_line})  # --arg problems name the option, at the recipe's args block
+    if ignore_unknown_args:
+        overrides = {k: v for k, v in overrides.items() if k in declared}
+    variants = data.get("variants")
+    if variants is not None and not (isinstance(variants, dict) and all(
+            isinstance(v, dict) or v is None for v in variants.values())):
+        ctx.report(top, ("variants",), "must be a mapping of variant names to argument values")
+        variants = None
+    out = []
+    for variant, given in (variants or {None: {}}).items():
+        vsrc = top.sub("variants", variant) if variant is not None else top
+        values = bind_args(declared, given or {}, ctx, "the recipe", lambda n: (vsrc, (n,)), from_text=False)
+        values = bind_args(declared, overrides, ctx, "the recipe", lambda n: (cli, (f"--arg {n}",)),
+                           from_text=True, base=values)
+        scope = declare_values(data.get("values"), values, ctx, top.sub("values"))
+        flat = {}
+        for key, value in data.items():
+            if key in CONTROL:
+                continue
+            flat[key] = evaluate_tree(value, scope, ctx, top.sub(key)) if key not in ITEM_SECTIONS + VERBATIM \
+                else value
+        result = Expanded(variant, flat, arg_names=tuple(declared))
+        for section in ITEM_SECTIONS:
+            items = data.get(section)
+            if not isinstance(items, dict):
+                if section in data:
+                    flat[section] = evaluate_tree(items, scope, ctx, top.sub(section))
+                continue
+            kept = {}
+            for name, item in items.items():
+                item = evaluate_tree(item, scope, ctx, top.sub(section, name))
+                if keep(item, ctx, top, (section, name)):
+                    kept[name] = item
+            flat[section] = kept
+        if "instances" in data:
+            parts_env = [(data.get("parts"), top.sub("parts"), scope, file)]
+            expand_instances(data["instances"], top.sub("instances"), scope, parts_env, ctx, flat, result.items,
+                             default_units=data.get("units") if isinstance(data.get("units"), str) else "m",
+                             chain=())
+        elif "parts" in data and not isinstance(data["parts"], dict):
+            ctx.report(top, ("parts",), "must be a mapping of part names to definitions or files")
+        if variant is not None and isinstance(flat.get("robot"), str):
+            flat["robot"] = f"{flat['robot']}_{variant}"
+        out.append(result)
+    for result in out:
+        result.files = tuple(sorted(p for p, (d, _) in ctx.part_files.items() if d is not None))
+    return out
+
+
+def _has_if(data: dict) -> bool:
+    return any(isinstance(items, dict) and any(isinstance(v, dict) and "if" in v for v in items.values())
+               for items in (data.get(s) for s in ITEM_SECTIONS))
+
+
+def _has_dollar(node) -> bool:
+    if isinstance(node, dict):
+        return any(_has_dollar(v) for v in node.values())
+    if isinstance(node, list):
+        return any(_has_dollar(v) for v in node)
+    return isinstance(node, str) and "${" in node
+
+
+def convert_units(data: dict, problem) -> dict:
+    """Quantities -> SI numbers in the flat recipe (after ``defaults:`` are merged)."""
+    return _units.convert(data, problem)
+
+
+def copy_marks(expanded: Expanded, where: dict) -> tuple[dict, dict]:
+    """Line marks of the flat recipe: the recipe's own, plus every instance item's, copied from
+    where it was written.  Returns (where, origins): origins maps a flat item's key path to
+    (its key path in its source, the instance text) for messages."""
+    out = dict(where)
+    origins = {}
+    index: dict = {}
+    for (section, name), (src, path) in expanded.items.items():
+        depth = len(path)
+        key = (id(src.where), depth)
+        if key not in index:
+            groups: dict = {}
+            for p, m in src.where.items():
+                if len(p) >= depth:
+                    groups.setdefault(p[:depth], []).append((p[depth:], m))
+            index[key] = groups
+        dst = (section, name)
+        for rest, m in index[key].get(path, []):
+            out[dst + rest] = m
+        origins[dst] = (path, src.via)
+    return out, origins
+
+
+def deepcopy(data):
+    return copy.deepcopy(data)
+
+
+def display(path) -> str:
+    return display_path(path)
