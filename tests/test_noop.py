@@ -56,7 +56,9 @@ class Calls:
 
 
 def build(capsys) -> str:
-    assert main(["build", "bot.yaml", "--out", "out"]) == 0
+    # -j 1: the CLI runs inside the test process, which holds other libraries' threads (rendering,
+    # Drake): a doit worker forked from it could deadlock
+    assert main(["build", "bot.yaml", "--out", "out", "-j", "1"]) == 0
     return capsys.readouterr().out.strip()
 
 
@@ -118,7 +120,7 @@ def test_a_failed_build_removes_the_stamp(project, capsys, monkeypatch):
     calls = Calls(monkeypatch)
     build(capsys)
     bump(project / "bot.yaml", RECIPE.replace("density: 1000", "density: -1"))
-    assert main(["build", "bot.yaml", "--out", "out"]) == 2
+    assert main(["build", "bot.yaml", "--out", "out", "-j", "1"]) == 2
     assert "density" in capsys.readouterr().err
     assert not list((project / "out" / ".robotkit").glob("stamp-*.json"))
     bump(project / "bot.yaml", RECIPE)  # back to what was built: doit finds every task up to date
@@ -129,7 +131,7 @@ def test_a_failed_build_removes_the_stamp(project, capsys, monkeypatch):
 def test_another_output_folder_has_its_own_stamp(project, capsys, monkeypatch):
     calls = Calls(monkeypatch)
     build(capsys)
-    assert main(["build", "bot.yaml", "--out", "other"]) == 0
+    assert main(["build", "bot.yaml", "--out", "other", "-j", "1"]) == 0
     assert capsys.readouterr().out.startswith("built other/bot: ") and calls.n == 2
     assert build(capsys).startswith("out/bot: up to date (") and calls.n == 2
 
