@@ -46,7 +46,9 @@ def ros1_packages(tmp_path_factory) -> Path:
     from robotkit.build import build
 
     out = tmp_path_factory.mktemp("ros1-build")
-    build([RECIPES / f"{name}.yaml" for name in EXAMPLES], out, jobs=2, ros="ros1")
+    # one process: a doit worker forked from the test process, which holds other libraries'
+    # threads (Drake, rendering), could deadlock; the session's mesh cache makes this quick
+    build([RECIPES / f"{name}.yaml" for name in EXAMPLES], out, ros="ros1")
     return out
 
 

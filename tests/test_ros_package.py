@@ -25,7 +25,9 @@ def ros2_packages(tmp_path_factory) -> Path:
     from robotkit.build import build
 
     out = tmp_path_factory.mktemp("ros2-build")
-    build([RECIPES / f"{name}.yaml" for name in EXAMPLES], out, jobs=2, ros="ros2")
+    # one process: a doit worker forked from the test process, which holds other libraries'
+    # threads (Drake, rendering), could deadlock; the session's mesh cache makes this quick
+    build([RECIPES / f"{name}.yaml" for name in EXAMPLES], out, ros="ros2")
     return out
 
 
