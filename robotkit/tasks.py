@@ -107,14 +107,14 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     for rel, mesh in sorted(processed.items()):
         target = str(root / "meshes" / rel)
         mesh_outputs.append(target)
-        report = str(state / "visual" / f"{mesh.key}.json")
+        visual_report = str(state / "visual" / f"{mesh.key}.json")
         tasks.append({
             "name": f"{robot.name}:visual:{mesh.file_name}",
             "doc": f"processed visual mesh {mesh.file_name}",
             "actions": [(actions.process_visual, [mesh.source, list(mesh.scale), list(mesh.decimate), mesh.repair,
-                                                  where.get(mesh.key, {}), target, report])],
+                                                  where.get(mesh.key, {}), target, visual_report])],
             "file_dep": [mesh.source, facts[mesh.key]],
-            "targets": [target, report],
+            "targets": [target, visual_report],
             "uptodate": [config_changed({"scale": list(mesh.scale), "decimate": list(mesh.decimate),
                                          "repair": mesh.repair, "version": actions.FACTS_VERSION})],
             "clean": True,
@@ -415,8 +415,8 @@ def load_robots(recipe_files, ros: str | None = None, args: dict[str, str] | Non
     return robots
 
 
-def all_tasks(recipe_files, out_dir, report: bool = True, args: dict[str, str] | None = None,
-              ignore_unknown_args: bool = False) -> list[dict]:
+def all_tasks(recipe_files, out_dir, args: dict[str, str] | None = None, ignore_unknown_args: bool = False,
+              report: bool = True) -> list[dict]:
     tasks = []
     for loaded, robot in load_robots(recipe_files, None, args, ignore_unknown_args):
         tasks.extend(robot_tasks(robot, out_dir, mesh_locations(loaded, robot), report=report))

@@ -559,7 +559,7 @@ def test_doit_takes_arguments_for_the_recipes_that_declare_them(tmp_path):
     a = write_recipe(tmp_path, "robot: a\nargs: {size: 0.1}\nlinks: {base: {visual: {sphere: {radius: '${size}'}}}}\n",
                      name="a.yaml")
     b = write_recipe(tmp_path, "robot: b\nlinks: {base: {}}\n", name="b.yaml")
-    tasks = all_tasks([a, b], tmp_path / "out", {"size": "0.2"}, ignore_unknown_args=True)
+    tasks = all_tasks([a, b], tmp_path / "out", args={"size": "0.2"}, ignore_unknown_args=True)
     assert tasks
     with pytest.raises(RobotkitError) as exc:
         all_tasks([a, b], tmp_path / "out", {"colour": "red"}, ignore_unknown_args=True)
