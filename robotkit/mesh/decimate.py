@@ -191,13 +191,19 @@ def surface_distance(a, b, samples: int = DEFAULT_SAMPLES, seed: int = 0) -> dic
     pb = _samples(b, samples, seed + 1)
     dab = point_surface_distance(pa, b)
     dba = point_surface_distance(pb, a)
+    return distance_summary(dab, dba, samples, "exact point-to-triangle distance from area-uniform samples "
+                            "(fixed seed), both directions")
+
+
+def distance_summary(dab, dba, samples: int, method: str) -> dict:
+    """The figures reported for two one-way distance samples (a to b, b to a)."""
     both = np.concatenate([dab, dba])
     return {
         "max": float(both.max()), "mean": float(both.mean()),
         "a_to_b_max": float(dab.max()), "a_to_b_mean": float(dab.mean()),
         "b_to_a_max": float(dba.max()), "b_to_a_mean": float(dba.mean()),
         "samples": int(samples),
-        "method": "exact point-to-triangle distance from area-uniform samples (fixed seed), both directions",
+        "method": method,
     }
 
 

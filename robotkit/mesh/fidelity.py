@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from robotkit.mesh.decimate import DEFAULT_SAMPLES, _samples, closed_volume, point_surface_distance, surface_distance
+from robotkit.mesh.decimate import (DEFAULT_SAMPLES, _samples, closed_volume, distance_summary, point_surface_distance,
+                                    surface_distance)
 
 
 def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed: int = 0) -> dict:
@@ -94,15 +95,8 @@ def _primitive_distance(prim, visual_mesh, samples: int, seed: int) -> dict:
     """:func:`surface_distance`'s figures between one primitive's exact surface and ``visual_mesh``."""
     dab = point_surface_distance(prim.sample(samples, seed), visual_mesh)
     dba = prim.distance(_samples(visual_mesh, samples, seed + 1))
-    both = np.concatenate([dab, dba])
-    return {
-        "max": float(both.max()), "mean": float(both.mean()),
-        "a_to_b_max": float(dab.max()), "a_to_b_mean": float(dab.mean()),
-        "b_to_a_max": float(dba.max()), "b_to_a_mean": float(dba.mean()),
-        "samples": int(samples),
-        "method": "exact distances between area-uniform samples of the primitive's exact surface and of "
-                  "the mesh (fixed seed) and the other surface, both directions",
-    }
+    return distance_summary(dab, dba, samples, "exact distances between area-uniform samples of the primitive's "
+                            "exact surface and of the mesh (fixed seed) and the other surface, both directions")
 
 
 def _union(meshes: list) -> tuple[trimesh.Trimesh, float | None, str]:
