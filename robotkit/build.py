@@ -37,9 +37,10 @@ SLOW = 1.0  # seconds: tasks at least this long are reported with their time
 class _Recorder:
     """A doit reporter that records instead of printing."""
 
-    def __init__(self, result: BuildResult, echo=None, progress=None):
+    def __init__(self, result: BuildResult, echo=None, progress=None, on_done=None):
         self.result = result
         self.echo = echo
+        self.on_done = on_done  # called with (task name, ok) as each task ends or is up to date
         self.progress = progress  # a stream for progress of long tasks (None: quiet)
         self.started: dict[str, float] = {}
         self.failures = []
@@ -66,6 +67,8 @@ class _Recorder:
     def add_failure(self, task, fail):
         from doit.exceptions import TaskFailed, UnmetDependency
 
+        if self.on_done is not None:
+            self.on_done(task.name, False)
         if isinstance(fail, UnmetDependency):
             return
         if isinstance(fail, TaskFailed):
@@ -77,6 +80,8 @@ class _Recorder:
     def add_success(self, task):
         import time
 
+        if self.on_done is not None:
+            self.on_done(task.name, True)
         start = self.started.pop(task.name, None)
         if start is None or self.progress is None or not self.progress.isatty():
             return  # quiet when not a terminal: logs and CI output stay deterministic
@@ -87,6 +92,8 @@ class _Recorder:
 
     def skip_uptodate(self, task):
         self.result.uptodate.append(task.name)
+        if self.on_done is not None:
+            self.on_done(task.name, True)
 
     def skip_ignore(self, task):
         pass
@@ -134,11 +141,16 @@ def to_doit(task: dict) -> dict:
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
           echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None,
-          report: bool = False, args: dict[str, str] | None = None) -> BuildResult:
+          report: bool = False, args: dict[str, str] | None = None, keep_going: bool = False,
+          on_plan=None, on_done=None) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
     ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key; ``args`` sets recipe arguments (``--arg``).
     ``report`` also writes each robot's picture report (``<robot>/report/report.html``); the
     command line does unless ``--no-report``.
+
+    ``keep_going`` returns the result with its ``failed`` tasks instead of raising, so that a
+    batch (``robotkit catalogue``) builds every robot it can; ``on_plan(n)`` is told how many
+    tasks the build has and ``on_done(task, ok)`` each one that ends.
 
     The stamp of the no-op fast path (:mod:`robotkit.stamp`) is removed first and written
     again when the build succeeds; ``stamp_options`` are the options it is kept under
@@ -163,7 +175,9 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     for loaded, robot in robots:
         tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot), report=report))
     (out / ".robotkit").mkdir(parents=True, exist_ok=True)
-    recorder = _Recorder(result, echo, progress)
+    recorder = _Recorder(result, echo, progress, on_done)
+    if on_plan is not None:
+        on_plan(len(tasks))
     inputs = _input_stats(robots, tasks)  # before running: an edit during the build is a change
 
     class Loader(TaskLoader2):
@@ -182,7 +196,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     rc = DoitMain(Loader(), config_filenames=()).run(args)
     if recorder.runtime_errors:
         result.errors.append(("doit", "\n".join(recorder.runtime_errors)))
-    if result.failed:
+    if result.failed and not keep_going:
         lines = []
         for _, msg in result.failed:
             for line in msg.splitlines():
@@ -191,10 +205,10 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         error = RobotkitError([Problem(line) for line in lines])
         error.exit_status = result.exit_status or 2
         raise error
-    if rc not in (0,) and not result.errors:
+    if rc not in (0,) and not result.errors and not result.failed:
         result.errors.append(("doit", f"doit exited with status {rc}"))
     result.warnings = collect_warnings(tasks) + collect_losses(out, result.robots)
-    if rc == 0 and not result.errors:
+    if rc == 0 and not result.errors and not result.failed:
         outputs = sorted({str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])})
         try:
             stamp.write(out, stamp_options, inputs, outputs,

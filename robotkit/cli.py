@@ -8,6 +8,7 @@ the commands, so ``robotkit --help`` and argument errors stay instant.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import time
@@ -35,6 +36,28 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--name", help="world name (default: the YAML file's stem)")
     w.add_argument("--height", type=float, default=2.0, metavar="H", help="wall height in metres (default: 2.0)")
     w.add_argument("--unknown-as-wall", action="store_true", help="treat unknown cells as walls")
+
+    k = sub.add_parser("catalogue", help="turn a folder of object meshes into simulation-ready objects",
+                       description="Build every STL/OBJ/DAE mesh below DIR (or listed in a text file, one path "
+                                   "a line) into OUT/<object>/ (URDF, SDF, MJCF, collision decomposition, mass "
+                                   "properties) and write OUT/catalogue.json and OUT/catalogue.csv. A bad mesh is "
+                                   "reported and skipped; a rerun builds only what is missing or changed. Exit 0 "
+                                   "when every object was made, 1 when some failed, 2 for bad input.")
+    k.add_argument("source", metavar="DIR", help="folder of meshes (searched recursively) or a list file")
+    k.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
+    k.add_argument("--density", type=float, default=1000.0, metavar="KG_M3",
+                   help="density for objects without a mass in the table (default: 1000)")
+    k.add_argument("--masses", metavar="CSV", help="table with columns name (object name or relative path), "
+                                                   "mass (kg) and optionally units (m, cm, mm, in)")
+    k.add_argument("--units", choices=["m", "cm", "mm", "in"],
+                   help="units of every mesh (default: guessed from each mesh's size and reported)")
+    k.add_argument("--collision", choices=["decompose", "hull", "box", "cylinder", "sphere", "capsule", "none"],
+                   default="decompose", help="collision geometry (default: decompose, CoACD)")
+    k.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
+                   help="parallel processes (default: the cores; with --scheduler, the cluster's threads)")
+    k.add_argument("--scheduler", metavar="ADDRESS",
+                   help="send the mesh work to this Dask scheduler (default: $DASK_SCHEDULER_ADDRESS); "
+                        "'local' starts one worker per core")
 
     c = sub.add_parser("check", help="validate a recipe, a build folder, or a URDF/SDF/MJCF file",
                        description="Run the validators, the URDF/SDF/MJCF equivalence check and a MuJoCo "
@@ -102,8 +125,12 @@ def _add_build(sub) -> None:
                        description="Build each RECIPE into OUT/<robot>/ (incremental: only what changed reruns).")
     b.add_argument("recipes", nargs="+", metavar="RECIPE", help="recipe YAML file(s)")
     b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
-    b.add_argument("-j", "--jobs", type=int, default=_cores(), metavar="N",
-                   help=f"run N tasks in parallel processes (default: the {_cores()} cores this process may use)")
+    b.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
+                   help=f"run N tasks in parallel processes (default: the {_cores()} cores this process may use; "
+                        "with --scheduler, the cluster's threads)")
+    b.add_argument("--scheduler", metavar="ADDRESS",
+                   help="send the expensive mesh work (CoACD, hulls, decimation) to this Dask scheduler "
+                        "(default: $DASK_SCHEDULER_ADDRESS); 'local' starts one worker per core")
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
     b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
                                                            "recipes' `ros` key)")
@@ -140,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return {"build": _build, "world": _world, "schema": _schema, "check": _check,
-                "import": _import, "report": _report, "view": _view, "expand": _expand}[args.command](args)
+                "import": _import, "report": _report, "catalogue": _catalogue, "view": _view, "expand": _expand}[args.command](args)
     except Exception as exc:
         from robotkit.errors import RobotkitError  # imported late: dataclasses costs a no-op build 10 ms
 
@@ -157,7 +184,7 @@ def main(argv: list[str] | None = None) -> int:
 def _build(args) -> int:
     from robotkit import stamp
 
-    if args.jobs < 1:
+    if args.jobs is not None and args.jobs < 1:
         print("robotkit: error: -j must be at least 1", file=sys.stderr)
         return 2
     start = time.perf_counter()
@@ -170,8 +197,9 @@ def _build(args) -> int:
     from robotkit.build import build
 
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
-    result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, ros=args.ros,
-                   report=not args.no_report, stamp_options=opts, args=dict(args.arg))
+    with _scheduler(args) as jobs:
+        result = build(args.recipes, args.out, jobs=jobs, echo=echo, progress=sys.stderr, ros=args.ros,
+                       report=not args.no_report, stamp_options=opts, args=dict(args.arg))
     if result.ran or args.verbose:
         for w in result.warnings:
             print(f"warning: {w}", file=sys.stderr)
@@ -192,6 +220,53 @@ def _build(args) -> int:
     else:
         print(f"{names}: up to date ({len(result.uptodate)} tasks, {elapsed:.2f} s)")
     return 0
+
+
+@contextlib.contextmanager
+def _scheduler(args):
+    """The number of doit jobs, with the Dask scheduler (``--scheduler``, ``local`` or
+    $DASK_SCHEDULER_ADDRESS) exported to the task processes (robotkit.distributed)."""
+    from robotkit import distributed
+
+    address = args.scheduler or os.environ.get(distributed.DASK_ENV)
+    if not address:
+        yield args.jobs or _cores()
+        return
+    old = os.environ.get(distributed.ENV)
+    with (distributed.LocalCluster() if address == "local" else contextlib.nullcontext()) as cluster:
+        address = cluster.address if cluster is not None else address
+        # every doit process waits on the cluster: as many as it has threads
+        jobs = args.jobs or min(64, cluster.workers if cluster is not None else distributed.cluster_threads(address))
+        os.environ[distributed.ENV] = address
+        try:
+            yield jobs
+        finally:
+            if old is None:
+                os.environ.pop(distributed.ENV, None)
+            else:
+                os.environ[distributed.ENV] = old
+
+
+def _catalogue(args) -> int:
+    if args.jobs is not None and args.jobs < 1:
+        print("robotkit: error: -j must be at least 1", file=sys.stderr)
+        return 2
+    from robotkit.catalogue import catalogue
+
+    start = time.perf_counter()
+    with _scheduler(args) as jobs:
+        index = catalogue(args.source, args.out, density=args.density, units=args.units, masses=args.masses,
+                          collision=args.collision, jobs=jobs)
+    for obj in index["objects"]:
+        if obj["status"] != "ok":
+            for line in obj["errors"] or ["failed"]:
+                print(f"{obj['source']}: {line}", file=sys.stderr)
+    guessed = sum(o["units_from"] == "guessed" for o in index["objects"])
+    out = os.path.relpath(os.path.abspath(args.out))
+    print(f"catalogue {out}: {index['ok']} objects made, {index['failed']} failed"
+          f"{f', units guessed for {guessed}' if guessed else ''} ({out}/catalogue.json, "
+          f"{time.perf_counter() - start:.1f} s)")
+    return 1 if index["failed"] else 0
 
 
 def _report_up_to_date(args, done: dict, start: float) -> int:

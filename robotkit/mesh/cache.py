@@ -7,8 +7,13 @@ scipy) and robotkit's version, followed by the digest of every input (raw
 bytes, or :func:`mesh_digest` of a mesh).  Changing any of them is a miss.
 
 **Location.**  ``Cache(root)``; by default ``$ROBOTKIT_CACHE``, else
-``$XDG_CACHE_HOME/robotkit``, else ``~/.cache/robotkit``.  Entries live in
-``<root>/v1/<key[:2]>/``:
+``$XDG_CACHE_HOME/robotkit``, else ``~/.cache/robotkit``.  When ``$ROBOTKIT_CACHE`` (or
+``root``) is a URL of a filesystem fsspec supports (``s3://bucket/prefix``...), that is a
+*shared* cache (:mod:`robotkit.mesh.remote`) and the local default folder is its
+read-through copy: a lookup tries the local copy, then the shared one (verified, then
+copied locally); a computed entry is stored locally and published to the shared copy
+unless ``ROBOTKIT_CACHE_READONLY`` is set.  Entries live in ``<root>/v1/<key[:2]>/``
+(the same names locally and remotely):
 
 - ``<key>.<payload sha256[:16]>.bin``: the meshes, as little-endian float64
   vertices and int32/int64 faces back to back (exact: binary STL would round
@@ -53,10 +58,17 @@ LIBRARIES = ("trimesh", "coacd", "meshlib", "manifold3d", "numpy", "scipy")
 
 
 def default_root() -> Path:
-    """``$ROBOTKIT_CACHE``, else ``$XDG_CACHE_HOME/robotkit``, else ``~/.cache/robotkit``."""
+    """The local cache folder: ``$ROBOTKIT_CACHE`` when it is a folder, else (no cache set, or
+    a shared one named by URL) ``$ROBOTKIT_CACHE_LOCAL``, ``$XDG_CACHE_HOME/robotkit`` or
+    ``~/.cache/robotkit``."""
+    from robotkit.mesh.remote import is_url
+
     env = os.environ.get("ROBOTKIT_CACHE")
-    if env:
+    if env and not is_url(env):
         return Path(env).expanduser()
+    local = os.environ.get("ROBOTKIT_CACHE_LOCAL")
+    if local:
+        return Path(local).expanduser()
     xdg = os.environ.get("XDG_CACHE_HOME")
     base = Path(xdg).expanduser() if xdg and os.path.isabs(os.path.expanduser(xdg)) else Path.home() / ".cache"
     return base / "robotkit"
@@ -120,10 +132,26 @@ class CacheCorrupt(Exception):
 class Cache:
     """See the module docstring.  ``versions`` overrides :func:`library_versions` (tests)."""
 
-    def __init__(self, root: str | os.PathLike | None = None, versions: dict | None = None):
-        self.root = Path(root).expanduser() if root is not None else default_root()
+    def __init__(self, root: str | os.PathLike | None = None, versions: dict | None = None, *,
+                 local: str | os.PathLike | None = None):
+        from robotkit.mesh.remote import is_url
+
+        location = os.fspath(root) if root is not None else os.environ.get("ROBOTKIT_CACHE", "")
+        self.remote, self.remote_writable, self.remote_problems = None, False, []
+        self.stats = {"hits": 0, "misses": 0, "corrupt": 0, "stored": 0,
+                      "remote_hits": 0, "remote_corrupt": 0, "published": 0, "remote_errors": 0}
+        if location and is_url(location):
+            from robotkit.mesh.remote import RemoteError, RemoteStore, read_only
+
+            try:
+                self.remote = RemoteStore(location)
+                self.remote_writable = not read_only()
+            except RemoteError as exc:
+                self._remote_problem(exc)
+            self.root = Path(local).expanduser() if local is not None else default_root()
+        else:
+            self.root = Path(location).expanduser() if location else default_root()
         self.versions = dict(versions) if versions is not None else library_versions()
-        self.stats = {"hits": 0, "misses": 0, "corrupt": 0, "stored": 0}
 
     # --- keys and paths ----------------------------------------------------------------------
 
@@ -141,6 +169,11 @@ class Cache:
     def manifest_path(self, key: str) -> Path:
         return self.folder(key) / f"{key}.json"
 
+    @staticmethod
+    def entry_name(key: str, file: str) -> str:
+        """The name of one of an entry's files relative to a cache root."""
+        return f"v{CACHE_FORMAT}/{key[:2]}/{file}"
+
     # --- public API ---------------------------------------------------------------------------
 
     def get_or_compute(self, op: str, params: dict, inputs, compute: Callable[[], object], *,
@@ -152,21 +185,68 @@ class Cache:
             if value is not None:
                 return value
             self.stats["misses"] += 1
-            return self.put(key, compute(), op=op, params=params)
+            from robotkit.distributed import run  # on a Dask cluster when one is configured
+
+            return self.put(key, run(compute), op=op, params=params)
 
     def get(self, key: str):
         """The verified value stored under ``key``, or None (a corrupt entry is removed)."""
         path = self.manifest_path(key)
         if not path.exists():
-            return None
+            return self._get_remote(key) if self.remote is not None else None
         try:
             value = self._read(key, path)
         except CacheCorrupt:
             self.stats["corrupt"] += 1
             self._remove(key)
-            return None
+            return self._get_remote(key) if self.remote is not None else None
         self.stats["hits"] += 1
         return value
+
+    def _get_remote(self, key: str):
+        """The shared copy's entry, verified and copied into the local folder; None on a miss,
+        a corrupt entry (republished by the next put) or an unreachable cache."""
+        from robotkit.mesh.remote import RemoteError
+
+        try:
+            manifest_bytes = self.remote.get(self.entry_name(key, f"{key}.json"))
+            if manifest_bytes is None:
+                return None
+            payloads = {}
+
+            def payload(file: str) -> bytes:
+                data = self.remote.get(self.entry_name(key, file))
+                if data is None:
+                    raise CacheCorrupt("payload missing")
+                payloads[file] = data
+                return data
+
+            try:
+                value = self._decode(key, manifest_bytes, payload)
+            except CacheCorrupt:
+                self.stats["remote_corrupt"] += 1
+                return None
+        except RemoteError as exc:
+            self._remote_problem(exc)
+            return None
+        try:
+            folder = self.folder(key)
+            folder.mkdir(parents=True, exist_ok=True)
+            for file, data in payloads.items():
+                _atomic_write(folder / file, data)
+            _atomic_write(self.manifest_path(key), manifest_bytes)
+        except OSError:
+            pass
+        self.stats["remote_hits"] += 1
+        return value
+
+    def _remote_problem(self, exc) -> None:
+        self.stats["remote_errors"] += 1
+        if not self.remote_problems:
+            import sys
+
+            print(f"robotkit: warning: shared cache: {exc} (building without it)", file=sys.stderr)
+        self.remote_problems.append(str(exc))
 
     def put(self, key: str, value, *, op: str = "", params: dict | None = None):
         """Store ``value`` under ``key``; return it rebuilt from the stored arrays."""
@@ -187,16 +267,29 @@ class Cache:
             "payload": {"file": f"{key}.{digest[:16]}.bin", "size": len(payload), "sha256": digest},
         }
         rebuilt = _build(kind, _parse(payload, shapes), manifest["info"])
+        manifest_bytes = (json.dumps(manifest, sort_keys=True, indent=1) + "\n").encode()
         try:
             folder = self.folder(key)
             folder.mkdir(parents=True, exist_ok=True)
             _atomic_write(folder / manifest["payload"]["file"], payload)
-            _atomic_write(self.manifest_path(key),
-                          (json.dumps(manifest, sort_keys=True, indent=1) + "\n").encode())
+            _atomic_write(self.manifest_path(key), manifest_bytes)
             self.stats["stored"] += 1
         except OSError:
             pass  # a read-only or full cache folder costs time, never correctness
+        if self.remote is not None and self.remote_writable:
+            self._publish(key, manifest["payload"]["file"], payload, manifest_bytes)
         return rebuilt
+
+    def _publish(self, key: str, payload_file: str, payload: bytes, manifest_bytes: bytes) -> None:
+        """Payload first, manifest last: a reader never finds a manifest without its payload."""
+        from robotkit.mesh.remote import RemoteError
+
+        try:
+            self.remote.put(self.entry_name(key, payload_file), payload)
+            self.remote.put(self.entry_name(key, f"{key}.json"), manifest_bytes)
+            self.stats["published"] += 1
+        except RemoteError as exc:
+            self._remote_problem(exc)
 
     def clear(self) -> None:
         """Remove every entry of this cache format."""
@@ -208,19 +301,28 @@ class Cache:
 
     def _read(self, key: str, path: Path):
         try:
-            manifest = json.loads(path.read_text(encoding="utf-8"))
+            manifest_bytes = path.read_bytes()
+        except OSError as exc:
+            raise CacheCorrupt(str(exc)) from exc
+        return self._decode(key, manifest_bytes, lambda file: (self.folder(key) / file).read_bytes())
+
+    @staticmethod
+    def _decode(key: str, manifest_bytes: bytes, read_payload: Callable[[str], bytes]):
+        """The value of one entry from its manifest and a reader of its payload, verified."""
+        try:
+            manifest = json.loads(manifest_bytes.decode("utf-8"))
             if manifest.get("format") != CACHE_FORMAT or manifest.get("key") != key:
                 raise CacheCorrupt("manifest of another key or format")
             pay = manifest["payload"]
-            if os.path.basename(pay["file"]) != pay["file"]:
-                raise CacheCorrupt("payload name with a folder")
-            data = (self.folder(key) / pay["file"]).read_bytes()
+            if os.path.basename(pay["file"]) != pay["file"] or not pay["file"].startswith(f"{key}."):
+                raise CacheCorrupt("payload name with a folder or of another key")
+            data = read_payload(pay["file"])
             if len(data) != pay["size"] or hashlib.sha256(data).hexdigest() != pay["sha256"]:
                 raise CacheCorrupt("payload size or checksum mismatch")
             return _build(manifest["kind"], _parse(data, manifest["meshes"]), manifest.get("info"))
         except CacheCorrupt:
             raise
-        except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+        except (OSError, ValueError, KeyError, TypeError, AttributeError, UnicodeDecodeError) as exc:
             raise CacheCorrupt(str(exc)) from exc
 
     def _remove(self, key: str) -> None:
