@@ -252,8 +252,8 @@ def _duration(seconds: float) -> str:
 
 def catalogue(source: str | os.PathLike, out_dir: str | os.PathLike, *, density: float = 1000.0,
               units: str | None = None, masses: str | os.PathLike | None = None, collision: str = "decompose",
-              jobs: int = 1, progress=sys.stderr) -> dict:
-    """Build every mesh of ``source`` into ``out_dir`` and write the index; returns the index."""
+              jobs: int = 1, progress=sys.stderr) -> "Result":
+    """Build every mesh of ``source`` into ``out_dir`` and write the index."""
     from robotkit import paths
 
     if not (math.isfinite(density) and density > 0):
@@ -331,7 +331,14 @@ def catalogue(source: str | os.PathLike, out_dir: str | os.PathLike, *, density:
     index = _index(items, out, base)
     _write_if_changed(out / "catalogue.json", json.dumps(index, indent=1, sort_keys=True) + "\n")
     _write_if_changed(out / "catalogue.csv", _csv(index))
-    return index
+    return Result(index, result.ran if result else [], result.uptodate if result else [])
+
+
+@dataclass
+class Result:
+    index: dict
+    ran: list[str]  # the build's tasks that ran (a rerun runs only what is missing or changed)
+    uptodate: list[str]
 
 
 def _index(items: list[Item], out: Path, base: Path) -> dict:

@@ -197,7 +197,7 @@ def _build(args) -> int:
     from robotkit.build import build
 
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
-    with _scheduler(args) as jobs:
+    with _scheduler(args) as jobs, _cache_report():
         result = build(args.recipes, args.out, jobs=jobs, echo=echo, progress=sys.stderr, ros=args.ros,
                        report=not args.no_report, stamp_options=opts, args=dict(args.arg))
     if result.ran or args.verbose:
@@ -220,6 +220,38 @@ def _build(args) -> int:
     else:
         print(f"{names}: up to date ({len(result.uptodate)} tasks, {elapsed:.2f} s)")
     return 0
+
+
+@contextlib.contextmanager
+def _cache_report():
+    """A shared cache that failed in any task process is told once, after the build (task
+    output is captured by doit)."""
+    if "://" not in os.environ.get("ROBOTKIT_CACHE", ""):
+        yield
+        return
+    import tempfile
+
+    from robotkit.mesh.cache import REPORT_ENV
+
+    fd, path = tempfile.mkstemp(prefix="robotkit-cache-", suffix=".log")
+    os.close(fd)
+    old = os.environ.get(REPORT_ENV)
+    os.environ[REPORT_ENV] = path
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop(REPORT_ENV, None)
+        else:
+            os.environ[REPORT_ENV] = old
+        try:
+            with open(path, encoding="utf-8") as f:
+                lines = [line.rstrip("\n") for line in f if line.strip()]
+            os.unlink(path)
+        except OSError:
+            lines = []
+        if lines:
+            print(lines[0], file=sys.stderr)
 
 
 @contextlib.contextmanager
@@ -254,9 +286,10 @@ def _catalogue(args) -> int:
     from robotkit.catalogue import catalogue
 
     start = time.perf_counter()
-    with _scheduler(args) as jobs:
-        index = catalogue(args.source, args.out, density=args.density, units=args.units, masses=args.masses,
-                          collision=args.collision, jobs=jobs)
+    with _scheduler(args) as jobs, _cache_report():
+        made = catalogue(args.source, args.out, density=args.density, units=args.units, masses=args.masses,
+                         collision=args.collision, jobs=jobs)
+    index = made.index
     for obj in index["objects"]:
         if obj["status"] != "ok":
             for line in obj["errors"] or ["failed"]:
@@ -264,8 +297,8 @@ def _catalogue(args) -> int:
     guessed = sum(o["units_from"] == "guessed" for o in index["objects"])
     out = os.path.relpath(os.path.abspath(args.out))
     print(f"catalogue {out}: {index['ok']} objects made, {index['failed']} failed"
-          f"{f', units guessed for {guessed}' if guessed else ''} ({out}/catalogue.json, "
-          f"{time.perf_counter() - start:.1f} s)")
+          f"{f', units guessed for {guessed}' if guessed else ''} ({out}/catalogue.json; "
+          f"{len(made.ran)} tasks run, {len(made.uptodate)} up to date, {time.perf_counter() - start:.1f} s)")
     return 1 if index["failed"] else 0
 
 

@@ -54,6 +54,7 @@ from typing import Callable
 import numpy as np
 
 CACHE_FORMAT = 1
+REPORT_ENV = "ROBOTKIT_CACHE_REPORT"
 LIBRARIES = ("trimesh", "coacd", "meshlib", "manifold3d", "numpy", "scipy")
 
 
@@ -241,11 +242,22 @@ class Cache:
         return value
 
     def _remote_problem(self, exc) -> None:
+        """Note that the shared copy failed; the first failure of a process is told once: to the
+        file named by ``$ROBOTKIT_CACHE_REPORT`` (the CLI prints it after the build: task output is
+        captured), else on stderr."""
         self.stats["remote_errors"] += 1
         if not self.remote_problems:
-            import sys
+            line = f"robotkit: warning: shared cache: {exc} (building without it)"
+            report = os.environ.get(REPORT_ENV)
+            try:
+                if not report:
+                    raise OSError
+                with open(report, "a", encoding="utf-8") as f:
+                    f.write(line.replace("\n", " ") + "\n")
+            except OSError:
+                import sys
 
-            print(f"robotkit: warning: shared cache: {exc} (building without it)", file=sys.stderr)
+                print(line, file=sys.stderr)
         self.remote_problems.append(str(exc))
 
     def put(self, key: str, value, *, op: str = "", params: dict | None = None):
