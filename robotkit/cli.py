@@ -36,17 +36,21 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--height", type=float, default=2.0, metavar="H", help="wall height in metres (default: 2.0)")
     w.add_argument("--unknown-as-wall", action="store_true", help="treat unknown cells as walls")
 
-    c = sub.add_parser("check", help="validate a recipe, a build folder, or a URDF/SDF/MJCF file",
+    c = sub.add_parser("check", help="validate recipes, build folders, or URDF/SDF/MJCF files",
                        description="Run the validators, the URDF/SDF/MJCF equivalence check and a MuJoCo "
-                                   "smoke test. Exit 0 when clean, 1 when problems are found, 2 for bad input.")
-    c.add_argument("path", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
+                                   "smoke test. Exit 0 when clean, 1 when problems are found, 2 for bad input "
+                                   "(reported in every format too).")
+    c.add_argument("paths", nargs="+", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
     c.add_argument("--format", choices=["text", "json", "junit", "github"], default="text",
                    help="report format: text for people, json, junit (CI test reporters), github (annotations)")
     c.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
                    help="where package://PKG/ meshes of a URDF are (repeatable)")
     c.add_argument("--fail-on", choices=["error", "warning"], default="error",
                    help="lowest severity that makes the exit status 1 (default: error)")
-    c.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    out = c.add_mutually_exclusive_group()
+    out.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    out.add_argument("--temp-out", action="store_true",
+                     help="build recipes in a temporary folder, removed afterwards (pre-commit: never the user's tree)")
     _add_arg_option(c)
 
     e = sub.add_parser("expand", help="print the flat recipe that a recipe's arguments, expressions, units, "
@@ -243,21 +247,41 @@ def _world(args) -> int:
 
 def _check(args) -> int:
     from robotkit.check import check, render
+    from robotkit.check.findings import input_findings
+    from robotkit.errors import RobotkitError
 
-    packages = {}
-    for item in args.package_path:
-        pkg, sep, folder = item.partition("=")
-        if not sep or not pkg or not folder:
-            print(f"robotkit: error: --package-path takes PKG=DIR (got '{item}')", file=sys.stderr)
-            return 2
-        packages[pkg] = folder
-    # github: the job summary points at the picture report, so a recipe's build writes it
-    findings = check(args.path, args.out, packages, args=dict(args.arg), report=args.format == "github")
-    sys.stdout.write(render(findings, args.format, args.path))
+    packages = _package_paths(args.package_path)
+    if packages is None:
+        return 2
+    if args.temp_out:
+        import tempfile
+
+        with tempfile.TemporaryDirectory(prefix="robotkit-check-") as out:
+            args.out = out
+            return _check_paths(args, packages, check, render, input_findings, RobotkitError)
+    return _check_paths(args, packages, check, render, input_findings, RobotkitError)
+
+
+def _check_paths(args, packages, check, render, input_findings, RobotkitError) -> int:
+    """Every PATH in turn; bad input (exit 2) is reported in the chosen format too, so a CI
+    report never comes out empty, and its lines go to stderr as always."""
+    findings, status = [], 0
+    for path in args.paths:
+        try:  # github: the job summary points at the picture report, so a recipe's build writes it
+            findings += check(path, args.out, packages, args=dict(args.arg), report=args.format == "github")
+        except RobotkitError as exc:
+            for line in exc.lines():
+                print(line, file=sys.stderr)
+            findings += input_findings(exc.problems, path)
+            status = max(status, exc.exit_status)
+    source = " ".join(args.paths)
+    if args.format != "text" or not status:
+        sys.stdout.write(render(findings, args.format, source, args.fail_on))
+    elif any(f.check != "input" for f in findings):  # the paths that could be checked
+        sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on))
     if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
-        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.path, args.out)
-    levels = ("error",) if args.fail_on == "error" else ("error", "warning")
-    return 1 if any(f.severity in levels for f in findings) else 0
+        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, args.out)
+    return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)
 
 
 def _package_paths(items: list[str]) -> dict[str, str] | None:
@@ -289,25 +313,29 @@ def _view(args) -> int:
     return serve(args.path, args.port, open_browser=not args.no_browser, build_out=args.out)
 
 
-def _job_summary(summary_file: str, findings, path: str, out: str) -> None:
+def _job_summary(summary_file: str, findings, paths: list[str], out: str) -> None:
     """Append the check's summary, pointing at the picture report, to GitHub's job summary."""
     from pathlib import Path
 
     from robotkit.check.report import job_summary
+    from robotkit.errors import RobotkitError
     from robotkit.tasks import REPORT
 
-    p = Path(path)
-    if p.suffix.lower() in (".yaml", ".yml"):
-        from robotkit.recipe.load import load_recipe
+    folders = []
+    for path in map(Path, paths):
+        if path.suffix.lower() in (".yaml", ".yml"):
+            from robotkit.recipe.load import load_recipe
 
-        folders = [Path(out) / load_recipe(p).recipe.robot]
-    elif p.is_dir():
-        folders = [p] if (p / "model.sdf").is_file() else sorted(d for d in p.iterdir() if (d / "model.sdf").is_file())
-    else:
-        folders = []
+            try:
+                folders.append(Path(out) / load_recipe(path).recipe.robot)
+            except RobotkitError:
+                pass  # a recipe that does not load has no report; its findings say why
+        elif path.is_dir():
+            folders += [path] if (path / "model.sdf").is_file() else sorted(
+                d for d in path.iterdir() if (d / "model.sdf").is_file())
     pages = [os.path.relpath(f / REPORT) for f in folders if (f / REPORT).is_file()]
     with open(summary_file, "a", encoding="utf-8") as f:
-        f.write(job_summary(findings, path, pages))
+        f.write(job_summary(findings, " ".join(paths), pages))
 
 
 def _import(args) -> int:

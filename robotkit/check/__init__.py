@@ -11,6 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from robotkit.check.findings import Finding
+from robotkit.check.locate import locate
 from robotkit.check.report import render  # noqa: F401  (the CLI renders through here)
 from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
 from robotkit.errors import Problem, RobotkitError
@@ -35,8 +36,8 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     links, joints, notes = read_urdf_facts(path, package_paths)
     findings = validate_urdf(path) + notes + lint(links, joints)
     build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths)
-    return findings + _stage("consumers", f"robot '{path.stem}'",
-                             lambda: consumer_findings(build, URDF_CONSUMERS)[0])
+    findings += _stage("consumers", f"robot '{path.stem}'", lambda: consumer_findings(build, URDF_CONSUMERS)[0])
+    return locate(findings, path)
 
 
 def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list[Finding]:
@@ -117,11 +118,13 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
     package_paths = package_paths or {}
     if p.is_dir():
         if (p / "model.sdf").is_file():
-            return check_build_dir(p)
-        dirs = sorted(d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
+            dirs = [p]
+        else:
+            dirs = sorted(d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
         if not dirs:
             raise RobotkitError(Problem("not a build folder (no <robot>/model.sdf below it)", file=path))
-        return [f for d in dirs for f in check_build_dir(d)]
+        # a build folder's findings point at its URDF
+        return [f for d in dirs for f in locate(check_build_dir(d), d / "urdf" / f"{d.name}.urdf")]
     if not p.is_file():
         raise RobotkitError(Problem("no such file or folder", file=path))
     suffix = p.suffix.lower()
@@ -130,9 +133,9 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
     if suffix == ".urdf":
         return check_urdf_file(p, package_paths)
     if suffix in (".sdf", ".world"):
-        return validate_sdf(p) + _inertial_lints(p, "sdf")
+        return locate(validate_sdf(p) + _inertial_lints(p, "sdf"), p)
     if suffix == ".xml":
-        return validate_mjcf(p) or _inertial_lints(p, "mjcf")
+        return locate(validate_mjcf(p) or _inertial_lints(p, "mjcf"), p)
     raise RobotkitError(Problem("unknown kind of file (expected a recipe .yaml, .urdf, .sdf or MJCF .xml)", file=path))
 
 
