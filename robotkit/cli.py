@@ -47,6 +47,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="where package://PKG/ meshes of a URDF are (repeatable)")
     c.add_argument("--fail-on", choices=["error", "warning"], default="error",
                    help="lowest severity that makes the exit status 1 (default: error)")
+    c.add_argument("--junit", metavar="FILE", help="also write the JUnit report to FILE (whatever --format says)")
     out = c.add_mutually_exclusive_group()
     out.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
     out.add_argument("--temp-out", action="store_true",
@@ -82,6 +83,12 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--port", type=int, default=8080, metavar="N", help="port to serve on (default: 8080)")
     v.add_argument("--no-browser", action="store_true", help="do not open a web browser")
     v.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+
+    n = sub.add_parser("new", help="write a starter recipe (a link, a joint and a mesh) that builds as written",
+                       description="Write NAME.yaml, meshes/NAME/arm.stl and recipe.schema.json (for the editor "
+                                   "modeline) into DIR; no existing file is overwritten.")
+    n.add_argument("name", metavar="NAME", help="the robot's name (letters, digits, '_', '.', '-')")
+    n.add_argument("--dir", "-C", default=".", metavar="DIR", help="folder to write into (default: .)")
 
     s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
     s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
@@ -144,7 +151,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return {"build": _build, "world": _world, "schema": _schema, "check": _check,
-                "import": _import, "report": _report, "view": _view, "expand": _expand}[args.command](args)
+                "import": _import, "report": _report, "view": _view, "expand": _expand,
+                "new": _new}[args.command](args)
     except Exception as exc:
         from robotkit.errors import RobotkitError  # imported late: dataclasses costs a no-op build 10 ms
 
@@ -177,10 +185,10 @@ def _build(args) -> int:
     result = build(args.recipes, args.out, jobs=args.jobs, echo=echo, progress=sys.stderr, ros=args.ros,
                    report=not args.no_report, stamp_options=opts, args=dict(args.arg))
     if result.ran or args.verbose:
-        for w in result.warnings:
-            print(f"warning: {w}", file=sys.stderr)
-    elif result.warnings:  # unchanged since they were shown; keep a no-op build quiet
-        print(f"{len(result.warnings)} warnings, unchanged since the last build (-v shows them; "
+        for w in result.warning_lines:
+            print(w, file=sys.stderr)  # file:line: key: warning: ...
+    elif result.warning_lines:  # unchanged since they were shown; keep a no-op build quiet
+        print(f"{len(result.warning_lines)} warnings, unchanged since the last build (-v shows them; "
               "report.json lists what each format could not express)", file=sys.stderr)
     if result.errors:
         for name, msg in result.errors:
@@ -203,7 +211,7 @@ def _report_up_to_date(args, done: dict, start: float) -> int:
     warnings = done.get("warnings", [])
     if args.verbose:
         for w in warnings:
-            print(f"warning: {w}", file=sys.stderr)
+            print(w, file=sys.stderr)  # file:line: key: warning: ...
     elif warnings:
         print(f"{len(warnings)} warnings, unchanged since the last build (-v shows them; "
               "report.json lists what each format could not express)", file=sys.stderr)
@@ -279,6 +287,11 @@ def _check_paths(args, packages, check, render, input_findings, RobotkitError) -
         sys.stdout.write(render(findings, args.format, source, args.fail_on))
     elif any(f.check != "input" for f in findings):  # the paths that could be checked
         sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on))
+    if args.junit:
+        from pathlib import Path
+
+        Path(args.junit).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.junit).write_text(render(findings, "junit", source, args.fail_on), encoding="utf-8")
     if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
         _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, args.out)
     return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)
@@ -348,6 +361,15 @@ def _expand(args) -> int:
     from robotkit.recipe.flat import flat_yaml
 
     sys.stdout.write(flat_yaml(args.recipe, dict(args.arg), args.variant))
+    return 0
+
+
+def _new(args) -> int:
+    from robotkit.starter import new
+
+    for path in new(args.name, args.dir):
+        print(os.path.relpath(path))
+    print(f"build it: robotkit build {os.path.relpath(os.path.join(args.dir, args.name + '.yaml'))}")
     return 0
 
 

@@ -82,22 +82,26 @@ def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, r
     from robotkit.build import build
     from robotkit.recipe.load import load_recipes
 
+    from robotkit.buildwarn import parse
+
     located = []
     result = build([path], out_dir, args=args, report=report)
+    warnings = [parse(w) for w in result.warning_lines]  # (file, line, key, text)
     for i, loaded in enumerate(load_recipes(path, args)):  # one per variant
         name = loaded.recipe.robot
         others = [r for r in result.robots if r != name]
         # a warning naming another variant's robot belongs to that one; the rest to the first
-        warnings = [w for w in result.warnings if w.startswith(f"{name}:")
-                    or (i == 0 and not any(w.startswith(f"{o}:") for o in others))]
-        located += _check_variant(loaded, warnings, out_dir)
+        mine = [w for w in warnings if w[3].startswith(f"{name}:")
+                or (i == 0 and not any(w[3].startswith(f"{o}:") for o in others))]
+        located += _check_variant(loaded, mine, out_dir)
     return located
 
 
-def _check_variant(loaded, warnings: list[str], out_dir: str) -> list[Finding]:
+def _check_variant(loaded, warnings: list[tuple], out_dir: str) -> list[Finding]:
     name = loaded.recipe.robot
-    findings = [Finding("warning", "build", f"robot '{name}'", w) for w in warnings]
-    findings += check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
+    build_findings = [Finding("warning", "build", key or f"robot '{name}'", text, file=file, line=line)
+                      for file, line, key, text in warnings]
+    findings = check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
     marks = loaded.marks
     located = []
     for f in findings:
@@ -108,7 +112,8 @@ def _check_variant(loaded, warnings: list[str], out_dir: str) -> list[Finding]:
             key = ("joints", f.subject[7:-1])
         file, line = marks.locate(key)
         located.append(replace(f, file=file, line=line))
-    return located
+    return [f if f.file else replace(f, **dict(zip(("file", "line"), marks.locate(("robot",)))))
+            for f in build_findings] + located
 
 
 def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
