@@ -105,7 +105,10 @@ def _losses(loaded, robot, out: Path, where: dict) -> list[tuple[str, str]]:
     for fmt, items in sorted(data.get("losses", {}).items()):
         for item in items:
             m = _NAMED.search(item)
-            place = _place(loaded, robot, m[1], m[2], where) if m else _at(loaded, ("robot",))
+            if m:
+                place = _place(loaded, robot, m[1], m[2], where)
+            else:  # the package's metadata, or the robot as a whole
+                place = (fmt == "package" and _at(loaded, ("metadata", "maintainers"))) or _at(loaded, ("robot",))
             text = f"{robot.name}: {names.get(fmt, fmt)}: {item}"
             lines.append((text, warning_line(text, place)))
     return lines

@@ -8,6 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 apt_need=()
+command -v python3 >/dev/null || apt_need+=(python3)  # a bare container (debian:12)
 python3 -c "import ensurepip, venv" 2>/dev/null || apt_need+=(python3-venv)
 # OSMesa: MuJoCo renders the picture report offscreen, with no display
 { ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libOSMesa.so || apt_need+=(libosmesa6)  # /sbin: not on a user's PATH
