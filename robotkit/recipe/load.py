@@ -15,7 +15,7 @@ from pathlib import Path
 
 import yaml
 
-from robotkit.errors import Problem, RecipeError
+from robotkit.errors import Problem, RecipeError, yaml_syntax_problem
 
 Path_ = tuple  # a key path: ("links", "base", "visual", 0, "mesh")
 
@@ -87,9 +87,7 @@ def _read_yaml(file: Path, problems: list[Problem]):
         except yaml.YAMLError:
             node = yaml.compose(text, Loader=_PyLoader)
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else None
-        problems.append(Problem(f"invalid YAML: {_syntax_message(exc)}", file=str(file), line=line))
+        problems.append(yaml_syntax_problem(exc, str(file)))
         return None, {}
     if node is None:
         problems.append(Problem("the file is empty", file=str(file)))
@@ -98,29 +96,6 @@ def _read_yaml(file: Path, problems: list[Problem]):
     constructor = _Loader(text)
     data = _construct(node, (), str(file), marks, problems, constructor)
     return data, marks
-
-
-def _syntax_message(exc) -> str:
-    """PyYAML's parser wording (``expected <block end>, but found '<block mapping start>'``) in
-    the recipe author's words, naming the line where the unclosed or misaligned part began."""
-    problem = getattr(exc, "problem", None) or str(exc)
-    context = getattr(exc, "context_mark", None)
-    began = f" at line {context.line + 1}" if context is not None else ""
-    if problem.startswith("expected ',' or '}'"):
-        return f"the {{...}} mapping opened{began} is not closed: a '}}' or ',' is missing"
-    if problem.startswith("expected ',' or ']'"):
-        return f"the [...] list opened{began} is not closed: a ']' or ',' is missing"
-    if problem.startswith("expected <block end>"):
-        return f"this line is indented differently from the keys of the mapping{began} (indent with spaces, aligned)"
-    if problem == "found character '\\t' that cannot start any token":
-        return "a tab character: YAML indents with spaces only"
-    if problem == "mapping values are not allowed here":
-        return "a ': ' where no key may start: quote a value that contains ': ', or put the key on its own line"
-    if problem == "could not find expected ':'":
-        return f"a line without ':' inside the mapping{began} (a key needs 'key: value')"
-    if problem.startswith("found undefined alias"):
-        return f"{problem.replace('found undefined alias', 'the alias')} names no anchor (&name) above it"
-    return problem
 
 
 def _construct(node, path, file, marks, problems, constructor):
