@@ -273,10 +273,13 @@ def _check(args) -> int:
 def _check_paths(args, packages, check, render, input_findings, RobotkitError) -> int:
     """Every PATH in turn; bad input (exit 2) is reported in the chosen format too, so a CI
     report never comes out empty, and its lines go to stderr as always."""
-    findings, status = [], 0
+    from robotkit.check import cases
+
+    findings, status, ran = [], 0, []
     for path in args.paths:
         try:  # github: the job summary points at the picture report, so a recipe's build writes it
             findings += check(path, args.out, packages, args=dict(args.arg), report=args.format == "github")
+            ran += cases(path, args.out, dict(args.arg))
         except RobotkitError as exc:
             for line in exc.lines():
                 print(line, file=sys.stderr)
@@ -284,14 +287,14 @@ def _check_paths(args, packages, check, render, input_findings, RobotkitError) -
             status = max(status, exc.exit_status)
     source = " ".join(args.paths)
     if args.format != "text" or not status:
-        sys.stdout.write(render(findings, args.format, source, args.fail_on))
+        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran))
     elif any(f.check != "input" for f in findings):  # the paths that could be checked
         sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on))
     if args.junit:
         from pathlib import Path
 
         Path(args.junit).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.junit).write_text(render(findings, "junit", source, args.fail_on), encoding="utf-8")
+        Path(args.junit).write_text(render(findings, "junit", source, args.fail_on, ran), encoding="utf-8")
     if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
         _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, args.out)
     return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)

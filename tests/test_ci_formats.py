@@ -78,10 +78,15 @@ def test_junit_counts_failures_at_each_fail_on(urdfs, junit_schema):
     assert proc.returncode == 0, proc.stderr
     doc = junit(junit_schema, proc.stdout)
     suite = doc.find("testsuite")
-    assert (suite.get("tests"), suite.get("failures")) == ("1", "0")
+    assert (suite.get("tests"), suite.get("failures")) == ("5", "0")
+    # one case per check and subject: what fired, then what ran and passed
+    assert [(c.get("classname"), c.get("name"), [e.tag for e in c]) for c in suite] == [
+        ("robotkit.inertia-box", "link 'arm'", ["system-out"]),
+        ("robotkit.check_urdf", str(warn), []),
+        ("robotkit.consumer", "robot 'warn'", []),
+        ("robotkit.lints", "link 'base'", []),
+        ("robotkit.lints", "joint 'shoulder'", [])]
     case = suite.find("testcase")
-    assert (case.get("classname"), case.get("name")) == ("robotkit.inertia-box", "link 'arm'")
-    assert case.find("failure") is None
     assert case.find("system-out").text.startswith(f"{warn}:{link_line(warn, 'arm')}: warning: ")
 
     proc = run_cli("check", warn, "--format", "junit", "--fail-on", "warning")

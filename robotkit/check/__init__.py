@@ -169,3 +169,42 @@ def _inertial_lints(path: Path, kind: str) -> list[Finding]:
     return out
 
 
+STAGES = ("check_urdf", "ign sdf -k", "mujoco", "equivalence", "consumer", "simulation", "build", "input")
+"""The checks that are stages; every other rule is a physics lint (robotkit.check.lints)."""
+
+
+def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None) -> list[tuple[str, str]]:
+    """Every (check, subject) that a check of ``path`` ran, named as its findings name them, so
+    CI reports list what passed too: each validator on each file, the equivalence, consumer and
+    simulation stages on the robot, and the physics lints (``lints``) on each link and joint."""
+    from robotkit.check.locate import element_lines
+
+    p = Path(path)
+
+    def described(file: Path) -> list[tuple[str, str]]:
+        names = element_lines(file)
+        return [("lints", f"{'link' if tag in ('link', 'body') else 'joint'} '{name}'")
+                for (tag, name) in names if tag in ("link", "joint", "body")]
+
+    def folder(d: Path) -> list[tuple[str, str]]:
+        name, robot = d.name, f"robot '{d.name}'"
+        urdf = d / "urdf" / f"{name}.urdf"
+        files = [("check_urdf", urdf), ("ign sdf -k", d / "model.sdf"), ("mujoco", d / "mjcf" / f"{name}.xml"),
+                 ("mujoco", d / "mjcf" / "scene.xml")]
+        return ([(c, str(f)) for c, f in files] + [(c, robot) for c in ("equivalence", "consumer", "simulation")]
+                + described(urdf))
+
+    if p.is_dir():
+        dirs = [p] if (p / "model.sdf").is_file() else sorted(
+            d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
+        return [c for d in dirs for c in folder(d)]
+    suffix = p.suffix.lower()
+    if suffix in (".yaml", ".yml"):
+        from robotkit.recipe.load import load_recipes
+
+        return [c for loaded in load_recipes(p, args) for c in folder(Path(out_dir) / loaded.recipe.robot)]
+    if suffix == ".urdf":
+        return [("check_urdf", str(p)), ("consumer", f"robot '{p.stem}'")] + described(p)
+    if suffix in (".sdf", ".world"):
+        return [("ign sdf -k", str(p))]
+    return [("mujoco", str(p))]

@@ -8,16 +8,19 @@ from dataclasses import asdict
 
 from robotkit.check.findings import Finding
 
-def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error") -> str:
+def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error",
+           cases: list[tuple[str, str]] | None = None) -> str:
     """``fail_on`` (``--fail-on``): the lowest severity that fails the check; every format says
-    which findings fail it (JUnit failures, GitHub ``::error``, JSON ``failed``, the text's last line)."""
+    which findings fail it (JUnit failures, GitHub ``::error``, JSON ``failed``, the text's last line).
+    ``cases``: every (check, subject) that ran (:func:`robotkit.check.cases`): JUnit lists the
+    ones without findings as passing test cases."""
     if fmt == "json":
         return json.dumps({"source": source, "errors": sum(f.severity == "error" for f in findings),
                            "warnings": sum(f.severity == "warning" for f in findings), "fail_on": fail_on,
                            "failed": sum(f.fails(fail_on) for f in findings),
                            "findings": [asdict(f) for f in findings]}, indent=1) + "\n"
     if fmt == "junit":
-        return _junit(findings, source, fail_on)
+        return _junit(findings, source, fail_on, cases or [])
     if fmt == "github":
         return "".join(annotation(f, fail_on) + "\n" for f in findings)
     if not findings:
@@ -70,18 +73,24 @@ def annotation(f: Finding, fail_on: str = "error") -> str:
     return f"::{'error' if f.fails(fail_on) else f.severity} {','.join(props)}::{_escape_data(text)}"
 
 
-def _junit(findings: list[Finding], source: str, fail_on: str) -> str:
+def _junit(findings: list[Finding], source: str, fail_on: str, ran: list[tuple[str, str]]) -> str:
     """One test case per check and subject, so CI test reporters list them; a case fails when
-    one of its findings fails the check (``--fail-on``)."""
+    one of its findings fails the check (``--fail-on``).  The checks that ran and found nothing
+    are passing cases (``robotkit.lints`` for a link or joint no physics lint fired on)."""
     import xml.etree.ElementTree as ET
+
+    from robotkit.check import STAGES
 
     cases: dict[tuple[str, str], list[Finding]] = {}
     for f in findings:
         cases.setdefault((f.check, f.subject), []).append(f)
+    linted = {f.subject for f in findings if f.check not in STAGES}
+    passed = list(dict.fromkeys(c for c in ran if c not in cases and not (c[0] == "lints" and c[1] in linted)))
     failing = [any(x.fails(fail_on) for x in v) for v in cases.values()]
-    suite = ET.Element("testsuite", name=f"robotkit check {source}", tests=str(max(len(cases), 1)),
+    total = len(cases) + len(passed)
+    suite = ET.Element("testsuite", name=f"robotkit check {source}", tests=str(max(total, 1)),
                        failures=str(sum(failing)), errors="0", skipped="0")
-    if not cases:
+    if not total:
         ET.SubElement(suite, "testcase", classname="robotkit", name="all checks")
     for ((check, subject), items), fails in zip(cases.items(), failing):
         case = ET.SubElement(suite, "testcase", classname=f"robotkit.{check}", name=subject)
@@ -92,6 +101,8 @@ def _junit(findings: list[Finding], source: str, fail_on: str) -> str:
             ET.SubElement(case, "failure", type=first.severity, message=first.message).text = text
         else:
             ET.SubElement(case, "system-out").text = text
+    for check, subject in passed:
+        ET.SubElement(suite, "testcase", classname=f"robotkit.{check}", name=subject)
     suites = ET.Element("testsuites", tests=suite.get("tests"), failures=suite.get("failures"), errors="0")
     suites.append(suite)
     return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(suites, encoding="unicode") + "\n"
