@@ -184,3 +184,27 @@ def test_annotation_escapes_properties_and_message():
                     "link 'a:b': 50%25 off%0Asecond line")
     command, props, message = workflow_command(line)
     assert unescape(props["file"]) == "dir,x/r:1.yaml" and unescape(message) == "link 'a:b': 50% off\nsecond line"
+
+
+def test_recipe_build_warnings_are_annotated_on_their_line(tmp_path):
+    """A build's warnings reach the CI formats on the line that causes them (not the robot's)."""
+    import trimesh
+
+    from conftest import write_recipe
+    from test_build_warnings import RECIPE
+
+    write_recipe(tmp_path, RECIPE, "careless.yaml",
+                 {"wheel.stl": trimesh.creation.cylinder(radius=66.0, height=26.0, sections=64)})
+    proc = run_cli("check", "careless.yaml", "--temp-out", "--format", "github", cwd=tmp_path)
+    builds = [workflow_command(line) for line in proc.stdout.splitlines() if "title=robotkit build" in line]
+    assert [(c, p["file"], p["line"], unescape(m)) for c, p, m in builds] == [
+        ("warning", "careless.yaml", "11", "links.wheel.visual.mesh: mesh 'wheel.stl' is 132 m across as declared "
+         "(scale 1): a mesh in millimetres declared as metres? (units: mm)"),
+        ("warning", "careless.yaml", "14", "links.payload.inertial: link 'payload': mass 2000 kg in 0.001 m^3 of "
+         "visual geometry implies 2e+06 kg/m^3, outside 10..25000 (grams written as kilograms, or a mesh in "
+         "millimetres declared as metres?)"),
+        ("warning", "careless.yaml", "6", "materials.blue: material 'blue' is used by no geometry"),
+        ("warning", "careless.yaml", "23", "actuators.wheel_joint: the velocity actuator of continuous joint "
+         "'wheel_joint' has no force range in MuJoCo (unbounded torque): the joint has no effort limit (give it "
+         "limit: {effort: ...})")]
+    assert not (tmp_path / "build").exists()  # --temp-out

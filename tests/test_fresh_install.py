@@ -101,6 +101,9 @@ def test_readme_transcript_matches_the_output(clone, quick_start):
         return re.sub(r"\d+\.\d\d s\)", "T s)", line)
 
     assert [timeless(line) for line in got] == [timeless(line) for line in outputs]
+    # `doit` in the repository root has the same tasks for every recipe in recipes/
+    listed = shell("source .venv/bin/activate\ndoit list", clone).stdout.split()
+    assert "turret_bot:urdf" in listed and "ur5:urdf" in listed
 
 
 GOOD = """\
