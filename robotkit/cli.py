@@ -278,7 +278,8 @@ def _check_paths(args, packages, check, render, input_findings, RobotkitError) -
     findings, status, ran = [], 0, []
     for path in args.paths:
         try:  # github: the job summary points at the picture report, so a recipe's build writes it
-            findings += check(path, args.out, packages, args=dict(args.arg), report=args.format == "github")
+            findings += check(path, args.out, packages, args=dict(args.arg),
+                              report=args.format == "github" and not args.temp_out)
             ran += cases(path, args.out, dict(args.arg))
         except RobotkitError as exc:
             for line in exc.lines():
@@ -296,7 +297,8 @@ def _check_paths(args, packages, check, render, input_findings, RobotkitError) -
         Path(args.junit).parent.mkdir(parents=True, exist_ok=True)
         Path(args.junit).write_text(render(findings, "junit", source, args.fail_on, ran), encoding="utf-8")
     if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
-        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, args.out)
+        # a temporary build folder is gone when the summary is read: no report to point at
+        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, None if args.temp_out else args.out)
     return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)
 
 
@@ -329,7 +331,7 @@ def _view(args) -> int:
     return serve(args.path, args.port, open_browser=not args.no_browser, build_out=args.out)
 
 
-def _job_summary(summary_file: str, findings, paths: list[str], out: str) -> None:
+def _job_summary(summary_file: str, findings, paths: list[str], out: str | None) -> None:
     """Append the check's summary, pointing at the picture report, to GitHub's job summary."""
     from pathlib import Path
 
@@ -339,7 +341,7 @@ def _job_summary(summary_file: str, findings, paths: list[str], out: str) -> Non
 
     folders = []
     for path in map(Path, paths):
-        if path.suffix.lower() in (".yaml", ".yml"):
+        if path.suffix.lower() in (".yaml", ".yml") and out is not None:
             from robotkit.recipe.load import load_recipe
 
             try:
