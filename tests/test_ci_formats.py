@@ -208,3 +208,28 @@ def test_recipe_build_warnings_are_annotated_on_their_line(tmp_path):
          "'wheel_joint' has no force range in MuJoCo (unbounded torque): the joint has no effort limit (give it "
          "limit: {effort: ...})")]
     assert not (tmp_path / "build").exists()  # --temp-out
+
+
+def test_sdf_and_mjcf_findings_name_their_line(tmp_path):
+    (tmp_path / "m.sdf").write_text(
+        '<?xml version="1.0"?>\n<sdf version="1.9">\n  <model name="m">\n    <link name="a">\n'
+        '      <pose>0 0 0 0 0 0</pose>\n    </link>\n  </model>\n</sdf>\n')
+    proc = run_cli("check", "m.sdf", "--format", "github", cwd=tmp_path)
+    assert proc.returncode == 1
+    assert [workflow_command(line)[:2] for line in proc.stdout.splitlines()] == [
+        ("error", {"file": "m.sdf", "line": "4", "title": "robotkit consumer"})]
+    (tmp_path / "m.xml").write_text('<mujoco model="m">\n  <worldbody>\n    <body name="b">\n'
+                                    '      <geom type="box" size="0.1 0.1 0.1" mass="-1"/>\n    </body>\n'
+                                    '  </worldbody>\n</mujoco>\n')
+    proc = run_cli("check", "m.xml", "--format", "github", cwd=tmp_path)
+    assert proc.returncode == 1
+    command, props, message = workflow_command(proc.stdout.strip())
+    assert (command, props) == ("error", {"file": "m.xml", "line": "1", "title": "robotkit mujoco"}), message
+    (tmp_path / "t.xml").write_text(
+        '<mujoco model="m">\n  <worldbody>\n    <body name="b">\n'
+        '      <inertial pos="0 0 0" mass="5e-7" diaginertia="4e-14 4e-14 4e-14"/>\n'
+        '      <geom type="sphere" size="0.0005" contype="0"/>\n    </body>\n  </worldbody>\n</mujoco>\n')
+    proc = run_cli("check", "t.xml", "--format", "github", cwd=tmp_path)
+    assert proc.returncode == 0
+    assert [workflow_command(line)[:2] for line in proc.stdout.splitlines()] == [
+        ("warning", {"file": "t.xml", "line": "3", "title": "robotkit tiny-mass"})]  # the <body name="b"> line

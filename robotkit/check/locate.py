@@ -37,21 +37,21 @@ def element_lines(path: Path) -> dict[tuple[str, str], int]:
 
 
 def locate(findings: list[Finding], path: Path) -> list[Finding]:
-    """Give each finding that has no place yet a file and line in the description ``path``;
-    a finding about another file (a validator's, say model.sdf) is placed on that file."""
-    lines = None
+    """Give each finding that has no line yet a file and line in the description ``path`` (or
+    in the file it already names: a validator's finding names the file it read, say model.sdf):
+    the line of the link or joint it is about, else of the root element."""
+    read: dict[str, dict] = {}
     out = []
     for f in findings:
-        if f.file is not None:
+        if f.line is not None:
             out.append(f)
             continue
-        if os.path.isfile(f.subject):  # a validator's finding names the file it read
-            out.append(replace(f, file=f.subject, line=element_lines(Path(f.subject)).get(("root", ""))))
-            continue
-        if lines is None:
-            lines = element_lines(path)
+        file = f.file or (f.subject if os.path.isfile(f.subject) else str(path))
+        if file not in read:
+            read[file] = element_lines(Path(file))
+        lines = read[file]
         kind, _, rest = f.subject.partition(" '")
         name = rest[:-1] if rest.endswith("'") else None
         line = next((lines[(tag, name)] for tag in TAGS.get(kind, ()) if (tag, name) in lines), None)
-        out.append(replace(f, file=str(path), line=line or lines.get(("root", ""))))
+        out.append(replace(f, file=file, line=line or lines.get(("root", ""))))
     return out
