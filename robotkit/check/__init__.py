@@ -169,10 +169,6 @@ def _inertial_lints(path: Path, kind: str) -> list[Finding]:
     return out
 
 
-STAGES = ("check_urdf", "ign sdf -k", "mujoco", "equivalence", "consumer", "simulation", "build", "input")
-"""The checks that are stages; every other rule is a physics lint (robotkit.check.lints)."""
-
-
 def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None) -> list[tuple[str, str]]:
     """Every (check, subject) that a check of ``path`` ran, named as its findings name them, so
     CI reports list what passed too: each validator on each file, the equivalence, consumer and

@@ -5,6 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 SEVERITIES = ("error", "warning")
+STAGES = ("check_urdf", "ign sdf -k", "mujoco", "equivalence", "consumer", "consumers", "simulation", "build",
+          "input")
+"""The checks that are stages; every other rule is a physics lint (robotkit.check.lints)."""
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 from dataclasses import asdict
 
-from robotkit.check.findings import Finding
+from robotkit.check.findings import STAGES, Finding
 
 def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error",
            cases: list[tuple[str, str]] | None = None) -> str:
@@ -78,8 +78,6 @@ def _junit(findings: list[Finding], source: str, fail_on: str, ran: list[tuple[s
     one of its findings fails the check (``--fail-on``).  The checks that ran and found nothing
     are passing cases (``robotkit.lints`` for a link or joint no physics lint fired on)."""
     import xml.etree.ElementTree as ET
-
-    from robotkit.check import STAGES
 
     cases: dict[tuple[str, str], list[Finding]] = {}
     for f in findings:
