@@ -254,10 +254,6 @@ def _world(args) -> int:
 
 
 def _check(args) -> int:
-    from robotkit.check import check, render
-    from robotkit.check.findings import input_findings
-    from robotkit.errors import RobotkitError
-
     packages = _package_paths(args.package_path)
     if packages is None:
         return 2
@@ -266,14 +262,16 @@ def _check(args) -> int:
 
         with tempfile.TemporaryDirectory(prefix="robotkit-check-") as out:
             args.out = out
-            return _check_paths(args, packages, check, render, input_findings, RobotkitError)
-    return _check_paths(args, packages, check, render, input_findings, RobotkitError)
+            return _check_paths(args, packages)
+    return _check_paths(args, packages)
 
 
-def _check_paths(args, packages, check, render, input_findings, RobotkitError) -> int:
+def _check_paths(args, packages: dict[str, str]) -> int:
     """Every PATH in turn; bad input (exit 2) is reported in the chosen format too, so a CI
     report never comes out empty, and its lines go to stderr as always."""
-    from robotkit.check import cases
+    from robotkit.check import cases, check, render
+    from robotkit.check.findings import input_findings
+    from robotkit.errors import RobotkitError
 
     findings, status, ran = [], 0, []
     for path in args.paths:
