@@ -80,9 +80,8 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
 
 def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
     from robotkit.build import build
-    from robotkit.recipe.load import load_recipes
-
     from robotkit.buildwarn import parse
+    from robotkit.recipe.load import load_recipes
 
     located = []
     result = build([path], out_dir, args=args, report=report)
