@@ -233,3 +233,11 @@ def test_sdf_and_mjcf_findings_name_their_line(tmp_path):
     assert proc.returncode == 0
     assert [workflow_command(line)[:2] for line in proc.stdout.splitlines()] == [
         ("warning", {"file": "t.xml", "line": "3", "title": "robotkit tiny-mass"})]  # the <body name="b"> line
+
+
+def test_several_paths_one_missing(urdfs):
+    """The paths that can be checked are, the bad one is named, and the exit status is 2."""
+    proc = run_cli("check", "warn.urdf", "nothing.urdf", cwd=urdfs)
+    assert proc.returncode == 2
+    assert proc.stderr == "nothing.urdf: no such file or folder\n"
+    assert proc.stdout.splitlines()[-1] == "warn.urdf nothing.urdf: 0 errors, 1 warning"
