@@ -25,6 +25,7 @@ WARNING = "warning: "
 DENSITY_RANGE = (10.0, 25000.0)  # kg/m^3, as robotkit.check.lints (not imported: it loads numpy and trimesh)
 PART_SIZE_RANGE = (1e-4, 10.0)  # m
 _LINE = re.compile(r"^(?:(?P<file>.+?)(?::(?P<line>\d+))?: (?:(?P<key>[^\s:]+): )?)?warning: (?P<text>.*)$")
+_PLACE = re.compile(r"^.+?:\d+: [^\s:]+: ")  # the file:line: key: a mesh task put before its warning
 _NAMED = re.compile(r"\b(link|joint|sensor|mesh|actuator|material) '([^']+)'")
 _KIND = {"link": "links", "joint": "joints", "sensor": "sensors", "actuator": "actuators", "material": "materials"}
 
@@ -50,17 +51,13 @@ def build_warnings(robots, out: Path) -> list[tuple[str, str]]:
     and the lints."""
     from robotkit.tasks import STATE, mesh_locations
 
+    places = [(loaded, robot, mesh_locations(loaded, robot), _mesh_facts(out / STATE / robot.name / "mesh", robot))
+              for loaded, robot in robots]
     pairs = []
-    for loaded, robot in robots:
-        where = mesh_locations(loaded, robot)
-        facts = _mesh_facts(out / STATE / robot.name / "mesh", robot)
-        for key, f in facts.items():  # recorded with their place (robotkit.actions.mesh_facts)
-            prefix = str(Problem("", **where.get(key, {})))
-            pairs += [(w, warning_line(w[len(prefix):] if w.startswith(prefix) else w, where.get(key)))
-                      for w in f.get("warnings", [])]
-    for loaded, robot in robots:
-        where = mesh_locations(loaded, robot)
-        facts = _mesh_facts(out / STATE / robot.name / "mesh", robot)
+    for loaded, robot, where, facts in places:
+        for key, f in facts.items():  # recorded with their place (robotkit.actions.mesh_facts): placed anew
+            pairs += [(w, warning_line(_PLACE.sub("", w, count=1), where.get(key))) for w in f.get("warnings", [])]
+    for loaded, robot, where, facts in places:
         pairs += _losses(loaded, robot, out, where) + lints(loaded, robot, facts, where)
     seen: dict[str, str] = {}
     for text, line in pairs:
