@@ -8,6 +8,7 @@ from dataclasses import asdict
 
 from robotkit.check.findings import STAGES, Finding
 
+
 def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error",
            cases: list[tuple[str, str]] | None = None) -> str:
     """``fail_on`` (``--fail-on``): the lowest severity that fails the check; every format says
