@@ -161,8 +161,8 @@ def lints(loaded, robot, facts: dict[str, dict], where: dict) -> list[tuple[str,
         else:
             continue
         if rho is not None and not DENSITY_RANGE[0] <= rho <= DENSITY_RANGE[1]:
-            cause = ("grams written as kilograms, or a mesh in millimetres declared as metres?" if rho > DENSITY_RANGE[1]
-                     else "MeshLab's density 1, or a mesh in metres declared as millimetres?")
+            cause = ("grams written as kilograms, or a mesh in millimetres declared as metres?"
+                     if rho > DENSITY_RANGE[1] else "MeshLab's density 1, or a mesh in metres declared as millimetres?")
             text = (f"link '{link.name}': density {rho:.4g} kg/m^3" if why == "density" else
                     f"link '{link.name}': {why} implies {rho:.4g} kg/m^3")
             warn(f"{text}, outside {DENSITY_RANGE[0]:g}..{DENSITY_RANGE[1]:g} ({cause})",

@@ -106,7 +106,7 @@ def test_junit_error_is_a_failing_case(urdfs, junit_schema):
     assert case.get("name") == "link 'arm'" and case.find("failure").get("type") == "error"
 
 
-def test_github_annotations_name_the_urdf_line(urdfs, monkeypatch):
+def test_github_annotations_name_the_urdf_line(urdfs):
     bad, warn = urdfs / "bad.urdf", urdfs / "warn.urdf"
     proc = run_cli("check", bad, warn, "--format", "github", cwd=urdfs)
     assert proc.returncode == 1

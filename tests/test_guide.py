@@ -57,7 +57,8 @@ def test_guide_commands_run(guide_run):
         assert "Traceback" not in proc.stderr, name
         # a build's warnings are one line each, located in the recipe; other lines are progress or
         # summaries (the importer's notes are about the file it reads)
-        assert name == "import" or [line for line in proc.stderr.splitlines() if "warning:" in line and not WARNING.match(line)] == [], name
+        unplaced = [line for line in proc.stderr.splitlines() if "warning:" in line and not WARNING.match(line)]
+        assert name == "import" or unplaced == [], name
     for robot in ("my_bot", "meshes_demo", "inertials_demo", "rover_mini", "contacts_demo", "world_bot"):
         out = folder / "build" / robot
         assert (out / "urdf" / f"{robot}.urdf").is_file() and (out / "mjcf" / f"{robot}.xml").is_file(), robot
