@@ -12,7 +12,6 @@ doit's own record (which tasks ran, which were up to date) is returned in a
 from __future__ import annotations
 
 import io
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +26,7 @@ class BuildResult:
     failed: list[tuple[str, str]] = field(default_factory=list)  # (task, message) user errors
     errors: list[tuple[str, str]] = field(default_factory=list)  # (task, traceback) bugs
     warnings: list[str] = field(default_factory=list)
+    warning_lines: list[str] = field(default_factory=list)  # the same, located: file:line: key: warning: ...
     robots: list[str] = field(default_factory=list)
     exit_status: int = 0  # of the failed tasks: 2 bad input, 1 a robot a consumer refuses
 
@@ -166,6 +166,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         stamp_options = stamp.options(recipes, out_dir, None if report else {"no_report": True})
     stamp.remove(out_dir, stamp_options)
 
+    from robotkit.buildwarn import build_warnings
     from robotkit.tasks import load_robots, mesh_locations, robot_tasks
 
     out = Path(out_dir).absolute()
@@ -207,12 +208,13 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         raise error
     if rc not in (0,) and not result.errors and not result.failed:
         result.errors.append(("doit", f"doit exited with status {rc}"))
-    result.warnings = collect_warnings(tasks) + collect_losses(out, result.robots)
+    warnings = build_warnings(robots, out)  # (text, file:line: key: warning: text) pairs
+    result.warnings, result.warning_lines = [t for t, _ in warnings], [line for _, line in warnings]
     if rc == 0 and not result.errors and not result.failed:
         outputs = sorted({str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])})
         try:
             stamp.write(out, stamp_options, inputs, outputs,
-                        {"robots": result.robots, "tasks": len(tasks), "warnings": result.warnings})
+                        {"robots": result.robots, "tasks": len(tasks), "warnings": result.warning_lines})
         except OSError:
             pass  # no stamp: the next build runs doit's checks
     return result
@@ -230,36 +232,3 @@ def _input_stats(robots, tasks) -> dict:
         for root, _dirs, names in os.walk(d):
             files |= {os.path.join(root, n) for n in names}
     return stamp.stats(sorted(files - targets))
-
-
-def collect_losses(out: Path, robots: list[str]) -> list[str]:
-    """What each output format could not express (from each robot's report.json)."""
-    lines = []
-    names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF", "package": "ROS package"}
-    for name in robots:
-        try:
-            data = json.loads((out / name / "report.json").read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            continue
-        for fmt, items in sorted(data.get("losses", {}).items()):
-            lines.extend(f"{name}: {names.get(fmt, fmt)}: {item}" for item in items)
-    return lines
-
-
-def collect_warnings(tasks: list[dict]) -> list[str]:
-    """Warnings recorded by this build's mesh tasks (shown on every build, not only the one
-    that ran them, so a no-op rebuild does not hide them)."""
-    seen: list[str] = []
-    for task in tasks:
-        if ":mesh:" not in task["name"]:
-            continue
-        for path in task["targets"]:
-            path = Path(path)
-            try:
-                data = json.loads(path.read_text(encoding="utf-8"))
-            except (OSError, ValueError):
-                continue
-            for w in data.get("warnings", []):
-                if w not in seen:
-                    seen.append(w)
-    return seen

@@ -59,17 +59,22 @@ def _parser() -> argparse.ArgumentParser:
                    help="send the mesh work to this Dask scheduler (default: $DASK_SCHEDULER_ADDRESS); "
                         "'local' starts one worker per core")
 
-    c = sub.add_parser("check", help="validate a recipe, a build folder, or a URDF/SDF/MJCF file",
+    c = sub.add_parser("check", help="validate recipes, build folders, or URDF/SDF/MJCF files",
                        description="Run the validators, the URDF/SDF/MJCF equivalence check and a MuJoCo "
-                                   "smoke test. Exit 0 when clean, 1 when problems are found, 2 for bad input.")
-    c.add_argument("path", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
+                                   "smoke test. Exit 0 when clean, 1 when problems are found, 2 for bad input "
+                                   "(reported in every format too).")
+    c.add_argument("paths", nargs="+", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
     c.add_argument("--format", choices=["text", "json", "junit", "github"], default="text",
                    help="report format: text for people, json, junit (CI test reporters), github (annotations)")
     c.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
                    help="where package://PKG/ meshes of a URDF are (repeatable)")
     c.add_argument("--fail-on", choices=["error", "warning"], default="error",
                    help="lowest severity that makes the exit status 1 (default: error)")
-    c.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    c.add_argument("--junit", metavar="FILE", help="also write the JUnit report to FILE (whatever --format says)")
+    out = c.add_mutually_exclusive_group()
+    out.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    out.add_argument("--temp-out", action="store_true",
+                     help="build recipes in a temporary folder, removed afterwards (pre-commit: never the user's tree)")
     _add_arg_option(c)
 
     e = sub.add_parser("expand", help="print the flat recipe that a recipe's arguments, expressions, units, "
@@ -101,6 +106,12 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--port", type=int, default=8080, metavar="N", help="port to serve on (default: 8080)")
     v.add_argument("--no-browser", action="store_true", help="do not open a web browser")
     v.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+
+    n = sub.add_parser("new", help="write a starter recipe (a link, a joint and a mesh) that builds as written",
+                       description="Write NAME.yaml, meshes/NAME/arm.stl and recipe.schema.json (for the editor "
+                                   "modeline) into DIR; no existing file is overwritten.")
+    n.add_argument("name", metavar="NAME", help="the robot's name (letters, digits, '_', '.', '-')")
+    n.add_argument("--dir", "-C", default=".", metavar="DIR", help="folder to write into (default: .)")
 
     s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
     s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
@@ -167,7 +178,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return {"build": _build, "world": _world, "schema": _schema, "check": _check,
-                "import": _import, "report": _report, "catalogue": _catalogue, "view": _view, "expand": _expand}[args.command](args)
+                "import": _import, "report": _report, "catalogue": _catalogue, "view": _view, "expand": _expand,
+                "new": _new}[args.command](args)
     except Exception as exc:
         from robotkit.errors import RobotkitError  # imported late: dataclasses costs a no-op build 10 ms
 
@@ -201,10 +213,10 @@ def _build(args) -> int:
         result = build(args.recipes, args.out, jobs=jobs, echo=echo, progress=sys.stderr, ros=args.ros,
                        report=not args.no_report, stamp_options=opts, args=dict(args.arg))
     if result.ran or args.verbose:
-        for w in result.warnings:
-            print(f"warning: {w}", file=sys.stderr)
-    elif result.warnings:  # unchanged since they were shown; keep a no-op build quiet
-        print(f"{len(result.warnings)} warnings, unchanged since the last build (-v shows them; "
+        for w in result.warning_lines:
+            print(w, file=sys.stderr)  # file:line: key: warning: ...
+    elif result.warning_lines:  # unchanged since they were shown; keep a no-op build quiet
+        print(f"{len(result.warning_lines)} warnings, unchanged since the last build (-v shows them; "
               "report.json lists what each format could not express)", file=sys.stderr)
     if result.errors:
         for name, msg in result.errors:
@@ -307,7 +319,7 @@ def _report_up_to_date(args, done: dict, start: float) -> int:
     warnings = done.get("warnings", [])
     if args.verbose:
         for w in warnings:
-            print(f"warning: {w}", file=sys.stderr)
+            print(w, file=sys.stderr)  # file:line: key: warning: ...
     elif warnings:
         print(f"{len(warnings)} warnings, unchanged since the last build (-v shows them; "
               "report.json lists what each format could not express)", file=sys.stderr)
@@ -350,22 +362,50 @@ def _world(args) -> int:
 
 
 def _check(args) -> int:
-    from robotkit.check import check, render
+    packages = _package_paths(args.package_path)
+    if packages is None:
+        return 2
+    if args.temp_out:
+        import tempfile
 
-    packages = {}
-    for item in args.package_path:
-        pkg, sep, folder = item.partition("=")
-        if not sep or not pkg or not folder:
-            print(f"robotkit: error: --package-path takes PKG=DIR (got '{item}')", file=sys.stderr)
-            return 2
-        packages[pkg] = folder
-    # github: the job summary points at the picture report, so a recipe's build writes it
-    findings = check(args.path, args.out, packages, args=dict(args.arg), report=args.format == "github")
-    sys.stdout.write(render(findings, args.format, args.path))
+        with tempfile.TemporaryDirectory(prefix="robotkit-check-") as out:
+            args.out = out
+            return _check_paths(args, packages)
+    return _check_paths(args, packages)
+
+
+def _check_paths(args, packages: dict[str, str]) -> int:
+    """Every PATH in turn; bad input (exit 2) is reported in the chosen format too, so a CI
+    report never comes out empty, and its lines go to stderr as always."""
+    from robotkit.check import cases, check, render
+    from robotkit.check.findings import input_findings
+    from robotkit.errors import RobotkitError
+
+    findings, status, ran = [], 0, []
+    for path in args.paths:
+        try:  # github: the job summary points at the picture report, so a recipe's build writes it
+            findings += check(path, args.out, packages, args=dict(args.arg),
+                              report=args.format == "github" and not args.temp_out)
+            ran += cases(path, args.out, dict(args.arg))
+        except RobotkitError as exc:
+            for line in exc.lines():
+                print(line, file=sys.stderr)
+            findings += input_findings(exc.problems, path)
+            status = max(status, exc.exit_status)
+    source = " ".join(args.paths)
+    if args.format != "text" or not status:
+        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran))
+    elif any(f.check != "input" for f in findings):  # the paths that could be checked
+        sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on))
+    if args.junit:
+        from pathlib import Path
+
+        Path(args.junit).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.junit).write_text(render(findings, "junit", source, args.fail_on, ran), encoding="utf-8")
     if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
-        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.path, args.out)
-    levels = ("error",) if args.fail_on == "error" else ("error", "warning")
-    return 1 if any(f.severity in levels for f in findings) else 0
+        # a temporary build folder is gone when the summary is read: no report to point at
+        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, None if args.temp_out else args.out)
+    return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)
 
 
 def _package_paths(items: list[str]) -> dict[str, str] | None:
@@ -397,25 +437,29 @@ def _view(args) -> int:
     return serve(args.path, args.port, open_browser=not args.no_browser, build_out=args.out)
 
 
-def _job_summary(summary_file: str, findings, path: str, out: str) -> None:
+def _job_summary(summary_file: str, findings, paths: list[str], out: str | None) -> None:
     """Append the check's summary, pointing at the picture report, to GitHub's job summary."""
     from pathlib import Path
 
     from robotkit.check.report import job_summary
+    from robotkit.errors import RobotkitError
     from robotkit.tasks import REPORT
 
-    p = Path(path)
-    if p.suffix.lower() in (".yaml", ".yml"):
-        from robotkit.recipe.load import load_recipe
+    folders = []
+    for path in map(Path, paths):
+        if path.suffix.lower() in (".yaml", ".yml") and out is not None:
+            from robotkit.recipe.load import load_recipe
 
-        folders = [Path(out) / load_recipe(p).recipe.robot]
-    elif p.is_dir():
-        folders = [p] if (p / "model.sdf").is_file() else sorted(d for d in p.iterdir() if (d / "model.sdf").is_file())
-    else:
-        folders = []
+            try:
+                folders.append(Path(out) / load_recipe(path).recipe.robot)
+            except RobotkitError:
+                pass  # a recipe that does not load has no report; its findings say why
+        elif path.is_dir():
+            folders += [path] if (path / "model.sdf").is_file() else sorted(
+                d for d in path.iterdir() if (d / "model.sdf").is_file())
     pages = [os.path.relpath(f / REPORT) for f in folders if (f / REPORT).is_file()]
     with open(summary_file, "a", encoding="utf-8") as f:
-        f.write(job_summary(findings, path, pages))
+        f.write(job_summary(findings, " ".join(paths), pages))
 
 
 def _import(args) -> int:
@@ -428,6 +472,15 @@ def _expand(args) -> int:
     from robotkit.recipe.flat import flat_yaml
 
     sys.stdout.write(flat_yaml(args.recipe, dict(args.arg), args.variant))
+    return 0
+
+
+def _new(args) -> int:
+    from robotkit.starter import new
+
+    for path in new(args.name, args.dir):
+        print(os.path.relpath(path))
+    print(f"build it: robotkit build {os.path.relpath(os.path.join(args.dir, args.name + '.yaml'))}")
     return 0
 
 

@@ -46,6 +46,35 @@ class Problem:
         return f"{where}{key}{self.message}"
 
 
+def _yaml_syntax_message(exc) -> str:
+    """PyYAML's parser wording (``expected <block end>, but found '<block mapping start>'``) in
+    the recipe author's words, naming the line where the unclosed or misaligned part began."""
+    problem = getattr(exc, "problem", None) or str(exc)
+    context = getattr(exc, "context_mark", None)
+    began = f" at line {context.line + 1}" if context is not None else ""
+    if problem.startswith("expected ',' or '}'"):
+        return f"the {{...}} mapping opened{began} is not closed: a '}}' or ',' is missing"
+    if problem.startswith("expected ',' or ']'"):
+        return f"the [...] list opened{began} is not closed: a ']' or ',' is missing"
+    if problem.startswith("expected <block end>"):
+        return f"this line is indented differently from the keys of the mapping{began} (indent with spaces, aligned)"
+    if problem == "found character '\\t' that cannot start any token":
+        return "a tab character: YAML indents with spaces only"
+    if problem == "mapping values are not allowed here":
+        return "a ': ' where no key may start: quote a value that contains ': ', or put the key on its own line"
+    if problem == "could not find expected ':'":
+        return f"a line without ':' inside the mapping{began} (a key needs 'key: value')"
+    if problem.startswith("found undefined alias"):
+        return f"{problem.replace('found undefined alias', 'the alias')} names no anchor (&name) above it"
+    return problem
+
+
+def yaml_syntax_problem(exc, file: str) -> Problem:
+    """A YAML syntax error (PyYAML's ``MarkedYAMLError``) as one problem on its line."""
+    mark = getattr(exc, "problem_mark", None)
+    return Problem(f"invalid YAML: {_yaml_syntax_message(exc)}", file=file, line=mark.line + 1 if mark else None)
+
+
 class RobotkitError(Exception):
     """A problem with the user's input; carries every problem found, in order.
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs robotkit into ./.venv (Debian 12 / Python >= 3.11). With --test, also what the
+# Installs robotkit into ./.venv (Debian 12 / Python >= 3.11). With --check, also the validators
+# `robotkit check` runs (check_urdf, `ign sdf`; the GitHub action uses this). With --test, also what the
 # tests need: pytest, MuJoCo and Playwright from PyPI, Chromium, and the validators check_urdf
 # (liburdfdom-tools) and `ign sdf` (libsdformat-dev, ignition-tools) from Debian's packages, and
 # Debian's ROS 1 (catkin, roslaunch, RViz, tf2, Xvfb) that the generated ROS packages are launched with.
@@ -7,12 +8,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 apt_need=()
+command -v python3 >/dev/null || apt_need+=(python3)  # a bare container (debian:12)
 python3 -c "import ensurepip, venv" 2>/dev/null || apt_need+=(python3-venv)
 # OSMesa: MuJoCo renders the picture report offscreen, with no display
-ldconfig -p 2>/dev/null | grep -q libOSMesa.so || apt_need+=(libosmesa6)
-if [ "${1:-}" = "--test" ]; then
+{ ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libOSMesa.so || apt_need+=(libosmesa6)  # /sbin: not on a user's PATH
+if [ "${1:-}" = "--test" ] || [ "${1:-}" = "--check" ]; then
   command -v check_urdf >/dev/null || apt_need+=(liburdfdom-tools)
   command -v ign >/dev/null || apt_need+=(libsdformat-dev ignition-tools)
+fi
+if [ "${1:-}" = "--test" ]; then
   command -v chromium >/dev/null || apt_need+=(chromium)  # the report and viewer tests (Playwright)
   # ROS 1 from Debian 12, for the generated catkin packages: build, launch, RViz under Xvfb, tf2
   ros1=(ros-core rosbash rospack-tools catkin python3-catkin-pkg python3-empy cmake g++ make

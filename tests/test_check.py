@@ -170,10 +170,11 @@ def test_d435_xacro_tensor_is_flagged(assets, tmp_path):
 def test_exit_codes_and_formats(tmp_path):
     bad = tmp_path / "bad.urdf"
     bad.write_text(arm_urdf(arm=link_xml("arm", inertia=(0.01, 0.01, 0.05))))
-    proc = run_cli("check", bad)
+    proc = run_cli("check", bad.name, cwd=tmp_path)
     assert proc.returncode == 1
+    line = next(i for i, text in enumerate(bad.read_text().splitlines(), 1) if '<link name="arm">' in text)
     assert proc.stdout.splitlines()[:2] == [
-        "link 'arm'",
+        f"link 'arm' (bad.urdf:{line})",
         "  error: principal moments 0.01, 0.01, 0.05 violate the triangle inequality (I1 + I2 >= I3): "
         "no real body has them [triangle-inequality]"]
     data = json.loads(run_cli("check", bad, "--format", "json").stdout)

@@ -19,7 +19,40 @@ CASES = {
         links:
           base: {visual: {box: {size: [1, 1, 1]}}
         """,
-        ["robot.yaml:4: invalid YAML: expected ',' or '}', but got '<stream end>'"],
+        ["robot.yaml:4: invalid YAML: the {...} mapping opened at line 3 is not closed: a '}' or ',' is missing"],
+    ),
+    "invalid_yaml_unclosed_list": (
+        """
+        robot: arm
+        links:
+          base: {visual: {box: {size: [1, 1, 1}}}
+        """,
+        ["robot.yaml:3: invalid YAML: the [...] list opened at line 3 is not closed: a ']' or ',' is missing"],
+    ),
+    "invalid_yaml_indentation": (
+        """
+        robot: arm
+        links:
+          base:
+            visual: {box: {size: [1, 1, 1]}}
+           inertial: {mass: 1}
+        """,
+        ["robot.yaml:5: invalid YAML: this line is indented differently from the keys of the mapping at line 3 "
+         "(indent with spaces, aligned)"],
+    ),
+    "invalid_yaml_tab": (
+        "robot: arm\nlinks:\n\tbase: {visual: {box: {size: [1, 1, 1]}}}\n",
+        ["robot.yaml:3: invalid YAML: a tab character: YAML indents with spaces only"],
+    ),
+    "invalid_yaml_colon_in_value": (
+        """
+        robot: arm
+        links:
+          base: {visual: {box: {size: [1, 1, 1]}}}
+        description: a robot: the arm
+        """,
+        ["robot.yaml:4: invalid YAML: a ': ' where no key may start: quote a value that contains ': ', "
+         "or put the key on its own line"],
     ),
     "unknown_key": (
         """
@@ -54,6 +87,16 @@ CASES = {
         links:
           base:
             visual: {mesh: nothere.stl}
+        """,
+        ["robot.yaml:4: links.base.visual.mesh: mesh file 'nothere.stl' does not exist"],
+    ),
+    "missing_mesh_file_with_inertial": (  # one line: not also "the inertial needs geometry"
+        """
+        robot: arm
+        links:
+          base:
+            visual: {mesh: nothere.stl, units: mm}
+            inertial: {mass: 1}
         """,
         ["robot.yaml:4: links.base.visual.mesh: mesh file 'nothere.stl' does not exist"],
     ),

@@ -189,10 +189,12 @@ def test_metadata_fills_package_xml(tmp_path):
 
 def test_no_maintainer_is_a_warning_not_an_invented_address(tmp_path):
     recipe = write_recipe(tmp_path, BOX.format(name="anon") + "metadata: {authors: [{name: Bob}], license: MIT}\n")
-    proc = run_cli("build", recipe, "--out", tmp_path / "out")
+    proc = run_cli("build", recipe.name, "--out", tmp_path / "out", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
-    assert ("warning: anon: ROS package: no maintainer: package.xml names none, and catkin and colcon refuse a "
-            "package without one (give metadata.maintainers, or an author with an email)") in proc.stderr.splitlines()
+    line = recipe.read_text().splitlines().index("metadata: {authors: [{name: Bob}], license: MIT}") + 1
+    assert (f"robot.yaml:{line}: metadata.maintainers: warning: anon: ROS package: no maintainer: package.xml names "
+            "none, and catkin and colcon refuse a package without one (give metadata.maintainers, or an author with "
+            "an email)") in proc.stderr.splitlines()
     text = (tmp_path / "out" / "anon" / "package.xml").read_text()
     assert "<maintainer" not in text and "example.com" not in text
 

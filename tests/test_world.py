@@ -524,7 +524,8 @@ def test_missing_keys_and_missing_file(tmp_path, monkeypatch):
 def test_invalid_yaml_and_not_a_mapping(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "a.yaml").write_text("image: m.pgm\nresolution: [0.05\n")
-    assert errors(tmp_path / "a.yaml") == ["a.yaml:3: invalid YAML: expected ',' or ']', but got '<stream end>'"]
+    assert errors(tmp_path / "a.yaml") == [
+        "a.yaml:3: invalid YAML: the [...] list opened at line 2 is not closed: a ']' or ',' is missing"]
     (tmp_path / "b.yaml").write_text("- image\n- m.pgm\n")
     assert errors(tmp_path / "b.yaml") == [
         "b.yaml:1: a map YAML file must be a mapping of map_server keys "

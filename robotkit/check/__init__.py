@@ -11,6 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from robotkit.check.findings import Finding
+from robotkit.check.locate import locate
 from robotkit.check.report import render  # noqa: F401  (the CLI renders through here)
 from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
 from robotkit.errors import Problem, RobotkitError
@@ -35,8 +36,8 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     links, joints, notes = read_urdf_facts(path, package_paths)
     findings = validate_urdf(path) + notes + lint(links, joints)
     build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths)
-    return findings + _stage("consumers", f"robot '{path.stem}'",
-                             lambda: consumer_findings(build, URDF_CONSUMERS)[0])
+    findings += _stage("consumers", f"robot '{path.stem}'", lambda: consumer_findings(build, URDF_CONSUMERS)[0])
+    return locate(findings, path)
 
 
 def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list[Finding]:
@@ -79,24 +80,27 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
 
 def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
     from robotkit.build import build
+    from robotkit.buildwarn import parse
     from robotkit.recipe.load import load_recipes
 
     located = []
     result = build([path], out_dir, args=args, report=report)
+    warnings = [parse(w) for w in result.warning_lines]  # (file, line, key, text)
     for i, loaded in enumerate(load_recipes(path, args)):  # one per variant
         name = loaded.recipe.robot
         others = [r for r in result.robots if r != name]
         # a warning naming another variant's robot belongs to that one; the rest to the first
-        warnings = [w for w in result.warnings if w.startswith(f"{name}:")
-                    or (i == 0 and not any(w.startswith(f"{o}:") for o in others))]
-        located += _check_variant(loaded, warnings, out_dir)
+        mine = [w for w in warnings if w[3].startswith(f"{name}:")
+                or (i == 0 and not any(w[3].startswith(f"{o}:") for o in others))]
+        located += _check_variant(loaded, mine, out_dir)
     return located
 
 
-def _check_variant(loaded, warnings: list[str], out_dir: str) -> list[Finding]:
+def _check_variant(loaded, warnings: list[tuple], out_dir: str) -> list[Finding]:
     name = loaded.recipe.robot
-    findings = [Finding("warning", "build", f"robot '{name}'", w) for w in warnings]
-    findings += check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
+    build_findings = [Finding("warning", "build", key or f"robot '{name}'", text, file=file, line=line)
+                      for file, line, key, text in warnings]
+    findings = check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
     marks = loaded.marks
     located = []
     for f in findings:
@@ -107,7 +111,8 @@ def _check_variant(loaded, warnings: list[str], out_dir: str) -> list[Finding]:
             key = ("joints", f.subject[7:-1])
         file, line = marks.locate(key)
         located.append(replace(f, file=file, line=line))
-    return located
+    return [f if f.file else replace(f, **dict(zip(("file", "line"), marks.locate(("robot",)))))
+            for f in build_findings] + located
 
 
 def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
@@ -117,11 +122,13 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
     package_paths = package_paths or {}
     if p.is_dir():
         if (p / "model.sdf").is_file():
-            return check_build_dir(p)
-        dirs = sorted(d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
+            dirs = [p]
+        else:
+            dirs = sorted(d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
         if not dirs:
             raise RobotkitError(Problem("not a build folder (no <robot>/model.sdf below it)", file=path))
-        return [f for d in dirs for f in check_build_dir(d)]
+        # a build folder's findings point at its URDF
+        return [f for d in dirs for f in locate(check_build_dir(d), d / "urdf" / f"{d.name}.urdf")]
     if not p.is_file():
         raise RobotkitError(Problem("no such file or folder", file=path))
     suffix = p.suffix.lower()
@@ -130,9 +137,9 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
     if suffix == ".urdf":
         return check_urdf_file(p, package_paths)
     if suffix in (".sdf", ".world"):
-        return validate_sdf(p) + _inertial_lints(p, "sdf")
+        return locate(validate_sdf(p) + _inertial_lints(p, "sdf"), p)
     if suffix == ".xml":
-        return validate_mjcf(p) or _inertial_lints(p, "mjcf")
+        return locate(validate_mjcf(p) or _inertial_lints(p, "mjcf"), p)
     raise RobotkitError(Problem("unknown kind of file (expected a recipe .yaml, .urdf, .sdf or MJCF .xml)", file=path))
 
 
@@ -161,3 +168,38 @@ def _inertial_lints(path: Path, kind: str) -> list[Finding]:
     return out
 
 
+def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None) -> list[tuple[str, str]]:
+    """Every (check, subject) that a check of ``path`` ran, named as its findings name them, so
+    CI reports list what passed too: each validator on each file, the equivalence, consumer and
+    simulation stages on the robot, and the physics lints (``lints``) on each link and joint."""
+    from robotkit.check.locate import element_lines
+
+    p = Path(path)
+
+    def described(file: Path) -> list[tuple[str, str]]:
+        names = element_lines(file)
+        return [("lints", f"{'link' if tag in ('link', 'body') else 'joint'} '{name}'")
+                for (tag, name) in names if tag in ("link", "joint", "body")]
+
+    def folder(d: Path) -> list[tuple[str, str]]:
+        name, robot = d.name, f"robot '{d.name}'"
+        urdf = d / "urdf" / f"{name}.urdf"
+        files = [("check_urdf", urdf), ("ign sdf -k", d / "model.sdf"), ("mujoco", d / "mjcf" / f"{name}.xml"),
+                 ("mujoco", d / "mjcf" / "scene.xml")]
+        return ([(c, str(f)) for c, f in files] + [(c, robot) for c in ("equivalence", "consumer", "simulation")]
+                + described(urdf))
+
+    if p.is_dir():
+        dirs = [p] if (p / "model.sdf").is_file() else sorted(
+            d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
+        return [c for d in dirs for c in folder(d)]
+    suffix = p.suffix.lower()
+    if suffix in (".yaml", ".yml"):
+        from robotkit.recipe.load import load_recipes
+
+        return [c for loaded in load_recipes(p, args) for c in folder(Path(out_dir) / loaded.recipe.robot)]
+    if suffix == ".urdf":
+        return [("check_urdf", str(p)), ("consumer", f"robot '{p.stem}'")] + described(p)
+    if suffix in (".sdf", ".world"):
+        return [("ign sdf -k", str(p))]
+    return [("mujoco", str(p))]

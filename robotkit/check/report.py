@@ -6,29 +6,24 @@ from __future__ import annotations
 import json
 from dataclasses import asdict
 
-from robotkit.check.findings import Finding
-
-SEVERITIES = ("error", "warning")
+from robotkit.check.findings import STAGES, Finding
 
 
-def render(findings: list[Finding], fmt: str, source: str) -> str:
+def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error",
+           cases: list[tuple[str, str]] | None = None) -> str:
+    """``fail_on`` (``--fail-on``): the lowest severity that fails the check; every format says
+    which findings fail it (JUnit failures, GitHub ``::error``, JSON ``failed``, the text's last line).
+    ``cases``: every (check, subject) that ran (:func:`robotkit.check.cases`): JUnit lists the
+    ones without findings as passing test cases."""
     if fmt == "json":
         return json.dumps({"source": source, "errors": sum(f.severity == "error" for f in findings),
-                           "warnings": sum(f.severity == "warning" for f in findings),
+                           "warnings": sum(f.severity == "warning" for f in findings), "fail_on": fail_on,
+                           "failed": sum(f.fails(fail_on) for f in findings),
                            "findings": [asdict(f) for f in findings]}, indent=1) + "\n"
     if fmt == "junit":
-        return _junit(findings, source)
+        return _junit(findings, source, fail_on, cases or [])
     if fmt == "github":
-        from robotkit.errors import display_path
-
-        lines = []
-        for f in findings:  # GitHub wants paths relative to the repository (the working directory)
-            where = f"file={display_path(f.file)}" + (f",line={f.line}" if f.line else "") if f.file else ""
-            text = f"{f.subject}: {f.message}" + (f" (hint: {f.hint})" if f.hint else "")
-            text = text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
-            lines.append(f"::{f.severity} {where}{',' if where else ''}title=robotkit {f.check}::{text}"
-                         .replace(" ,title", " title"))
-        return "".join(line + "\n" for line in lines)
+        return "".join(annotation(f, fail_on) + "\n" for f in findings)
     if not findings:
         return f"{source}: ok, no problems found\n"
     groups: dict[str, list[Finding]] = {}
@@ -48,32 +43,77 @@ def render(findings: list[Finding], fmt: str, source: str) -> str:
                 out.append(f"    hint: {f.hint}")
     errors = sum(f.severity == "error" for f in findings)
     warnings = len(findings) - errors
-    out.append(f"{source}: {errors} error{'s' * (errors != 1)}, {warnings} warning{'s' * (warnings != 1)}")
+    tail = " (they fail the check: --fail-on warning)" if fail_on == "warning" and warnings else ""
+    out.append(f"{source}: {errors} error{'s' * (errors != 1)}, {warnings} warning{'s' * (warnings != 1)}{tail}")
     return "\n".join(out) + "\n"
 
 
-def _junit(findings: list[Finding], source: str) -> str:
-    """One test case per check and subject, so CI test reporters list them."""
+def _escape_data(text: str) -> str:
+    """A workflow command's message: % CR LF escaped (GitHub's workflow-command syntax)."""
+    return text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
+
+
+def _escape_property(text: str) -> str:
+    """A workflow command's property value: also : and , escaped."""
+    return _escape_data(text).replace(":", "%3A").replace(",", "%2C")
+
+
+def annotation(f: Finding, fail_on: str = "error") -> str:
+    """One GitHub workflow command: ``::error file=F,line=L,title=T::message``.  A finding that
+    fails the check (``--fail-on``) is an ``error`` whatever its severity; the title keeps it."""
+    from robotkit.errors import display_path
+
+    props = []
+    if f.file:  # GitHub wants paths relative to the repository (the working directory)
+        props.append(f"file={_escape_property(display_path(f.file))}")
+        if f.line:
+            props.append(f"line={f.line}")
+    title = f"robotkit {f.check}" + (f" ({f.severity})" if f.fails(fail_on) and f.severity != "error" else "")
+    props.append(f"title={_escape_property(title)}")
+    text = f"{f.subject}: {f.message}" + (f" (hint: {f.hint})" if f.hint else "")
+    return f"::{'error' if f.fails(fail_on) else f.severity} {','.join(props)}::{_escape_data(text)}"
+
+
+def _junit(findings: list[Finding], source: str, fail_on: str, ran: list[tuple[str, str]]) -> str:
+    """One test case per check and subject, so CI test reporters list them; a case fails when
+    one of its findings fails the check (``--fail-on``).  The checks that ran and found nothing
+    are passing cases (``robotkit.lints`` for a link or joint no physics lint fired on)."""
     import xml.etree.ElementTree as ET
 
     cases: dict[tuple[str, str], list[Finding]] = {}
     for f in findings:
         cases.setdefault((f.check, f.subject), []).append(f)
-    suite = ET.Element("testsuite", name=f"robotkit check {source}", tests=str(max(len(cases), 1)),
-                       failures=str(sum(any(x.severity == "error" for x in v) for v in cases.values())),
-                       errors="0", skipped="0")
-    if not cases:
+    linted = {f.subject for f in findings if f.check not in STAGES}
+    passed = list(dict.fromkeys(c for c in ran if c not in cases and not (c[0] == "lints" and c[1] in linted)))
+    failing = [any(x.fails(fail_on) for x in v) for v in cases.values()]
+    total = len(cases) + len(passed)
+    suite = ET.Element("testsuite", name=f"robotkit check {source}", tests=str(max(total, 1)),
+                       failures=str(sum(failing)), errors="0", skipped="0")
+    if not total:
         ET.SubElement(suite, "testcase", classname="robotkit", name="all checks")
-    for (check, subject), items in cases.items():
+    for ((check, subject), items), fails in zip(cases.items(), failing):
         case = ET.SubElement(suite, "testcase", classname=f"robotkit.{check}", name=subject)
-        text = "\n".join(f"{f.severity}: {f.message}" + (f" (hint: {f.hint})" if f.hint else "") for f in items)
-        if any(f.severity == "error" for f in items):
-            ET.SubElement(case, "failure", message=items[0].message).text = text
+        first = next((x for x in items if x.fails(fail_on)), items[0])
+        text = "\n".join(_where(f) + f"{f.severity}: {f.message}" + (f" (hint: {f.hint})" if f.hint else "")
+                         for f in items)
+        if fails:
+            ET.SubElement(case, "failure", type=first.severity, message=first.message).text = text
         else:
             ET.SubElement(case, "system-out").text = text
-    suites = ET.Element("testsuites")
+    for check, subject in passed:
+        ET.SubElement(suite, "testcase", classname=f"robotkit.{check}", name=subject)
+    suites = ET.Element("testsuites", tests=suite.get("tests"), failures=suite.get("failures"), errors="0")
     suites.append(suite)
     return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(suites, encoding="unicode") + "\n"
+
+
+def _where(f: Finding) -> str:
+    """``file:line: `` of a finding (the JUnit schema has no place for it but the text)."""
+    if not f.file:
+        return ""
+    from robotkit.errors import display_path
+
+    return display_path(f.file) + (f":{f.line}" if f.line else "") + ": "
 
 
 def job_summary(findings: list[Finding], source: str, reports: list[str]) -> str:

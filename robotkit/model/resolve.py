@@ -123,10 +123,13 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
         ispec = link.inertial
         policy = (ispec.open_mesh if ispec and ispec != "none" and ispec.open_mesh else None) or r.open_mesh
         visuals = []
+        unusable = set()  # roles with a geometry already reported (a missing mesh): no second line
         for i, g in _indexed(link.visual):
             geom = make_geom(g, lp + ("visual",) + i, name, policy)
             if geom is not None:
                 visuals.append(geom)
+            else:
+                unusable.add("visual")
         collisions = []
         format_collisions = []
         strategy = link.collision if isinstance(link.collision, Collision) else (
@@ -158,10 +161,12 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                 geom = make_geom(g, lp + ("collision",) + i, name, policy, "collision")
                 if geom is not None:
                     collisions.append(geom)
+                else:
+                    unusable.add("collision")
         spec = InertialSpec("none") if ispec == "none" else _inertial_spec(ispec, r.density)
         source = visuals if spec.source == "visual" else collisions
         if spec.mode in ("density", "mass") and not source:
-            if ispec is None:
+            if ispec is None or spec.source in unusable:
                 spec = InertialSpec("none")
             else:
                 problems.append(marks.problem(lp + ("inertial",),

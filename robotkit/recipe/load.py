@@ -15,7 +15,7 @@ from pathlib import Path
 
 import yaml
 
-from robotkit.errors import Problem, RecipeError
+from robotkit.errors import Problem, RecipeError, yaml_syntax_problem
 
 Path_ = tuple  # a key path: ("links", "base", "visual", 0, "mesh")
 
@@ -87,10 +87,7 @@ def _read_yaml(file: Path, problems: list[Problem]):
         except yaml.YAMLError:
             node = yaml.compose(text, Loader=_PyLoader)
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else None
-        what = getattr(exc, "problem", None) or str(exc)
-        problems.append(Problem(f"invalid YAML: {what}", file=str(file), line=line))
+        problems.append(yaml_syntax_problem(exc, str(file)))
         return None, {}
     if node is None:
         problems.append(Problem("the file is empty", file=str(file)))

@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robotkit.errors import MapError, Problem, display_path
+from robotkit.errors import MapError, Problem, display_path, yaml_syntax_problem
 
 MODES = ("trinary", "scale", "raw")
 REQUIRED = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh")
@@ -150,10 +150,7 @@ def _read_yaml(yaml_path: Path, problems: list[Problem]):
     try:
         node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else None
-        what = getattr(exc, "problem", None) or str(exc)
-        problems.append(Problem(f"invalid YAML: {what}", file=file, line=line))
+        problems.append(yaml_syntax_problem(exc, file))
         return None, {}
     if not isinstance(node, yaml.MappingNode):
         problems.append(Problem("a map YAML file must be a mapping of map_server keys "
