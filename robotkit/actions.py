@@ -303,7 +303,7 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
         args = dict(threshold=c["threshold"], max_hulls=c["max_hulls"], resolution=c["resolution"],
                     preprocess=c["preprocess"], preprocess_resolution=c["preprocess_resolution"], seed=c["seed"],
                     max_hull_vertices=strategy["max_vertices"], mcts_iterations=c["mcts_iterations"])
-        op, make = "collision-coacd/1", (lambda: decompose(mesh, **args))
+        op, make = "collision-coacd/2", (lambda: decompose(mesh, **args))  # /2: bodies joined (coacd_input)
     pieces, info = cache.get_or_compute(op, {**args, "fidelity_samples": 4000}, [mesh], with_report(make))
     return list(pieces) if isinstance(pieces, (list, tuple)) else [pieces], info["fidelity"]
 

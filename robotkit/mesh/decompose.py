@@ -40,7 +40,8 @@ def decompose(mesh, threshold: float = 0.05, max_hulls: int = -1, resolution: in
     ``threshold``: CoACD's concavity threshold (0.01-1, smaller = more, finer
     pieces); ``max_hulls``: upper bound on the number of pieces (-1: none);
     ``resolution``: CoACD's sampling resolution; ``preprocess``: ``auto``
-    (remesh only when the input is not a 2-manifold), ``on`` or ``off``;
+    (a closed mesh: the union of its bodies, no remeshing; otherwise CoACD's
+    remesh when the input is not a 2-manifold; see :func:`coacd_input`), ``on`` or ``off``;
     ``preprocess_resolution``: voxel resolution of that remeshing; ``seed``:
     CoACD's random seed; ``max_hull_vertices``: vertex budget per piece (>= 4);
     ``mcts_iterations``, ``mcts_nodes``, ``mcts_max_depth``: CoACD's cutting-plane
@@ -64,12 +65,13 @@ def decompose(mesh, threshold: float = 0.05, max_hulls: int = -1, resolution: in
 
     import coacd
 
+    V, F, mode = coacd_input(V, F, preprocess)
     coacd.set_log_level("off")
     budget = int(max_hull_vertices) if max_hull_vertices is not None else None
     try:
         parts = coacd.run_coacd(
             coacd.Mesh(V, F), threshold=float(threshold), max_convex_hull=int(max_hulls),
-            preprocess_mode=preprocess, preprocess_resolution=int(preprocess_resolution),
+            preprocess_mode=mode, preprocess_resolution=int(preprocess_resolution),
             resolution=int(resolution), seed=int(seed), decimate=False, mcts_iterations=int(mcts_iterations),
             mcts_nodes=int(mcts_nodes), mcts_max_depth=int(mcts_max_depth))
     except Exception as exc:  # the ctypes wrapper raises plain exceptions or asserts
@@ -91,6 +93,35 @@ def decompose(mesh, threshold: float = 0.05, max_hulls: int = -1, resolution: in
     keys = np.array([np.append(p.vertices.mean(axis=0), p.volume) for p in pieces])
     order = np.lexsort(keys.T[::-1])
     return [pieces[i] for i in order]
+
+
+def coacd_input(V: np.ndarray, F: np.ndarray, preprocess: str) -> tuple[np.ndarray, np.ndarray, str]:
+    """The mesh CoACD gets and its ``preprocess_mode``: (vertices, faces, mode).
+
+    ``auto``: a closed mesh whose bodies overlap (CAD exports often are several
+    closed bodies pushed into each other) is replaced by the union of its bodies
+    (manifold3d's exact boolean union, float64), and CoACD runs with its
+    preprocessing off.  CoACD's own ``auto`` finds such a mesh "not manifold"
+    (its triangles intersect) and remeshes it on a voxel grid: the UR5's
+    500-1,200-face collision parts became 64,000-104,000 triangles, which made
+    CoACD 3-5 times slower and the pieces no closer (docs/performance.md).  A
+    mesh manifold3d does not take as a closed volume keeps CoACD's ``auto``.
+    ``on`` and ``off`` pass the mesh unchanged with CoACD's meaning.
+    """
+    if preprocess != "auto":
+        return V, F, preprocess
+    import manifold3d as m3
+
+    whole = m3.Manifold(m3.Mesh64(vert_properties=np.array(V, dtype=np.float64), tri_verts=np.array(F, dtype=np.uint64)))
+    if whole.status() != m3.Error.NoError or whole.is_empty():
+        return V, F, "auto"
+    bodies = whole.decompose()
+    union = m3.Manifold.batch_boolean(bodies, m3.OpType.Add) if len(bodies) > 1 else whole
+    if union.status() != m3.Error.NoError or union.is_empty():
+        return V, F, "auto"
+    mesh = union.to_mesh64()
+    return (np.ascontiguousarray(np.asarray(mesh.vert_properties)[:, :3], dtype=np.float64),
+            np.ascontiguousarray(mesh.tri_verts, dtype=np.int32), "off")
 
 
 def _check(threshold, max_hulls, resolution, preprocess, preprocess_resolution, seed, max_hull_vertices,
