@@ -65,25 +65,13 @@ def rectangles(mask: np.ndarray) -> np.ndarray:
     return rects[np.lexsort((rects[:, 0], rects[:, 1]))]
 
 
-def _segments(types: np.ndarray, breaks: np.ndarray):
-    """Split each line of unit edges into segments between consecutive breaks.
-
-    ``types`` (lines, n): 0 no wall face, +1/-1 a face and its direction; ``breaks``
-    (lines, n + 1): the points where a segment must end.  Returns (line, start, end, type)
-    of every segment with a face.
-    """
-    n = types.shape[1]
-    flat = np.flatnonzero(breaks.ravel())
-    line, pos = np.divmod(flat, n + 1)
-    same = line[1:] == line[:-1]
-    line, start, end = line[:-1][same], pos[:-1][same], pos[1:][same]
-    kind = types[line, start]
-    keep = kind != 0
-    return line[keep], start[keep], end[keep], kind[keep]
-
-
 class _Grid:
-    """The padded wall mask and what the outline needs from it."""
+    """The padded wall mask and what the outline needs from it.
+
+    Only the points where the outline turns are kept (as coordinate lists), not whole
+    arrays per grid point: a 5000 x 5000 map has 25 million grid points and a few hundred
+    thousand turns.
+    """
 
     def __init__(self, mask: np.ndarray):
         self.mask = mask
@@ -92,35 +80,59 @@ class _Grid:
         g[1:-1, 1:-1] = mask
         self.g = g
         # the four cells around each grid point (y, x), shape (rows + 1, cols + 1)
-        sw, se, nw, ne = g[:-1, :-1] > 0, g[:-1, 1:] > 0, g[1:, :-1] > 0, g[1:, 1:] > 0
-        self.pinch_ne_sw = sw & ne & ~nw & ~se
-        self.pinch_nw_se = nw & se & ~sw & ~ne
-        self.pinch = self.pinch_ne_sw | self.pinch_nw_se
-        count = sw.astype(np.int8) + se + nw + ne
-        self.turns = (count == 1) | (count == 3) | self.pinch  # where the outline changes direction
-        self.pinch_y, self.pinch_x = np.nonzero(self.pinch)
-        self.pinch_index = np.full(self.pinch.shape, -1, dtype=np.int64)
-        self.pinch_index[self.pinch_y, self.pinch_x] = np.arange(len(self.pinch_x))
-        # unit edges: horizontal line y = j, +1 when the cell below is a wall and the one above is not;
-        # vertical line x = i, +1 when the cell on the left is a wall and the one on the right is not
-        self.th = g[:-1, 1:-1] - g[1:, 1:-1]
-        self.tv = (g[1:-1, :-1] - g[1:-1, 1:]).T
+        sw, se, nw, ne = g[:-1, :-1], g[:-1, 1:], g[1:, :-1], g[1:, 1:]
+        count = sw + se
+        count += nw
+        count += ne
+        # the outline changes direction where one or three of the four cells are walls, and at
+        # a pinch: two walls touching at a corner (then sw == ne)
+        turns = (count & 1).astype(bool)
+        turns |= (count == 2) & (sw == ne)
+        self.turn_y, self.turn_x = np.nonzero(turns)  # row-major order
+        pinch = count[self.turn_y, self.turn_x] == 2
+        self.pinch_y, self.pinch_x = self.turn_y[pinch], self.turn_x[pinch]
+        self._pinch_keys = self.pinch_y * (self.cols + 1) + self.pinch_x  # sorted
+        self._pinch_ne_sw = sw[self.pinch_y, self.pinch_x] > 0  # else the north-west / south-east pinch
 
-    def outline(self, breaks: np.ndarray):
-        """Directed outline segments A -> B (the wall on the left), split at ``breaks`` (grid points).
+    def pinch_index(self, y: np.ndarray, x: np.ndarray, ne_sw: bool | None = None) -> np.ndarray:
+        """The index of the pinch at each grid point (y, x) (of that kind, unless None), -1 where there is none."""
+        keys = np.asarray(y, dtype=np.int64) * (self.cols + 1) + x
+        if len(self._pinch_keys) == 0:
+            return np.full(keys.shape, -1, dtype=np.int64)
+        pos = np.minimum(np.searchsorted(self._pinch_keys, keys), len(self._pinch_keys) - 1)
+        found = self._pinch_keys[pos] == keys
+        if ne_sw is not None:
+            found &= self._pinch_ne_sw[pos] == ne_sw
+        return np.where(found, pos, -1)
 
+    def outline(self, py: np.ndarray, px: np.ndarray):
+        """Directed outline segments A -> B (the wall on the left), split at the grid points (py, px).
+
+        The points must include every turn, once each, in row-major order.  Between two
+        consecutive points of a grid line, the unit edges all have the same wall face or none:
+        horizontal line y = j, +1 when the cell below is a wall and the one above is not;
+        vertical line x = i, +1 when the cell on the left is a wall and the one on the right is not.
         Returns ax, ay, bx, by, am, bm: am / bm is the pinch index when the wall face of this
         segment must split its vertical edge at A / B (see the module docstring), else -1.
         """
-        j, xa, xb, kind = _segments(self.th, breaks)
-        west = kind > 0
-        low = self.pinch_index[j, xa]  # a pinch at the segment's west end belongs to this segment's cell
+        g = self.g
+        same = py[1:] == py[:-1]
+        j, xa, xb = py[:-1][same], px[:-1][same], px[1:][same]
+        kind = g[j, xa + 1] - g[j + 1, xa + 1]
+        keep = kind != 0
+        j, xa, xb, west = j[keep], xa[keep], xb[keep], kind[keep] > 0
+        low = self.pinch_index(j, xa)  # a pinch at the segment's west end belongs to this segment's cell
         h = (np.where(west, xb, xa), j, np.where(west, xa, xb), j,
              np.where(west, -1, low), np.where(west, low, -1))
-        i, ya, yb, kind = _segments(self.tv, breaks.T)
-        north = kind > 0
-        low = np.where(self.pinch_ne_sw[ya, i], self.pinch_index[ya, i], -1)
-        high = np.where(self.pinch_nw_se[yb, i], self.pinch_index[yb, i], -1)
+        order = np.lexsort((py, px))
+        vy, vx = py[order], px[order]
+        same = vx[1:] == vx[:-1]
+        i, ya, yb = vx[:-1][same], vy[:-1][same], vy[1:][same]
+        kind = g[ya + 1, i] - g[ya + 1, i + 1]
+        keep = kind != 0
+        i, ya, yb, north = i[keep], ya[keep], yb[keep], kind[keep] > 0
+        low = self.pinch_index(ya, i, ne_sw=True)
+        high = self.pinch_index(yb, i, ne_sw=False)
         v = (i, np.where(north, ya, yb), i, np.where(north, yb, ya),
              np.where(north, low, high), np.where(north, high, low))
         return tuple(np.concatenate(p) for p in zip(h, v))
@@ -352,7 +364,7 @@ def extrude(mask: np.ndarray, height: float, method: str = "outline"):
 
     for attempt in dict.fromkeys((method, "rectangles")):
         if attempt == "outline":
-            seg = grid.outline(grid.turns)
+            seg = grid.outline(grid.turn_y, grid.turn_x)
             caps = _outline_caps(grid, seg)
             if caps is None:
                 continue
@@ -360,7 +372,8 @@ def extrude(mask: np.ndarray, height: float, method: str = "outline"):
             centres = np.zeros((0, 2))
         else:
             corner, cx, cy, cap, centres = _rectangle_caps(grid, rectangles(mask))
-            seg = grid.outline(corner | grid.turns)
+            breaks = np.union1d(cy * width + cx, grid.turn_y * width + grid.turn_x)  # sorted: row-major
+            seg = grid.outline(*np.divmod(breaks, width))
         ax, ay, bx, by, am, bm = seg
         # vertices: grid points used (bottom, then top), centres (bottom, top), pinch splits
         keys, inverse = np.unique(np.concatenate([cy * width + cx, ay * width + ax, by * width + bx]),
