@@ -469,6 +469,11 @@ def test_missing_image(tmp_path, monkeypatch):
     (b"", "cannot read 'bad.pgm': the file is empty"),
     (b"P5\n10 8\n255\n" + bytes(30), "cannot read 'bad.pgm': the pixel data is truncated "
                                      "(its header announces 10 x 8 pixels)"),
+    # a header announcing 400 million pixels: refused before decoding (not Pillow's DecompressionBombError)
+    (b"P5\n20000 20000\n255\n" + bytes(64), "'bad.pgm' is 20000 x 20000 pixels, more than robotkit reads "
+                                            "(100,000,000 pixels; crop or downsample the map)"),
+    (b"P5\n10001 10000\n255\n" + bytes(64), "'bad.pgm' is 10001 x 10000 pixels, more than robotkit reads "
+                                            "(100,000,000 pixels; crop or downsample the map)"),
 ])
 def test_unreadable_image(tmp_path, monkeypatch, content, message):
     monkeypatch.chdir(tmp_path)
@@ -577,6 +582,16 @@ def test_cli_bad_map_exits_2_with_one_line(tmp_path):
     assert proc.returncode == 2
     assert proc.stderr.splitlines() == ["nav2_empty_room/empty_room.yaml:1: image: file 'empty.pgm' does not exist "
                                         "(looked in nav2_empty_room/; did you mean 'empty_room.pgm'?)"]
+    assert not (tmp_path / "OUT").exists()
+
+
+def test_cli_too_large_map_exits_2_with_one_line(tmp_path):
+    path = write_map(tmp_path / "maps", None, name="x", image="huge.pgm")
+    (tmp_path / "maps" / "huge.pgm").write_bytes(b"P5\n20000 20000\n255\n" + bytes(64))
+    proc = run_cli("world", path, "--out", tmp_path / "OUT", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == ["maps/x.yaml:1: image: 'huge.pgm' is 20000 x 20000 pixels, more than "
+                                        "robotkit reads (100,000,000 pixels; crop or downsample the map)"]
     assert not (tmp_path / "OUT").exists()
 
 
