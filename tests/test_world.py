@@ -608,3 +608,35 @@ def test_building_a_world_does_not_import_trimesh(tmp_path):
             "print(sorted(m for m in ('trimesh', 'scipy') if m in sys.modules))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
     assert proc.stdout.strip() == "[]", proc.stderr
+
+
+def test_cycles_of_a_permutation_in_walking_order():
+    from robotkit.world.walls import _cycles
+
+    rng = np.random.default_rng(3)
+    succ = rng.permutation(2000)
+    seen, walk, sizes = set(), [], []
+    for s in range(len(succ)):  # the plain walk: from each unvisited index, follow succ
+        size = 0
+        while s not in seen:
+            seen.add(s)
+            walk.append(s)
+            s = int(succ[s])
+            size += 1
+        if size:
+            sizes.append(size)
+    order, got = _cycles(succ)
+    assert order.tolist() == walk and got.tolist() == sizes
+
+
+def test_closed_check_of_the_wall_mesh():
+    from robotkit.world.walls import _closed
+
+    box = trimesh.creation.box([1, 1, 1])
+    faces = np.asarray(box.faces)
+    assert _closed(faces, len(box.vertices))
+    assert not _closed(faces[1:], len(box.vertices))  # a hole
+    assert not _closed(np.concatenate([faces, faces[:1]]), len(box.vertices))  # a face twice
+    flipped = faces.copy()
+    flipped[0] = flipped[0, ::-1]
+    assert not _closed(flipped, len(box.vertices))  # one face the wrong way round

@@ -36,14 +36,26 @@ def grid_mask(walls_image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(walls_image[::-1, :], dtype=bool)
 
 
-def _runs_merged(mask: np.ndarray) -> np.ndarray:
-    """Row runs of ``mask`` merged with identical runs in consecutive rows: (n, 4) [x0, y0, x1, y1]."""
+def _runs_merged(mask: np.ndarray, axis: int = 1) -> np.ndarray:
+    """Runs of ``mask`` along its rows (``axis`` 1) or columns (0), each merged with identical
+    runs in the next lines: (n, 4) [start, line0, end, line1 + 1] (for columns: y, x, not x, y).
+
+    The columns are read in place (a difference down the columns, then the few transitions
+    sorted), not from a transposed copy of the mask.
+    """
     rows, cols = mask.shape
-    pad = np.zeros((rows, cols + 2), dtype=np.int8)
-    pad[:, 1:-1] = mask
-    d = np.diff(pad, axis=1)
-    ys, xs = np.nonzero(d == 1)
-    _, xe = np.nonzero(d == -1)
+    if axis == 1:
+        pad = np.zeros((rows, cols + 2), dtype=np.int8)
+        pad[:, 1:-1] = mask
+        line, pos = np.nonzero(np.diff(pad, axis=1))  # row by row, left to right
+    else:
+        pad = np.zeros((rows + 2, cols), dtype=np.int8)
+        pad[1:-1] = mask
+        pos, line = np.nonzero(np.diff(pad, axis=0))
+        order = np.lexsort((pos, line))  # column by column, bottom to top
+        line, pos = line[order], pos[order]
+    # along a line a run starts (+1) and ends (-1) in turn
+    ys, xs, xe = line[0::2], pos[0::2], pos[1::2]
     order = np.lexsort((ys, xe, xs))
     xs, xe, ys = xs[order], xe[order], ys[order]
     new = np.ones(len(xs), dtype=bool)
@@ -60,7 +72,7 @@ def rectangles(mask: np.ndarray) -> np.ndarray:
     sorted by y0 then x0.
     """
     by_rows = _runs_merged(mask)
-    by_cols = _runs_merged(mask.T)[:, [1, 0, 3, 2]]
+    by_cols = _runs_merged(mask, axis=0)[:, [1, 0, 3, 2]]
     rects = by_rows if len(by_rows) <= len(by_cols) else by_cols
     return rects[np.lexsort((rects[:, 0], rects[:, 1]))]
 
@@ -180,25 +192,10 @@ def _outline_caps(grid: _Grid, seg):
     succ = np.where(left >= 0, left, right)
     if (succ < 0).any():
         return None
-    # follow the successor permutation into loops
-    succ_list = succ.tolist()
-    seen = bytearray(n)
-    loops = []
-    for s in range(n):
-        if seen[s]:
-            continue
-        loop = []
-        while not seen[s]:
-            seen[s] = 1
-            loop.append(s)
-            s = succ_list[s]
-        loops.append(loop)
-    idx = np.fromiter((s for loop in loops for s in loop), dtype=np.int64, count=n)
-    polygons = []
-    for loop in loops:
-        pts = np.empty((len(loop), 2), dtype=np.float64)
-        pts[:, 0], pts[:, 1] = ax[loop], ay[loop]
-        polygons.append(pts)
+    idx, sizes = _cycles(succ)
+    pts = np.empty((n, 2), dtype=np.float64)
+    pts[:, 0], pts[:, 1] = ax[idx], ay[idx]
+    polygons = np.split(pts, np.cumsum(sizes)[:-1])
     try:
         tris = np.asarray(manifold3d.triangulate(polygons), dtype=np.int64).reshape(-1, 3)
     except Exception:  # noqa: BLE001 - any failure of the optional fast path falls back
@@ -206,6 +203,33 @@ def _outline_caps(grid: _Grid, seg):
     px, py = ax[idx], ay[idx]
     tris = _flip_flat(px, py, tris)
     return None if tris is None else (px, py, tris)
+
+
+def _cycles(succ: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The cycles of the permutation ``succ``: (every index in cycle order, the cycle sizes).
+
+    Cycles come in the order of their smallest index, each starting there and following
+    ``succ``: what walking from index 0 upwards and following each unvisited cycle gives,
+    computed by pointer doubling (log2(n) whole-array steps instead of a Python loop).
+    """
+    n = len(succ)
+    label = np.arange(n)
+    jump = succ.copy()
+    steps = max(int(n).bit_length(), 1)
+    for _ in range(steps):  # label: the smallest index of each cycle
+        np.minimum(label, label[jump], out=label)
+        jump = jump[jump]
+    start = label == np.arange(n)
+    # distance forward to the cycle's start, by list ranking with the start as the end
+    nxt = np.where(start, np.arange(n), succ)
+    dist = (~start).astype(np.int64)
+    for _ in range(steps):
+        dist += dist[nxt]
+        nxt = nxt[nxt]
+    size = np.bincount(label, minlength=n)
+    pos = (size[label] - dist) % size[label]  # the start 0, its successor 1, ...
+    order = np.lexsort((pos, label))
+    return order, size[start]
 
 
 def _cross(px, py, tris) -> np.ndarray:
@@ -342,8 +366,8 @@ def _closed(faces: np.ndarray, n_vertices: int) -> bool:
     key_sorted = np.sort(key)
     if (key_sorted[1:] == key_sorted[:-1]).any():
         return False
-    pos = np.clip(np.searchsorted(key_sorted, rev), 0, len(key_sorted) - 1)
-    return bool((key_sorted[pos] == rev).all())
+    rev.sort()  # the directed edges are unique: every reverse is there iff both sets are equal
+    return bool(np.array_equal(key_sorted, rev))
 
 
 def extrude(mask: np.ndarray, height: float, method: str = "outline"):
