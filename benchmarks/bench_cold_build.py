@@ -29,13 +29,15 @@ def cold_build(checkout: Path, recipe: str, jobs: int, work: Path) -> dict:
         shutil.rmtree(d, ignore_errors=True)
     env = {**os.environ, "ROBOTKIT_CACHE": str(cache), "PYTHONPATH": str(checkout)}
     load0 = os.getloadavg()[0]
-    t0 = time.perf_counter()
-    p = subprocess.Popen([sys.executable, "-m", "robotkit", "build", str(checkout / recipe), "-j", str(jobs),
-                          "--out", str(out)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(p.pid, 0)
-    wall = time.perf_counter() - t0
-    if status != 0:
-        raise SystemExit(f"build failed in {checkout}: {p.stderr.read().decode()}")
+    with tempfile.TemporaryFile() as err:  # a file, not a pipe: a long stderr would block the build
+        t0 = time.perf_counter()
+        p = subprocess.Popen([sys.executable, "-m", "robotkit", "build", str(checkout / recipe), "-j", str(jobs),
+                              "--out", str(out)], env=env, stdout=subprocess.DEVNULL, stderr=err)
+        _, status, usage = os.wait4(p.pid, 0)
+        wall = time.perf_counter() - t0
+        if status != 0:
+            err.seek(0)
+            raise SystemExit(f"build failed in {checkout}: {err.read().decode()}")
     return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "load": (load0, os.getloadavg()[0])}
 
 
