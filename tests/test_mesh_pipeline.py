@@ -422,6 +422,21 @@ def test_coacd_gets_the_union_of_overlapping_bodies():
     assert fidelity(both, pieces)["proxy_volume"] == pytest.approx(3.0, rel=0.02)  # the union, tightly
 
 
+def test_coacd_input_above_the_face_limit_is_decimated_and_stays_closed():
+    from robotkit.mesh.decompose import coacd_input
+
+    torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=80, minor_sections=40)
+    V, F = np.asarray(torus.vertices), np.asarray(torus.faces)  # 6,400 faces
+    V2, F2, mode = coacd_input(V, F, "auto", input_faces=1000)
+    fewer = trimesh.Trimesh(V2, F2, process=False)
+    assert mode == "off" and 980 <= len(F2) <= 1000 and fewer.is_volume
+    assert fewer.volume == pytest.approx(torus.volume, rel=0.02)
+    V3, F3, _ = coacd_input(V, F, "auto", input_faces=0)  # 0: never
+    assert len(F3) == len(F)
+    V4, F4, _ = coacd_input(V, F, "auto", input_faces=len(F))  # at the limit: as it is
+    assert len(F4) == len(F)
+
+
 def test_decompose_rejects_bad_parameters():
     box = trimesh.creation.box([1, 1, 1])
     with pytest.raises(ValueError, match="threshold"):
