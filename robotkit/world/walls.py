@@ -253,9 +253,21 @@ def _flip_flat(px, py, tris):
     if len(flat) == 0:
         return tris
     tris = tris.copy()
-    owner = {}
-    for t, (a, b, c) in enumerate(tris.tolist()):
-        owner[a, b] = owner[b, c] = owner[c, a] = t
+    # the triangle owning each directed edge: a sorted table of the edges as they are, and the
+    # flips' changes on top (a dict of every edge cost more than the flips on a big map)
+    n_pts = len(px)
+    edges = tris[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+    keys = edges[:, 0] * n_pts + edges[:, 1]
+    order = np.argsort(keys, kind="stable")
+    table, table_owner = keys[order], order // 3
+    changed: dict[int, int | None] = {}
+
+    def owner(a, b):
+        k = a * n_pts + b
+        if k in changed:
+            return changed[k]
+        i = int(np.searchsorted(table, k, side="right")) - 1  # the last, as a dict filled in order
+        return int(table_owner[i]) if i >= 0 and table[i] == k else None
     xs, ys = px.tolist(), py.tolist()
 
     def is_flat(tri):
@@ -281,15 +293,15 @@ def _flip_flat(px, py, tris):
                 break
         else:
             return None
-        u = owner.get((b, a))
+        u = owner(b, a)
         if u is None:
             return None
         d = [v for v in tris[u].tolist() if v not in (a, b)][0]
         for e in ((a, b), (b, c), (c, a), (b, a), (a, d), (d, b)):
-            owner.pop(e, None)
+            changed[e[0] * n_pts + e[1]] = None
         tris[t], tris[u] = (c, a, d), (c, d, b)
-        owner[c, a] = owner[a, d] = owner[d, c] = t
-        owner[c, d] = owner[d, b] = owner[b, c] = u
+        for (e0, e1), x in (((c, a), t), ((a, d), t), ((d, c), t), ((c, d), u), ((d, b), u), ((b, c), u)):
+            changed[e0 * n_pts + e1] = x
         queue.extend(x for x in (t, u) if is_flat(tris[x].tolist()))
     return tris if (_cross(px, py, tris) > 0).all() else None
 
