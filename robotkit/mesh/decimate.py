@@ -214,6 +214,8 @@ def _samples(mesh, count: int, seed: int) -> np.ndarray:
 
 def point_surface_distance(points, mesh, chunk: int = 4096) -> np.ndarray:
     """Exact distance from each point to the closest point of ``mesh``'s triangles."""
+    from itertools import chain
+
     from scipy.spatial import cKDTree
 
     P = np.asarray(points, dtype=np.float64).reshape(-1, 3)
@@ -246,7 +248,7 @@ def point_surface_distance(points, mesh, chunk: int = 4096) -> np.ndarray:
             if counts.sum() == 0:
                 continue
             pi = np.repeat(np.arange(a, a + len(idx)), counts)
-            fi = group[np.concatenate([np.asarray(i, dtype=np.int64) for i in idx if len(i)])]
+            fi = group[np.fromiter(chain.from_iterable(idx), dtype=np.int64, count=int(counts.sum()))]
             near = _box_closer(P, pi, lo[fi], hi[fi], best)
             best = np.minimum(best, _pair_min(P, tri, pi[near], fi[near], len(P)))
     return best
