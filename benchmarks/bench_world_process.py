@@ -40,37 +40,45 @@ def big_map(folder: Path, size: int) -> Path:
     return folder / "big.yaml"
 
 
-def run(map_yaml: Path, out: Path) -> tuple[float, float]:
+def run(map_yaml: Path, out: Path, checkout: Path = REPO) -> tuple[float, float, float]:
+    """(wall s, peak MB, CPU s) of one ``robotkit world`` process running ``checkout``'s code."""
     if out.exists():
         shutil.rmtree(out)
+    env = {**os.environ, "PYTHONPATH": str(checkout)}
     t0 = time.perf_counter()
     p = subprocess.Popen([str(ROBOTKIT), "world", str(map_yaml), "--out", str(out)],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
     _, status, usage = os.wait4(p.pid, 0)
     dt = time.perf_counter() - t0
     if status != 0:
         raise SystemExit(f"robotkit world {map_yaml} failed: {p.stderr.read().decode()}")
-    return dt, usage.ru_maxrss / 1024.0  # MB
+    return dt, usage.ru_maxrss / 1024.0, usage.ru_utime + usage.ru_stime  # MB
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--size", type=int, default=5000)
+    ap.add_argument("--checkout", type=Path, help="another robotkit checkout to time beside this one, interleaved")
     args = ap.parse_args()
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the start; median of {args.repeat}")
     with tempfile.TemporaryDirectory(prefix="bench_world.") as tmp:
         tmp = Path(tmp)
         maps = {"nav2 warehouse 1006 x 1674": WAREHOUSE, f"tiled {args.size} x {args.size}": big_map(tmp, args.size)}
-        times = {k: [] for k in maps}
-        mem = {k: 0.0 for k in maps}
+        checkouts = [("this", REPO)] + ([("other", args.checkout.resolve())] if args.checkout else [])
+        runs = [(k, c) for k in maps for c in checkouts]
+        times = {r: [] for r in runs}
+        cpu = {r: [] for r in runs}
+        mem = {r: 0.0 for r in runs}
         for _ in range(args.repeat):
-            for k, m in maps.items():
-                dt, mb = run(m, tmp / "out")
-                times[k].append(dt)
-                mem[k] = max(mem[k], mb)
-        for k in maps:
-            print(f"  {k:28} {statistics.median(times[k]):6.2f} s  peak {mem[k]:6.0f} MB")
+            for k, (name, checkout) in runs:
+                dt, mb, used = run(maps[k], tmp / "out", checkout)
+                times[k, (name, checkout)].append(dt)
+                cpu[k, (name, checkout)].append(used)
+                mem[k, (name, checkout)] = max(mem[k, (name, checkout)], mb)
+        for r in runs:
+            print(f"  {r[0]:28} {r[1][0]:5} {statistics.median(times[r]):6.2f} s  CPU "
+                  f"{statistics.median(cpu[r]):6.2f} s  peak {mem[r]:6.0f} MB")
     print(f"load average {os.getloadavg()[0]:.1f} at the end")
     return 0
 

@@ -297,13 +297,14 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
         op, args, make = "collision-hull/1", {"max_vertices": strategy["max_vertices"], "contain": False}, \
             (lambda: [convex_hull(mesh, strategy["max_vertices"])])
     else:
-        from robotkit.mesh.decompose import decompose
+        from robotkit.mesh.decompose import INPUT_FACES, decompose
 
         c = strategy["coacd"]
         args = dict(threshold=c["threshold"], max_hulls=c["max_hulls"], resolution=c["resolution"],
                     preprocess=c["preprocess"], preprocess_resolution=c["preprocess_resolution"], seed=c["seed"],
-                    max_hull_vertices=strategy["max_vertices"], mcts_iterations=c["mcts_iterations"])
-        op, make = "collision-coacd/1", (lambda: decompose(mesh, **args))
+                    max_hull_vertices=strategy["max_vertices"], mcts_iterations=c["mcts_iterations"],
+                    input_faces=INPUT_FACES)  # in the cache key: the effective parameters
+        op, make = "collision-coacd/2", (lambda: decompose(mesh, **args))  # /2: bodies joined (coacd_input)
     pieces, info = cache.get_or_compute(op, {**args, "fidelity_samples": 4000}, [mesh], with_report(make))
     return list(pieces) if isinstance(pieces, (list, tuple)) else [pieces], info["fidelity"]
 

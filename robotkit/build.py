@@ -38,37 +38,35 @@ class _Recorder:
     """A doit reporter that records instead of printing."""
 
     def __init__(self, result: BuildResult, echo=None, progress=None, on_done=None):
+        from robotkit.progress import Progress
+
         self.result = result
         self.echo = echo
         self.on_done = on_done  # called with (task name, ok) as each task ends or is up to date
-        self.progress = progress  # a stream for progress of long tasks (None: quiet)
-        self.started: dict[str, float] = {}
+        # the progress line on a terminal (robotkit.progress); quiet with echo or no stream
+        self.progress = Progress(None if echo else progress, slow=SLOW)
         self.failures = []
         self.runtime_errors: list[str] = []
 
     def initialize(self, tasks, selected_tasks):
-        pass
+        self.progress.total = len(tasks)
 
     def get_status(self, task):
         pass
 
     def execute_task(self, task):
-        import time
-
         if task.actions:
             self.result.ran.append(task.name)
-            self.started[task.name] = time.perf_counter()
             if self.echo:
                 self.echo(f"  {task.name}")
-            elif self.progress is not None and self.progress.isatty():
-                self.progress.write(f"\r\033[K  running {task.name}")
-                self.progress.flush()
+            self.progress.started(task.name)
 
     def add_failure(self, task, fail):
         from doit.exceptions import TaskFailed, UnmetDependency
 
         if self.on_done is not None:
             self.on_done(task.name, False)
+        self.progress.finished(task.name, ran=False)
         if isinstance(fail, UnmetDependency):
             return
         if isinstance(fail, TaskFailed):
@@ -78,22 +76,16 @@ class _Recorder:
             self.result.errors.append((task.name, fail.get_msg()))
 
     def add_success(self, task):
-        import time
-
         if self.on_done is not None:
             self.on_done(task.name, True)
-        start = self.started.pop(task.name, None)
-        if start is None or self.progress is None or not self.progress.isatty():
-            return  # quiet when not a terminal: logs and CI output stay deterministic
-        elapsed = time.perf_counter() - start
-        if elapsed >= SLOW:  # long tasks (CoACD, decimation) are named with their time
-            self.progress.write(f"\r\033[K  {task.name}: {elapsed:.1f} s\n")
-            self.progress.flush()
+        # long tasks (CoACD, decimation) are named with their time, on a terminal only
+        self.progress.finished(task.name, ran=bool(task.actions))
 
     def skip_uptodate(self, task):
         self.result.uptodate.append(task.name)
         if self.on_done is not None:
             self.on_done(task.name, True)
+        self.progress.finished(task.name, ran=False)
 
     def skip_ignore(self, task):
         pass
@@ -108,9 +100,7 @@ class _Recorder:
         pass
 
     def complete_run(self):
-        if self.progress is not None and self.progress.isatty():
-            self.progress.write("\r\033[K")
-            self.progress.flush()
+        self.progress.clear()  # before the caller prints warnings or errors
 
 
 def state_db(out_dir: Path) -> str:
@@ -194,7 +184,10 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     args = ["run"]
     if jobs > 1:
         args += ["-n", str(jobs), "-P", "process"]
-    rc = DoitMain(Loader(), config_filenames=()).run(args)
+    try:
+        rc = DoitMain(Loader(), config_filenames=()).run(args)
+    finally:
+        recorder.progress.clear()  # no progress line left behind, whatever happened
     if recorder.runtime_errors:
         result.errors.append(("doit", "\n".join(recorder.runtime_errors)))
     if result.failed and not keep_going:

@@ -104,22 +104,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             processed.setdefault(mesh.path, mesh)
             continue
         copies.setdefault(mesh.file_name, (mesh.source, []))[1].append(facts[key])
-    for rel, mesh in sorted(processed.items()):
-        target = str(root / "meshes" / rel)
-        mesh_outputs.append(target)
-        visual_report = str(state / "visual" / f"{mesh.key}.json")
-        tasks.append({
-            "name": f"{robot.name}:visual:{mesh.file_name}",
-            "doc": f"processed visual mesh {mesh.file_name}",
-            "actions": [(actions.process_visual, [mesh.source, list(mesh.scale), list(mesh.decimate), mesh.repair,
-                                                  where.get(mesh.key, {}), target, visual_report])],
-            "file_dep": [mesh.source, facts[mesh.key]],
-            "targets": [target, visual_report],
-            "uptodate": [config_changed({"scale": list(mesh.scale), "decimate": list(mesh.decimate),
-                                         "repair": mesh.repair, "version": actions.FACTS_VERSION})],
-            "clean": True,
-        })
-
+    # collision pieces before the other mesh work: CoACD is the longest, and doit -j N hands
+    # out tasks in list order, so the slow ones start first and the quick ones fill in around them
     proxies: dict[str, str] = {}
     for key, shape in robot.proxies().items():
         m = shape.mesh
@@ -138,6 +124,22 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                                          "version": actions.FACTS_VERSION})],
             "clean": True,
         })
+    for rel, mesh in sorted(processed.items()):
+        target = str(root / "meshes" / rel)
+        mesh_outputs.append(target)
+        visual_report = str(state / "visual" / f"{mesh.key}.json")
+        tasks.append({
+            "name": f"{robot.name}:visual:{mesh.file_name}",
+            "doc": f"processed visual mesh {mesh.file_name}",
+            "actions": [(actions.process_visual, [mesh.source, list(mesh.scale), list(mesh.decimate), mesh.repair,
+                                                  where.get(mesh.key, {}), target, visual_report])],
+            "file_dep": [mesh.source, facts[mesh.key]],
+            "targets": [target, visual_report],
+            "uptodate": [config_changed({"scale": list(mesh.scale), "decimate": list(mesh.decimate),
+                                         "repair": mesh.repair, "version": actions.FACTS_VERSION})],
+            "clean": True,
+        })
+
     from robotkit.mesh.io import companions
 
     extras: dict[str, str] = {}  # textures and material files the copied meshes reference

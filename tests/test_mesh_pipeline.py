@@ -396,6 +396,47 @@ def test_decompose_l_shape(capfd):
     assert max(len(p.vertices) for p in tight) <= 8
 
 
+def test_coacd_gets_the_union_of_overlapping_bodies():
+    from robotkit.mesh.decompose import coacd_input
+
+    a = trimesh.creation.box([2.0, 1.0, 1.0])
+    b = trimesh.creation.box([1.0, 1.0, 2.0])
+    b.apply_translation([0.5, 0.0, 0.5])
+    both = trimesh.util.concatenate([a, b])  # closed, but its surfaces cross each other
+    V, F, mode = coacd_input(np.asarray(both.vertices), np.asarray(both.faces), "auto")
+    union = trimesh.Trimesh(V, F, process=False)
+    assert mode == "off" and F.dtype == np.int32
+    assert union.is_volume and len(union.split(only_watertight=False)) == 1
+    assert union.volume == pytest.approx(2.0 + 2.0 - 1.0, rel=1e-12)  # the 1 x 1 x 1 overlap counted once
+    for mode in ("on", "off"):  # the mesh as given
+        V2, F2, got = coacd_input(np.asarray(both.vertices), np.asarray(both.faces), mode)
+        assert got == mode and V2 is not None and np.array_equal(F2, both.faces)
+    open_box = a.copy()
+    open_box.update_faces(np.arange(len(a.faces)) > 0)
+    V3, F3, got = coacd_input(np.asarray(open_box.vertices), np.asarray(open_box.faces), "auto")
+    assert got == "auto" and np.array_equal(F3, open_box.faces)  # not a volume: CoACD's own remeshing
+    pieces = decompose(both, max_hull_vertices=16)
+    again = decompose(both, max_hull_vertices=16)
+    assert [p.vertices.tobytes() for p in again] == [p.vertices.tobytes() for p in pieces]
+    assert all(p.is_volume and p.is_convex and len(p.vertices) <= 16 for p in pieces)
+    assert fidelity(both, pieces)["proxy_volume"] == pytest.approx(3.0, rel=0.02)  # the union, tightly
+
+
+def test_coacd_input_above_the_face_limit_is_decimated_and_stays_closed():
+    from robotkit.mesh.decompose import coacd_input
+
+    torus = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=80, minor_sections=40)
+    V, F = np.asarray(torus.vertices), np.asarray(torus.faces)  # 6,400 faces
+    V2, F2, mode = coacd_input(V, F, "auto", input_faces=1000)
+    fewer = trimesh.Trimesh(V2, F2, process=False)
+    assert mode == "off" and 980 <= len(F2) <= 1000 and fewer.is_volume
+    assert fewer.volume == pytest.approx(torus.volume, rel=0.02)
+    V3, F3, _ = coacd_input(V, F, "auto", input_faces=0)  # 0: never
+    assert len(F3) == len(F)
+    V4, F4, _ = coacd_input(V, F, "auto", input_faces=len(F))  # at the limit: as it is
+    assert len(F4) == len(F)
+
+
 def test_decompose_rejects_bad_parameters():
     box = trimesh.creation.box([1, 1, 1])
     with pytest.raises(ValueError, match="threshold"):

@@ -50,9 +50,15 @@ def test_ur5_collision_pieces_are_closed_convex_and_cached(tmp_path):
     assert tree_bytes(out2) == tree_bytes(out1)
     data = report(out1, "ur5")
     assert len(data["collision"]) == 7
-    for entry in data["collision"].values():
-        f = entry["fidelity"]
-        assert f["pieces"] >= 1 and 0.9 < f["volume_ratio"] < 1.5
+    fids = [entry["fidelity"] for entry in data["collision"].values()]
+    for f in fids:
+        assert f["pieces"] >= 1 and 1 <= f["volume_ratio"]
+    # the recipe's fidelity target (benchmarks/bench_coacd.py): no worse than the slower settings
+    # before it (threshold 0.08, 40 iterations, CoACD's voxel remeshing of the overlapping bodies)
+    assert max(f["distance_relative"] for f in fids) <= 0.1962
+    assert max(f["volume_ratio"] for f in fids) <= 1.1997
+    assert sum(f["volume_ratio"] for f in fids) / 7 <= 1.0880
+    assert sum(f["distance"]["mean"] for f in fids) / 7 <= 3.38e-3
     check_urdf(out1 / "ur5" / "urdf" / "ur5.urdf")
     ign_sdf_check(out1 / "ur5" / "model.sdf")
     mujoco().MjModel.from_xml_path(str(out1 / "ur5" / "mjcf" / "scene.xml"))

@@ -469,6 +469,11 @@ def test_missing_image(tmp_path, monkeypatch):
     (b"", "cannot read 'bad.pgm': the file is empty"),
     (b"P5\n10 8\n255\n" + bytes(30), "cannot read 'bad.pgm': the pixel data is truncated "
                                      "(its header announces 10 x 8 pixels)"),
+    # a header announcing 400 million pixels: refused before decoding (not Pillow's DecompressionBombError)
+    (b"P5\n20000 20000\n255\n" + bytes(64), "'bad.pgm' is 20000 x 20000 pixels, more than robotkit reads "
+                                            "(100,000,000 pixels; crop or downsample the map)"),
+    (b"P5\n10001 10000\n255\n" + bytes(64), "'bad.pgm' is 10001 x 10000 pixels, more than robotkit reads "
+                                            "(100,000,000 pixels; crop or downsample the map)"),
 ])
 def test_unreadable_image(tmp_path, monkeypatch, content, message):
     monkeypatch.chdir(tmp_path)
@@ -581,6 +586,16 @@ def test_cli_bad_map_exits_2_with_one_line(tmp_path):
     assert not (tmp_path / "OUT").exists()
 
 
+def test_cli_too_large_map_exits_2_with_one_line(tmp_path):
+    path = write_map(tmp_path / "maps", None, name="x", image="huge.pgm")
+    (tmp_path / "maps" / "huge.pgm").write_bytes(b"P5\n20000 20000\n255\n" + bytes(64))
+    proc = run_cli("world", path, "--out", tmp_path / "OUT", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == ["maps/x.yaml:1: image: 'huge.pgm' is 20000 x 20000 pixels, more than "
+                                        "robotkit reads (100,000,000 pixels; crop or downsample the map)"]
+    assert not (tmp_path / "OUT").exists()
+
+
 def test_importing_the_package_stays_light():
     code = "import sys, robotkit.world; print(sorted(m for m in ('numpy', 'PIL', 'trimesh') if m in sys.modules))"
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
@@ -594,3 +609,35 @@ def test_building_a_world_does_not_import_trimesh(tmp_path):
             "print(sorted(m for m in ('trimesh', 'scipy') if m in sys.modules))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO)
     assert proc.stdout.strip() == "[]", proc.stderr
+
+
+def test_cycles_of_a_permutation_in_walking_order():
+    from robotkit.world.walls import _cycles
+
+    rng = np.random.default_rng(3)
+    succ = rng.permutation(2000)
+    seen, walk, sizes = set(), [], []
+    for s in range(len(succ)):  # the plain walk: from each unvisited index, follow succ
+        size = 0
+        while s not in seen:
+            seen.add(s)
+            walk.append(s)
+            s = int(succ[s])
+            size += 1
+        if size:
+            sizes.append(size)
+    order, got = _cycles(succ)
+    assert order.tolist() == walk and got.tolist() == sizes
+
+
+def test_closed_check_of_the_wall_mesh():
+    from robotkit.world.walls import _closed
+
+    box = trimesh.creation.box([1, 1, 1])
+    faces = np.asarray(box.faces)
+    assert _closed(faces, len(box.vertices))
+    assert not _closed(faces[1:], len(box.vertices))  # a hole
+    assert not _closed(np.concatenate([faces, faces[:1]]), len(box.vertices))  # a face twice
+    flipped = faces.copy()
+    flipped[0] = flipped[0, ::-1]
+    assert not _closed(flipped, len(box.vertices))  # one face the wrong way round

@@ -214,6 +214,8 @@ def _samples(mesh, count: int, seed: int) -> np.ndarray:
 
 def point_surface_distance(points, mesh, chunk: int = 4096) -> np.ndarray:
     """Exact distance from each point to the closest point of ``mesh``'s triangles."""
+    from itertools import chain
+
     from scipy.spatial import cKDTree
 
     P = np.asarray(points, dtype=np.float64).reshape(-1, 3)
@@ -222,6 +224,7 @@ def point_surface_distance(points, mesh, chunk: int = 4096) -> np.ndarray:
         raise ValueError("distance to an empty mesh")
     cen = tri.mean(axis=1)
     rad = np.linalg.norm(tri - cen[:, None, :], axis=2).max(axis=1)
+    lo, hi = tri.min(axis=1), tri.max(axis=1)
     # upper bound: exact distance to the faces of the nearest few centroids
     k = min(8, len(tri))
     nn = cKDTree(cen).query(P, k=k)[1].reshape(len(P), k)
@@ -234,8 +237,9 @@ def point_surface_distance(points, mesh, chunk: int = 4096) -> np.ndarray:
         group = np.nonzero(level == lv)[0]
         r_max = float(rad[group].max()) * (1 + 1e-9) + 1e-15
         if len(group) <= 64:
-            pi = np.repeat(np.arange(len(P)), len(group))
-            best = np.minimum(best, _pair_min(P, tri, pi, np.tile(group, len(P)), len(P)))
+            pi, fi = np.repeat(np.arange(len(P)), len(group)), np.tile(group, len(P))
+            near = _box_closer(P, pi, lo[fi], hi[fi], best)
+            best = np.minimum(best, _pair_min(P, tri, pi[near], fi[near], len(P)))
             continue
         tree = cKDTree(cen[group])
         for a in range(0, len(P), chunk):
@@ -244,9 +248,21 @@ def point_surface_distance(points, mesh, chunk: int = 4096) -> np.ndarray:
             if counts.sum() == 0:
                 continue
             pi = np.repeat(np.arange(a, a + len(idx)), counts)
-            fi = group[np.concatenate([np.asarray(i, dtype=np.int64) for i in idx if len(i)])]
-            best = np.minimum(best, _pair_min(P, tri, pi, fi, len(P)))
+            fi = group[np.fromiter(chain.from_iterable(idx), dtype=np.int64, count=int(counts.sum()))]
+            near = _box_closer(P, pi, lo[fi], hi[fi], best)
+            best = np.minimum(best, _pair_min(P, tri, pi[near], fi[near], len(P)))
     return best
+
+
+def _box_closer(P, pi, lo, hi, best) -> np.ndarray:
+    """The pairs (point pi, triangle with bounding box lo..hi) whose box is closer than the
+    point's best distance so far: only those can lower it (a triangle is never closer than
+    its box), so the exact distance is computed for them alone and the result is the same."""
+    p = P[pi]
+    far = np.maximum(lo - p, 0.0)
+    far += np.maximum(p - hi, 0.0)
+    bound = best[pi]
+    return np.einsum("ij,ij->i", far, far) <= bound * bound * (1 + 1e-9)  # margin: rounding never prunes a tie
 
 
 def _pair_min(P, tri, pi, fi, n, block: int = 1 << 18) -> np.ndarray:

@@ -20,7 +20,10 @@ Run time depends on the shape more than on the face count: 0.4 s for the
 and 3 pieces for the UR5 forearm (21k faces), 74 s and 32 pieces for the UR5
 wrist3 (1.7k faces), 209 s and 184 pieces for the TurtleBot3 LDS (13k faces)
 on 2 cores.  Limit ``max_hulls``, raise ``threshold`` for detailed parts, and
-cache the result (:mod:`robotkit.mesh.cache`).
+cache the result (:mod:`robotkit.mesh.cache`).  A closed mesh made of
+overlapping bodies is decomposed as the union of its bodies, without CoACD's
+voxel remeshing (:func:`coacd_input`): 3-5 times faster on the UR5's parts,
+with pieces as close or closer (docs/performance.md).
 """
 
 from __future__ import annotations
@@ -29,29 +32,33 @@ import numpy as np
 import trimesh
 
 PREPROCESS = ("auto", "on", "off")
+INPUT_FACES = 20_000  # ``auto``: a larger closed input is decimated to this many faces for CoACD
 
 
 def decompose(mesh, threshold: float = 0.05, max_hulls: int = -1, resolution: int = 2000,
               preprocess: str = "auto", preprocess_resolution: int = 50, seed: int = 0,
               max_hull_vertices: int | None = None, *, mcts_iterations: int = 150, mcts_nodes: int = 20,
-              mcts_max_depth: int = 3) -> list[trimesh.Trimesh]:
+              mcts_max_depth: int = 3, input_faces: int = INPUT_FACES) -> list[trimesh.Trimesh]:
     """Split ``mesh`` into convex pieces with CoACD.
 
     ``threshold``: CoACD's concavity threshold (0.01-1, smaller = more, finer
     pieces); ``max_hulls``: upper bound on the number of pieces (-1: none);
     ``resolution``: CoACD's sampling resolution; ``preprocess``: ``auto``
-    (remesh only when the input is not a 2-manifold), ``on`` or ``off``;
+    (a closed mesh: the union of its bodies, no remeshing; otherwise CoACD's
+    remesh when the input is not a 2-manifold; see :func:`coacd_input`), ``on`` or ``off``;
     ``preprocess_resolution``: voxel resolution of that remeshing; ``seed``:
     CoACD's random seed; ``max_hull_vertices``: vertex budget per piece (>= 4);
     ``mcts_iterations``, ``mcts_nodes``, ``mcts_max_depth``: CoACD's cutting-plane
     search (fewer iterations = faster, coarser; scikit-robot's "balanced" preset
-    uses threshold 0.2, at most 6 hulls and 30 iterations).
+    uses threshold 0.2, at most 6 hulls and 30 iterations).  ``input_faces``: with
+    ``preprocess='auto'``, a closed input of more faces is decimated to this many
+    first (:func:`coacd_input`; 0: never).
 
     Raises ValueError for invalid parameters or an empty or flat mesh, and
     RuntimeError when CoACD fails or returns nothing usable.
     """
     _check(threshold, max_hulls, resolution, preprocess, preprocess_resolution, seed, max_hull_vertices,
-           mcts_iterations, mcts_nodes, mcts_max_depth)
+           mcts_iterations, mcts_nodes, mcts_max_depth, input_faces)
     V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
     F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
     if len(F) == 0:
@@ -64,12 +71,13 @@ def decompose(mesh, threshold: float = 0.05, max_hulls: int = -1, resolution: in
 
     import coacd
 
+    V, F, mode = coacd_input(V, F, preprocess, input_faces)
     coacd.set_log_level("off")
     budget = int(max_hull_vertices) if max_hull_vertices is not None else None
     try:
         parts = coacd.run_coacd(
             coacd.Mesh(V, F), threshold=float(threshold), max_convex_hull=int(max_hulls),
-            preprocess_mode=preprocess, preprocess_resolution=int(preprocess_resolution),
+            preprocess_mode=mode, preprocess_resolution=int(preprocess_resolution),
             resolution=int(resolution), seed=int(seed), decimate=False, mcts_iterations=int(mcts_iterations),
             mcts_nodes=int(mcts_nodes), mcts_max_depth=int(mcts_max_depth))
     except Exception as exc:  # the ctypes wrapper raises plain exceptions or asserts
@@ -93,8 +101,50 @@ def decompose(mesh, threshold: float = 0.05, max_hulls: int = -1, resolution: in
     return [pieces[i] for i in order]
 
 
+def coacd_input(V: np.ndarray, F: np.ndarray, preprocess: str,
+                input_faces: int = INPUT_FACES) -> tuple[np.ndarray, np.ndarray, str]:
+    """The mesh CoACD gets and its ``preprocess_mode``: (vertices, faces, mode).
+
+    ``auto``: a closed mesh whose bodies overlap (CAD exports often are several
+    closed bodies pushed into each other) is replaced by the union of its bodies
+    (manifold3d's exact boolean union, float64), and CoACD runs with its
+    preprocessing off.  CoACD's own ``auto`` finds such a mesh "not manifold"
+    (its triangles intersect) and remeshes it on a voxel grid: the UR5's
+    500-1,200-face collision parts became 64,000-104,000 triangles, which made
+    CoACD 3-5 times slower and the pieces no closer (docs/performance.md).  A
+    mesh manifold3d does not take as a closed volume keeps CoACD's ``auto``.
+    CoACD's time grows with the faces it cuts (a 100,000-face torus: 15 s; decimated to
+    20,000 faces: 4.4 s, 1 % more volume), so a union of more than ``input_faces`` faces
+    is decimated to that many first (MeshLib, :func:`robotkit.mesh.decimate.decimate`;
+    kept only if it is still a closed volume).
+    ``on`` and ``off`` pass the mesh unchanged with CoACD's meaning.
+    """
+    if preprocess != "auto":
+        return V, F, preprocess
+    import manifold3d as m3
+
+    whole = m3.Manifold(m3.Mesh64(vert_properties=np.array(V, dtype=np.float64), tri_verts=np.array(F, dtype=np.uint64)))
+    if whole.status() != m3.Error.NoError or whole.is_empty():
+        return V, F, "auto"
+    bodies = whole.decompose()
+    union = m3.Manifold.batch_boolean(bodies, m3.OpType.Add) if len(bodies) > 1 else whole
+    if union.status() != m3.Error.NoError or union.is_empty():
+        return V, F, "auto"
+    mesh = union.to_mesh64()
+    V = np.ascontiguousarray(np.asarray(mesh.vert_properties)[:, :3], dtype=np.float64)
+    F = np.ascontiguousarray(mesh.tri_verts, dtype=np.int32)
+    if input_faces and len(F) > input_faces:
+        from robotkit.mesh.decimate import closed_volume, decimate
+
+        fewer, _ = decimate(trimesh.Trimesh(V, F, process=False), target_faces=int(input_faces), samples=0)
+        if closed_volume(fewer) is not None:
+            V = np.ascontiguousarray(fewer.vertices, dtype=np.float64)
+            F = np.ascontiguousarray(fewer.faces, dtype=np.int32)
+    return V, F, "off"
+
+
 def _check(threshold, max_hulls, resolution, preprocess, preprocess_resolution, seed, max_hull_vertices,
-           mcts_iterations=150, mcts_nodes=20, mcts_max_depth=3):
+           mcts_iterations=150, mcts_nodes=20, mcts_max_depth=3, input_faces=INPUT_FACES):
     def whole(name, v, low):
         if isinstance(v, bool) or not float(v).is_integer() or int(v) < low:
             raise ValueError(f"{name} must be a whole number >= {low}, got {v!r}")
@@ -113,3 +163,4 @@ def _check(threshold, max_hulls, resolution, preprocess, preprocess_resolution, 
     whole("mcts_iterations", mcts_iterations, 1)
     whole("mcts_nodes", mcts_nodes, 1)
     whole("mcts_max_depth", mcts_max_depth, 1)
+    whole("input_faces", input_faces, 0)

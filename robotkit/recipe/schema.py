@@ -143,7 +143,7 @@ class Coacd(Strict):
     resolution: Annotated[int, Field(gt=0)] = 2000
     """Surface sampling resolution."""
     preprocess: Literal["auto", "on", "off"] = "auto"
-    """Remesh the input into a manifold first (auto: only when it is not one)."""
+    """``auto``: a closed mesh goes to CoACD as the union of its bodies (exact, no remeshing; above 20,000 faces decimated to 20,000 first), any other mesh is remeshed into a manifold when it is not one; ``on``: always remesh; ``off``: the mesh as it is."""
     preprocess_resolution: Annotated[int, Field(gt=0)] = 50
     """Voxel resolution of that remeshing."""
     seed: int = 0

@@ -27,8 +27,10 @@ _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 
 @dataclass(frozen=True)
 class Box:
-    pos: tuple[float, float, float]
-    size: tuple[float, float, float]  # half sizes, as MuJoCo wants them
+    """One collision box as the MJCF attributes read: three numbers each, as text."""
+
+    pos: str
+    size: str  # half sizes, as MuJoCo wants them
 
 
 @dataclass(frozen=True)
@@ -72,10 +74,21 @@ def world_context(name: str, occupancy_map, height: float, rects) -> WorldContex
     centre = (float(round((cx.max() + cx.min()) / 2, 3)), float(round((cy.max() + cy.min()) / 2, 3)))
     # in the grid frame (the map origin and yaw go on the enclosing frame); rounded to the
     # nanometre so that 0.03 * 513 / 2 reads 7.695, not 7.694999999999999
-    nm = lambda v: round(v, 9) + 0.0  # noqa: E731 (+ 0.0: no -0)
+    # Each number is res * k / 2 for a whole k, so it is formatted once per k (a big map has
+    # 10^5 boxes and a few thousand distinct k).
+    from robotkit.emit.env import fmt
+
+    text: dict[int, str] = {}
+
+    def num(k: int) -> str:
+        t = text.get(k)
+        if t is None:
+            t = text[k] = fmt(round(res * k / 2, 9) + 0.0)  # + 0.0: no -0
+        return t
+
+    z = fmt(round(height / 2, 9) + 0.0)
     boxes = tuple(
-        Box(pos=(nm(res * (x0 + x1) / 2), nm(res * (y0 + y1) / 2), nm(height / 2)),
-            size=(nm(res * (x1 - x0) / 2), nm(res * (y1 - y0) / 2), nm(height / 2)))
+        Box(pos=f"{num(x0 + x1)} {num(y0 + y1)} {z}", size=f"{num(x1 - x0)} {num(y1 - y0)} {z}")
         for x0, y0, x1, y1 in rects.tolist()
     )
     stem = Path(om.yaml_path).name

@@ -41,6 +41,7 @@ MODES = ("trinary", "scale", "raw")
 REQUIRED = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh")
 
 OCCUPIED, FREE, UNKNOWN = 100, 0, -1
+MAX_CELLS = 100_000_000  # largest image read (10,000 x 10,000): checked from the header, before decoding
 IMAGE_SUFFIXES = (".pgm", ".png", ".bmp", ".ppm", ".pbm", ".jpg", ".jpeg", ".gif", ".tif", ".tiff")
 
 
@@ -314,15 +315,25 @@ def _read_image(path: Path, name: str, bad) -> tuple[np.ndarray, np.ndarray | No
         if path.stat().st_size == 0:
             bad(f"cannot read '{name}': the file is empty")
             return None
-        with Image.open(path) as im:
+        with _open_header(Image, path) as im:
             size = im.size
+            if size[0] * size[1] > MAX_CELLS:
+                bad(f"'{name}' is {size[0]} x {size[1]} pixels, more than robotkit reads "
+                    f"({MAX_CELLS:,} pixels; crop or downsample the map)")
+                return None
             im.load()
             mode = im.mode
+            if mode == "L":  # 8-bit grey, nearly every map: the bytes as they are (classify's table)
+                colours = np.asarray(im)[..., None]
+                alpha = None
+                mode = ""
             if mode in ("1", "P", "PA", "CMYK", "YCbCr", "LAB", "HSV", "La", "RGBa", "RGBX"):
                 has_alpha = mode in ("PA", "La", "RGBa") or "transparency" in im.info
                 im = im.convert("RGBA" if has_alpha else ("L" if mode == "1" else "RGB"))
                 mode = im.mode
-            if mode.startswith("I;16") or mode == "I":
+            if not mode:
+                pass
+            elif mode.startswith("I;16") or mode == "I":
                 colours = np.asarray(im, dtype=np.float64)[..., None] / 65535.0
                 alpha = None
             elif mode == "F":
@@ -353,6 +364,21 @@ def _read_image(path: Path, name: str, bad) -> tuple[np.ndarray, np.ndarray | No
     return colours, alpha
 
 
+def _open_header(Image, path: Path):
+    """``Image.open`` (which reads the header only) without Pillow's decompression-bomb check:
+    the size is checked against :data:`MAX_CELLS` before decoding, into one clean problem."""
+    import warnings
+
+    limit = Image.MAX_IMAGE_PIXELS
+    Image.MAX_IMAGE_PIXELS = None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            return Image.open(path)
+    finally:
+        Image.MAX_IMAGE_PIXELS = limit
+
+
 def _did_you_mean(path: Path) -> str:
     """``; did you mean 'x.pgm'?`` naming the closest image file in the same folder, if any."""
     import difflib
@@ -366,8 +392,18 @@ def _did_you_mean(path: Path) -> str:
 
 
 def classify(pixels, *, mode: str, negate: bool, occupied_thresh: float, free_thresh: float) -> np.ndarray:
-    """nav2 map_io: pixels -> OccupancyGrid values (int8, image order)."""
+    """nav2 map_io: pixels -> OccupancyGrid values (int8, image order).
+
+    8-bit single-channel pixels without alpha (``uint8``) go through a table of the 256
+    values, made by this same function on the 256 shades as floats: the same result, one
+    byte per cell instead of several float64 arrays.
+    """
     colours, alpha = pixels
+    if colours.dtype == np.uint8 and colours.shape[-1] == 1 and alpha is None:
+        shades = (np.arange(256, dtype=np.float64) / 255.0).reshape(256, 1, 1)
+        table = classify((shades, None), mode=mode, negate=negate, occupied_thresh=occupied_thresh,
+                         free_thresh=free_thresh).reshape(256)
+        return table[colours[..., 0]]
     channels = colours.shape[-1]
     rgb_mean = colours.mean(axis=-1) if channels > 1 else colours[..., 0]
     if mode == "raw":

@@ -36,14 +36,26 @@ def grid_mask(walls_image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(walls_image[::-1, :], dtype=bool)
 
 
-def _runs_merged(mask: np.ndarray) -> np.ndarray:
-    """Row runs of ``mask`` merged with identical runs in consecutive rows: (n, 4) [x0, y0, x1, y1]."""
+def _runs_merged(mask: np.ndarray, axis: int = 1) -> np.ndarray:
+    """Runs of ``mask`` along its rows (``axis`` 1) or columns (0), each merged with identical
+    runs in the next lines: (n, 4) [start, line0, end, line1 + 1] (for columns: y, x, not x, y).
+
+    The columns are read in place (a difference down the columns, then the few transitions
+    sorted), not from a transposed copy of the mask.
+    """
     rows, cols = mask.shape
-    pad = np.zeros((rows, cols + 2), dtype=np.int8)
-    pad[:, 1:-1] = mask
-    d = np.diff(pad, axis=1)
-    ys, xs = np.nonzero(d == 1)
-    _, xe = np.nonzero(d == -1)
+    if axis == 1:
+        pad = np.zeros((rows, cols + 2), dtype=np.int8)
+        pad[:, 1:-1] = mask
+        line, pos = np.nonzero(np.diff(pad, axis=1))  # row by row, left to right
+    else:
+        pad = np.zeros((rows + 2, cols), dtype=np.int8)
+        pad[1:-1] = mask
+        pos, line = np.nonzero(np.diff(pad, axis=0))
+        order = np.lexsort((pos, line))  # column by column, bottom to top
+        line, pos = line[order], pos[order]
+    # along a line a run starts (+1) and ends (-1) in turn
+    ys, xs, xe = line[0::2], pos[0::2], pos[1::2]
     order = np.lexsort((ys, xe, xs))
     xs, xe, ys = xs[order], xe[order], ys[order]
     new = np.ones(len(xs), dtype=bool)
@@ -60,30 +72,18 @@ def rectangles(mask: np.ndarray) -> np.ndarray:
     sorted by y0 then x0.
     """
     by_rows = _runs_merged(mask)
-    by_cols = _runs_merged(mask.T)[:, [1, 0, 3, 2]]
+    by_cols = _runs_merged(mask, axis=0)[:, [1, 0, 3, 2]]
     rects = by_rows if len(by_rows) <= len(by_cols) else by_cols
     return rects[np.lexsort((rects[:, 0], rects[:, 1]))]
 
 
-def _segments(types: np.ndarray, breaks: np.ndarray):
-    """Split each line of unit edges into segments between consecutive breaks.
-
-    ``types`` (lines, n): 0 no wall face, +1/-1 a face and its direction; ``breaks``
-    (lines, n + 1): the points where a segment must end.  Returns (line, start, end, type)
-    of every segment with a face.
-    """
-    n = types.shape[1]
-    flat = np.flatnonzero(breaks.ravel())
-    line, pos = np.divmod(flat, n + 1)
-    same = line[1:] == line[:-1]
-    line, start, end = line[:-1][same], pos[:-1][same], pos[1:][same]
-    kind = types[line, start]
-    keep = kind != 0
-    return line[keep], start[keep], end[keep], kind[keep]
-
-
 class _Grid:
-    """The padded wall mask and what the outline needs from it."""
+    """The padded wall mask and what the outline needs from it.
+
+    Only the points where the outline turns are kept (as coordinate lists), not whole
+    arrays per grid point: a 5000 x 5000 map has 25 million grid points and a few hundred
+    thousand turns.
+    """
 
     def __init__(self, mask: np.ndarray):
         self.mask = mask
@@ -92,35 +92,59 @@ class _Grid:
         g[1:-1, 1:-1] = mask
         self.g = g
         # the four cells around each grid point (y, x), shape (rows + 1, cols + 1)
-        sw, se, nw, ne = g[:-1, :-1] > 0, g[:-1, 1:] > 0, g[1:, :-1] > 0, g[1:, 1:] > 0
-        self.pinch_ne_sw = sw & ne & ~nw & ~se
-        self.pinch_nw_se = nw & se & ~sw & ~ne
-        self.pinch = self.pinch_ne_sw | self.pinch_nw_se
-        count = sw.astype(np.int8) + se + nw + ne
-        self.turns = (count == 1) | (count == 3) | self.pinch  # where the outline changes direction
-        self.pinch_y, self.pinch_x = np.nonzero(self.pinch)
-        self.pinch_index = np.full(self.pinch.shape, -1, dtype=np.int64)
-        self.pinch_index[self.pinch_y, self.pinch_x] = np.arange(len(self.pinch_x))
-        # unit edges: horizontal line y = j, +1 when the cell below is a wall and the one above is not;
-        # vertical line x = i, +1 when the cell on the left is a wall and the one on the right is not
-        self.th = g[:-1, 1:-1] - g[1:, 1:-1]
-        self.tv = (g[1:-1, :-1] - g[1:-1, 1:]).T
+        sw, se, nw, ne = g[:-1, :-1], g[:-1, 1:], g[1:, :-1], g[1:, 1:]
+        count = sw + se
+        count += nw
+        count += ne
+        # the outline changes direction where one or three of the four cells are walls, and at
+        # a pinch: two walls touching at a corner (then sw == ne)
+        turns = (count & 1).astype(bool)
+        turns |= (count == 2) & (sw == ne)
+        self.turn_y, self.turn_x = np.nonzero(turns)  # row-major order
+        pinch = count[self.turn_y, self.turn_x] == 2
+        self.pinch_y, self.pinch_x = self.turn_y[pinch], self.turn_x[pinch]
+        self._pinch_keys = self.pinch_y * (self.cols + 1) + self.pinch_x  # sorted
+        self._pinch_ne_sw = sw[self.pinch_y, self.pinch_x] > 0  # else the north-west / south-east pinch
 
-    def outline(self, breaks: np.ndarray):
-        """Directed outline segments A -> B (the wall on the left), split at ``breaks`` (grid points).
+    def pinch_index(self, y: np.ndarray, x: np.ndarray, ne_sw: bool | None = None) -> np.ndarray:
+        """The index of the pinch at each grid point (y, x) (of that kind, unless None), -1 where there is none."""
+        keys = np.asarray(y, dtype=np.int64) * (self.cols + 1) + x
+        if len(self._pinch_keys) == 0:
+            return np.full(keys.shape, -1, dtype=np.int64)
+        pos = np.minimum(np.searchsorted(self._pinch_keys, keys), len(self._pinch_keys) - 1)
+        found = self._pinch_keys[pos] == keys
+        if ne_sw is not None:
+            found &= self._pinch_ne_sw[pos] == ne_sw
+        return np.where(found, pos, -1)
 
+    def outline(self, py: np.ndarray, px: np.ndarray):
+        """Directed outline segments A -> B (the wall on the left), split at the grid points (py, px).
+
+        The points must include every turn, once each, in row-major order.  Between two
+        consecutive points of a grid line, the unit edges all have the same wall face or none:
+        horizontal line y = j, +1 when the cell below is a wall and the one above is not;
+        vertical line x = i, +1 when the cell on the left is a wall and the one on the right is not.
         Returns ax, ay, bx, by, am, bm: am / bm is the pinch index when the wall face of this
         segment must split its vertical edge at A / B (see the module docstring), else -1.
         """
-        j, xa, xb, kind = _segments(self.th, breaks)
-        west = kind > 0
-        low = self.pinch_index[j, xa]  # a pinch at the segment's west end belongs to this segment's cell
+        g = self.g
+        same = py[1:] == py[:-1]
+        j, xa, xb = py[:-1][same], px[:-1][same], px[1:][same]
+        kind = g[j, xa + 1] - g[j + 1, xa + 1]
+        keep = kind != 0
+        j, xa, xb, west = j[keep], xa[keep], xb[keep], kind[keep] > 0
+        low = self.pinch_index(j, xa)  # a pinch at the segment's west end belongs to this segment's cell
         h = (np.where(west, xb, xa), j, np.where(west, xa, xb), j,
              np.where(west, -1, low), np.where(west, low, -1))
-        i, ya, yb, kind = _segments(self.tv, breaks.T)
-        north = kind > 0
-        low = np.where(self.pinch_ne_sw[ya, i], self.pinch_index[ya, i], -1)
-        high = np.where(self.pinch_nw_se[yb, i], self.pinch_index[yb, i], -1)
+        order = np.lexsort((py, px))
+        vy, vx = py[order], px[order]
+        same = vx[1:] == vx[:-1]
+        i, ya, yb = vx[:-1][same], vy[:-1][same], vy[1:][same]
+        kind = g[ya + 1, i] - g[ya + 1, i + 1]
+        keep = kind != 0
+        i, ya, yb, north = i[keep], ya[keep], yb[keep], kind[keep] > 0
+        low = self.pinch_index(ya, i, ne_sw=True)
+        high = self.pinch_index(yb, i, ne_sw=False)
         v = (i, np.where(north, ya, yb), i, np.where(north, yb, ya),
              np.where(north, low, high), np.where(north, high, low))
         return tuple(np.concatenate(p) for p in zip(h, v))
@@ -168,25 +192,10 @@ def _outline_caps(grid: _Grid, seg):
     succ = np.where(left >= 0, left, right)
     if (succ < 0).any():
         return None
-    # follow the successor permutation into loops
-    succ_list = succ.tolist()
-    seen = bytearray(n)
-    loops = []
-    for s in range(n):
-        if seen[s]:
-            continue
-        loop = []
-        while not seen[s]:
-            seen[s] = 1
-            loop.append(s)
-            s = succ_list[s]
-        loops.append(loop)
-    idx = np.fromiter((s for loop in loops for s in loop), dtype=np.int64, count=n)
-    polygons = []
-    for loop in loops:
-        pts = np.empty((len(loop), 2), dtype=np.float64)
-        pts[:, 0], pts[:, 1] = ax[loop], ay[loop]
-        polygons.append(pts)
+    idx, sizes = _cycles(succ)
+    pts = np.empty((n, 2), dtype=np.float64)
+    pts[:, 0], pts[:, 1] = ax[idx], ay[idx]
+    polygons = np.split(pts, np.cumsum(sizes)[:-1])
     try:
         tris = np.asarray(manifold3d.triangulate(polygons), dtype=np.int64).reshape(-1, 3)
     except Exception:  # noqa: BLE001 - any failure of the optional fast path falls back
@@ -194,6 +203,33 @@ def _outline_caps(grid: _Grid, seg):
     px, py = ax[idx], ay[idx]
     tris = _flip_flat(px, py, tris)
     return None if tris is None else (px, py, tris)
+
+
+def _cycles(succ: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The cycles of the permutation ``succ``: (every index in cycle order, the cycle sizes).
+
+    Cycles come in the order of their smallest index, each starting there and following
+    ``succ``: what walking from index 0 upwards and following each unvisited cycle gives,
+    computed by pointer doubling (log2(n) whole-array steps instead of a Python loop).
+    """
+    n = len(succ)
+    label = np.arange(n)
+    jump = succ.copy()
+    steps = max(int(n).bit_length(), 1)
+    for _ in range(steps):  # label: the smallest index of each cycle
+        np.minimum(label, label[jump], out=label)
+        jump = jump[jump]
+    start = label == np.arange(n)
+    # distance forward to the cycle's start, by list ranking with the start as the end
+    nxt = np.where(start, np.arange(n), succ)
+    dist = (~start).astype(np.int64)
+    for _ in range(steps):
+        dist += dist[nxt]
+        nxt = nxt[nxt]
+    size = np.bincount(label, minlength=n)
+    pos = (size[label] - dist) % size[label]  # the start 0, its successor 1, ...
+    order = np.lexsort((pos, label))
+    return order, size[start]
 
 
 def _cross(px, py, tris) -> np.ndarray:
@@ -217,9 +253,21 @@ def _flip_flat(px, py, tris):
     if len(flat) == 0:
         return tris
     tris = tris.copy()
-    owner = {}
-    for t, (a, b, c) in enumerate(tris.tolist()):
-        owner[a, b] = owner[b, c] = owner[c, a] = t
+    # the triangle owning each directed edge: a sorted table of the edges as they are, and the
+    # flips' changes on top (a dict of every edge cost more than the flips on a big map)
+    n_pts = len(px)
+    edges = tris[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+    keys = edges[:, 0] * n_pts + edges[:, 1]
+    order = np.argsort(keys, kind="stable")
+    table, table_owner = keys[order], order // 3
+    changed: dict[int, int | None] = {}
+
+    def owner(a, b):
+        k = a * n_pts + b
+        if k in changed:
+            return changed[k]
+        i = int(np.searchsorted(table, k, side="right")) - 1  # the last, as a dict filled in order
+        return int(table_owner[i]) if i >= 0 and table[i] == k else None
     xs, ys = px.tolist(), py.tolist()
 
     def is_flat(tri):
@@ -245,15 +293,15 @@ def _flip_flat(px, py, tris):
                 break
         else:
             return None
-        u = owner.get((b, a))
+        u = owner(b, a)
         if u is None:
             return None
         d = [v for v in tris[u].tolist() if v not in (a, b)][0]
         for e in ((a, b), (b, c), (c, a), (b, a), (a, d), (d, b)):
-            owner.pop(e, None)
+            changed[e[0] * n_pts + e[1]] = None
         tris[t], tris[u] = (c, a, d), (c, d, b)
-        owner[c, a] = owner[a, d] = owner[d, c] = t
-        owner[c, d] = owner[d, b] = owner[b, c] = u
+        for (e0, e1), x in (((c, a), t), ((a, d), t), ((d, c), t), ((c, d), u), ((d, b), u), ((b, c), u)):
+            changed[e0 * n_pts + e1] = x
         queue.extend(x for x in (t, u) if is_flat(tris[x].tolist()))
     return tris if (_cross(px, py, tris) > 0).all() else None
 
@@ -330,8 +378,8 @@ def _closed(faces: np.ndarray, n_vertices: int) -> bool:
     key_sorted = np.sort(key)
     if (key_sorted[1:] == key_sorted[:-1]).any():
         return False
-    pos = np.clip(np.searchsorted(key_sorted, rev), 0, len(key_sorted) - 1)
-    return bool((key_sorted[pos] == rev).all())
+    rev.sort()  # the directed edges are unique: every reverse is there iff both sets are equal
+    return bool(np.array_equal(key_sorted, rev))
 
 
 def extrude(mask: np.ndarray, height: float, method: str = "outline"):
@@ -352,7 +400,7 @@ def extrude(mask: np.ndarray, height: float, method: str = "outline"):
 
     for attempt in dict.fromkeys((method, "rectangles")):
         if attempt == "outline":
-            seg = grid.outline(grid.turns)
+            seg = grid.outline(grid.turn_y, grid.turn_x)
             caps = _outline_caps(grid, seg)
             if caps is None:
                 continue
@@ -360,7 +408,8 @@ def extrude(mask: np.ndarray, height: float, method: str = "outline"):
             centres = np.zeros((0, 2))
         else:
             corner, cx, cy, cap, centres = _rectangle_caps(grid, rectangles(mask))
-            seg = grid.outline(corner | grid.turns)
+            breaks = np.union1d(cy * width + cx, grid.turn_y * width + grid.turn_x)  # sorted: row-major
+            seg = grid.outline(*np.divmod(breaks, width))
         ax, ay, bx, by, am, bm = seg
         # vertices: grid points used (bottom, then top), centres (bottom, top), pinch splits
         keys, inverse = np.unique(np.concatenate([cy * width + cx, ay * width + ax, by * width + bx]),
