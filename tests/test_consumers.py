@@ -282,7 +282,7 @@ def test_check_names_the_1_kg_default_of_an_sdf_link(tmp_path):
     proc = run_cli("check", "m.sdf", cwd=tmp_path)
     assert proc.returncode == 1
     assert proc.stdout.splitlines() == [
-        "link 'a' (m.sdf)",
+        "link 'a' (m.sdf:2)",
         "  error: has no <inertial>: Gazebo and Drake give it a mass of 1 kg and a unit inertia [consumer]",
         "    hint: give it an <inertial>, or make a massless thing a <frame>",
         "m.sdf: 1 error, 0 warnings"]
