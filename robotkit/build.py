@@ -37,14 +37,16 @@ SLOW = 1.0  # seconds: tasks at least this long are reported with their time
 class _Recorder:
     """A doit reporter that records instead of printing."""
 
-    def __init__(self, result: BuildResult, echo=None, progress=None, on_done=None):
+    def __init__(self, result: BuildResult, echo=None, progress=None):
         from robotkit.progress import Progress
 
         self.result = result
         self.echo = echo
-        self.on_done = on_done  # called with (task name, ok) as each task ends or is up to date
         # the progress line on a terminal (robotkit.progress); quiet with echo or no stream
-        self.progress = Progress(None if echo else progress, slow=SLOW)
+        if isinstance(progress, Progress):  # a caller's own (robotkit catalogue: time left, CI log lines)
+            self.progress = progress
+        else:
+            self.progress = Progress(None if echo else progress, slow=SLOW)
         self.failures = []
         self.runtime_errors: list[str] = []
 
@@ -64,8 +66,6 @@ class _Recorder:
     def add_failure(self, task, fail):
         from doit.exceptions import TaskFailed, UnmetDependency
 
-        if self.on_done is not None:
-            self.on_done(task.name, False)
         self.progress.finished(task.name, ran=False)
         if isinstance(fail, UnmetDependency):
             return
@@ -76,15 +76,11 @@ class _Recorder:
             self.result.errors.append((task.name, fail.get_msg()))
 
     def add_success(self, task):
-        if self.on_done is not None:
-            self.on_done(task.name, True)
         # long tasks (CoACD, decimation) are named with their time, on a terminal only
         self.progress.finished(task.name, ran=bool(task.actions))
 
     def skip_uptodate(self, task):
         self.result.uptodate.append(task.name)
-        if self.on_done is not None:
-            self.on_done(task.name, True)
         self.progress.finished(task.name, ran=False)
 
     def skip_ignore(self, task):
@@ -131,16 +127,15 @@ def to_doit(task: dict) -> dict:
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
           echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None,
-          report: bool = False, args: dict[str, str] | None = None, keep_going: bool = False,
-          on_plan=None, on_done=None) -> BuildResult:
+          report: bool = False, args: dict[str, str] | None = None, keep_going: bool = False) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
     ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key; ``args`` sets recipe arguments (``--arg``).
     ``report`` also writes each robot's picture report (``<robot>/report/report.html``); the
     command line does unless ``--no-report``.
 
     ``keep_going`` returns the result with its ``failed`` tasks instead of raising, so that a
-    batch (``robotkit catalogue``) builds every robot it can; ``on_plan(n)`` is told how many
-    tasks the build has and ``on_done(task, ok)`` each one that ends.
+    batch (``robotkit catalogue``) builds every robot it can.  ``progress`` is a stream for the
+    progress line (:mod:`robotkit.progress`, terminals only) or a ``Progress`` of the caller's.
 
     The stamp of the no-op fast path (:mod:`robotkit.stamp`) is removed first and written
     again when the build succeeds; ``stamp_options`` are the options it is kept under
@@ -166,9 +161,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     for loaded, robot in robots:
         tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot), report=report))
     (out / ".robotkit").mkdir(parents=True, exist_ok=True)
-    recorder = _Recorder(result, echo, progress, on_done)
-    if on_plan is not None:
-        on_plan(len(tasks))
+    recorder = _Recorder(result, echo, progress)
     inputs = _input_stats(robots, tasks)  # before running: an edit during the build is a change
 
     class Loader(TaskLoader2):

@@ -8,7 +8,7 @@
     one build          robotkit.build over every recipe: the same doit tasks as any robot
                        (repair, mass properties, collision decomposition, URDF, SDF, MJCF),
                        incremental, -j / --scheduler for the mesh work, and a failing object
-                       never stops the others
+                       never stops the others; progress with the time left (robotkit.progress)
     index              OUT/catalogue.json and OUT/catalogue.csv: what was made, what failed and why
 
 A rerun builds only what is missing or changed (doit's record and the mesh cache); the
@@ -25,7 +25,6 @@ import math
 import os
 import re
 import sys
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -211,45 +210,6 @@ def _write_if_changed(path: Path, text: str) -> None:
     os.replace(tmp, path)
 
 
-class Progress:
-    """``done/total objects, time left`` while the build runs: rewritten in place on a terminal,
-    a line every ``every`` seconds otherwise (CI logs)."""
-
-    def __init__(self, total_tasks: int, stream=sys.stderr, every: float = 10.0):
-        self.total, self.done, self.stream, self.every = total_tasks, 0, stream, every
-        self.start = time.monotonic()
-        self.last = self.start
-        self.tty = hasattr(stream, "isatty") and stream.isatty()
-
-    def __call__(self, task: str, ok: bool) -> None:
-        self.done += 1
-        now = time.monotonic()
-        if not self.tty and now - self.last < self.every:
-            return
-        self.last = now
-        rate = (now - self.start) / max(self.done, 1)
-        left = rate * max(self.total - self.done, 0)
-        line = f"catalogue: {self.done}/{self.total} tasks, about {_duration(left)} left"
-        if self.tty:
-            self.stream.write(f"\r\033[K{line}")
-        else:
-            self.stream.write(line + "\n")
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.tty:
-            self.stream.write("\r\033[K")
-            self.stream.flush()
-
-
-def _duration(seconds: float) -> str:
-    if seconds < 90:
-        return f"{seconds:.0f} s"
-    if seconds < 5400:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
-
-
 def catalogue(source: str | os.PathLike, out_dir: str | os.PathLike, *, density: float = 1000.0,
               units: str | None = None, masses: str | os.PathLike | None = None, collision: str = "decompose",
               jobs: int = 1, progress=sys.stderr) -> "Result":
@@ -298,14 +258,12 @@ def catalogue(source: str | os.PathLike, out_dir: str | os.PathLike, *, density:
 
         roots = os.environ.get(paths.ROOT_ENV, "")
         os.environ[paths.ROOT_ENV] = os.pathsep.join(r for r in (roots, str(base.resolve())) if r)
-        bar = Progress(0, progress) if progress is not None else None
+        from robotkit.progress import Progress
+
+        bar = Progress(progress, slow=float("inf"), eta=True, log_every=10.0, label="catalogue ")
         try:
-            result = build(recipes, out, jobs=jobs, report=False, keep_going=True,
-                           on_plan=(lambda n: setattr(bar, "total", n)) if bar else None,
-                           on_done=bar)
+            result = build(recipes, out, jobs=jobs, report=False, keep_going=True, progress=bar)
         finally:
-            if bar is not None:
-                bar.close()
             if roots:
                 os.environ[paths.ROOT_ENV] = roots
             else:

@@ -8,7 +8,10 @@ minute of CoACD shows its clock moving.  It is cut to the terminal's width (a wr
 could not be erased).  Tasks that took at least ``slow`` seconds get a line of their own
 (``  ur5:collision:shoulder: 9.1 s``) above it.
 
-Quiet unless ``stream.isatty()``: logs, pipes and CI output carry no progress at all.
+Quiet unless ``stream.isatty()``: logs, pipes and CI output carry no progress at all,
+unless ``log_every`` asks for a plain line (no control characters) every so many seconds
+(a long batch, ``robotkit catalogue``, in a CI log).  ``eta`` adds an estimate of the time
+left from the pace so far.
 Every write holds one lock, and :meth:`Progress.clear` (called when the run ends, before
 the caller prints any warning or error) erases the line and stops the thread, so a
 progress line never ends up inside another line.
@@ -30,9 +33,13 @@ class Progress:
     """Progress of ``total`` tasks on ``stream`` (quiet when it is not a terminal)."""
 
     def __init__(self, stream, total: int = 0, *, interval: float = 1.0, slow: float = 1.0, clock=time.monotonic,
-                 width=None):
+                 width=None, eta: bool = False, log_every: float | None = None, label: str = ""):
         self.stream = stream
         self.active = stream is not None and bool(getattr(stream, "isatty", lambda: False)())
+        self.eta = eta
+        self.label = label
+        self.log_every = log_every if stream is not None and not self.active else None
+        self._logged = clock()
         self.total = total
         self.done = 0
         self.interval = interval
@@ -65,6 +72,9 @@ class Progress:
                 self._write(f"\r\033[K  {name}: {elapsed:.1f} s\n")
                 self._shown = False
             self._draw()
+            if self.log_every is not None and self.clock() - self._logged >= self.log_every:
+                self._logged = self.clock()
+                self._write(self.head().strip() + "\n")
         return elapsed
 
     def clear(self) -> None:
@@ -82,13 +92,21 @@ class Progress:
     def line(self) -> str:
         """The progress line (without control characters), cut to the width."""
         now = self.clock()
-        head = f"  [{self.done}/{self.total}] {_clock(now - self.start)}" if self.total else \
-            f"  {_clock(now - self.start)}"
+        head = self.head()
         tasks = ", ".join(f"{name} {int(now - t)} s" for name, t in self.running.items())
         text = f"{head}  {tasks}" if tasks else head
         width = self.width if self.width is not None else shutil.get_terminal_size((80, 24)).columns
         limit = max(width - 1, 10)  # the last column would wrap on some terminals
         return text if len(text) <= limit else text[:limit - 3] + "..."
+
+    def head(self) -> str:
+        """Tasks done, the clock and (with ``eta``) the time left."""
+        elapsed = self.clock() - self.start
+        head = f"  {self.label}[{self.done}/{self.total}] {_clock(elapsed)}" if self.total else \
+            f"  {self.label}{_clock(elapsed)}"
+        if self.eta and self.total and 0 < self.done < self.total:
+            head += f", about {_clock(elapsed / self.done * (self.total - self.done))} left"
+        return head
 
     def _draw(self) -> None:
         if self.active and not self._stop.is_set():

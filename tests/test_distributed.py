@@ -332,7 +332,7 @@ def test_catalogue_on_a_cluster_survives_a_killed_worker(tmp_path):
         assert killed is not None, "no worker was ever busy"
     assert proc.returncode == 1, stderr  # two broken meshes
     assert "5 objects made, 2 failed" in stdout
-    problems = [line for line in stderr.splitlines() if not line.startswith("catalogue: ")]  # progress lines
+    problems = [line for line in stderr.splitlines() if not line.startswith("catalogue [")]  # progress lines
     assert problems == ["broken.stl: mesh file 'broken.stl' holds no triangles",
                         "kitchen/empty.obj: mesh file 'empty.obj' holds no triangles"]
     index = json.loads((out / "catalogue.json").read_text())

@@ -120,3 +120,21 @@ def test_build_progress_on_a_terminal_only(tmp_path):
     head, tail = shown.rsplit("\r\033[K", 1)  # the line erased at the end, before the warnings
     assert "maintainer" in tail and "\033" not in tail and "\r" not in tail.replace("\r\n", "")
     assert "maintainer" not in head
+
+
+def test_time_left_and_plain_lines_for_logs():
+    """A batch's progress (robotkit catalogue): the time left from the pace so far, and off a
+    terminal a plain line every ``log_every`` seconds."""
+    now = [0.0]
+    out = io.StringIO()  # not a terminal
+    p = Progress(out, total=4, interval=0, clock=lambda: now[0], eta=True, log_every=10.0, label="catalogue ")
+    p.started("a")
+    now[0] = 5.0
+    p.finished("a")  # 5 s after the start: no line yet
+    assert out.getvalue() == ""
+    now[0] = 12.0
+    p.finished("b")
+    assert out.getvalue() == "catalogue [2/4] 0:12, about 0:12 left\n"
+    now[0] = 15.0
+    p.finished("c")  # within 10 s of the last line
+    assert out.getvalue().count("\n") == 1
