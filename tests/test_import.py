@@ -677,7 +677,7 @@ def test_untrusted_expressions_fail_clearly(tmp_path, monkeypatch, case):
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "evil.yaml", {}, {})
     lines = info.value.lines()
-    assert len(lines) == 1 and lines[0].startswith("evil.urdf.xacro: ")
+    assert len(lines) == 1 and lines[0].startswith("evil.urdf.xacro:3: ")
     if case != "getattr-string":  # python['vars'] is not there at all: xacro's own error
         assert "refusing to evaluate xacro expression" in lines[0], lines[0]
     assert not target.exists() and not (tmp_path / "evil.yaml").exists()
@@ -694,7 +694,7 @@ def test_untrusted_yaml_is_safe_loaded(tmp_path, monkeypatch):
     """)
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "y.yaml", {}, {})
-    assert info.value.lines()[0].startswith("y.urdf.xacro: xacro: ")
+    assert info.value.lines()[0].startswith("y.urdf.xacro:3: xacro: ")
     assert not (tmp_path / "PWNED").exists()
 
 
@@ -727,7 +727,7 @@ def test_missing_package_in_xacro(tmp_path, monkeypatch):
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "r.yaml", {}, {})
     assert info.value.lines() == [
-        "robot.urdf.xacro: package 'foo_description' not found; give --package-path foo_description=DIR"]
+        "robot.urdf.xacro:2: package 'foo_description' not found; give --package-path foo_description=DIR"]
     assert not (tmp_path / "r.yaml").exists()
 
 
@@ -738,7 +738,7 @@ def test_missing_package_in_an_included_file(tmp_path, monkeypatch, gripper_arm)
     with pytest.raises(RobotkitError) as info:
         import_file(top, tmp_path / "r.yaml", packages, ARM_ARGS)
     assert info.value.lines() == [
-        "src/gripper_arm_description/urdf/gripper_arm.urdf.xacro: package 'hand_description' not found; "
+        "src/gripper_arm_description/urdf/gripper_arm.urdf.xacro:9: package 'hand_description' not found; "
         "give --package-path hand_description=DIR"]
 
 
@@ -773,7 +773,7 @@ def test_missing_xacro_argument_and_bad_package_path(tmp_path, monkeypatch):
     """)
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "a.yaml", {}, {})
-    assert info.value.lines() == ["a.xacro: xacro argument 'link_name' is not set; give --arg link_name:=VALUE"]
+    assert info.value.lines() == ["a.xacro:2: xacro argument 'link_name' is not set; give --arg link_name:=VALUE"]
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "a.yaml", {"p": str(tmp_path / "nowhere")}, {"link_name": "b"})
     assert info.value.lines() == [f"--package-path p={tmp_path / 'nowhere'}: no such folder"]
