@@ -34,6 +34,8 @@ class ImportResult:
     """With ``recompute_inertials``: per link, the given and the recomputed inertial."""
     extras: list[str] = field(default_factory=list)
     """A label per element carried verbatim in ``urdf_extras``."""
+    repairs: dict[str, str] = field(default_factory=dict)
+    """Per link whose inertial the recipe changes from the original: what was wrong and what it does."""
 
 
 def is_xacro(path: Path, text: str) -> bool:
@@ -108,7 +110,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
                       + ("at the recipe's density" if density is not None else "keeping each link's given mass"))
     else:
         header.append("inertials as given in the original (explicit)")
-    text_out = dump_recipe(recipe, header)
+    text_out = dump_recipe(recipe, header, {"links": conv.repairs})
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text(text_out, encoding="utf-8")
@@ -119,7 +121,8 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         raise
     os.replace(tmp, out)
 
-    result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras))
+    result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
+                          repairs=dict(conv.repairs))
     if recompute_inertials:
         _report_recomputed(out, conv, result)
     return result

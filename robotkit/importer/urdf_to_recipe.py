@@ -29,6 +29,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from robotkit.model import inertia_policy
 from robotkit.errors import Problem, RobotkitError, display_path
 from robotkit.recipe.schema import NAME_RE, UNITS
 
@@ -56,6 +57,7 @@ class Converted:
     explicit: dict[str, dict] = field(default_factory=dict)  # link -> the given inertial
     extras: list[str] = field(default_factory=list)  # a short label per verbatim element
     invalid_inertias: set[str] = field(default_factory=set)  # links whose given inertia the build rejects
+    repairs: dict[str, str] = field(default_factory=dict)  # link -> what was wrong and what the recipe does
 
 
 def no_inertial_form():
@@ -299,15 +301,16 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         visuals, collisions, vis_materials = [], [], []
         for kind, items in (("visual", visuals), ("collision", collisions)):
             for i, g_el in enumerate(el.findall(kind)):
-                geom = _geometry(g_el, name, kind, len(items), resolver, problems, warnings, out)
-                if geom is None:
+                made = _geometry(g_el, name, kind, len(items), resolver, problems, warnings, out)
+                if made is None:
                     continue
-                if kind == "visual":
-                    mat = g_el.find("material")
-                    if mat is not None:
-                        geom["material"] = material_ref(mat, name)
-                        vis_materials.append(geom["material"])
-                items.append(geom)
+                for geom in made if isinstance(made, list) else [made]:
+                    if kind == "visual":
+                        mat = g_el.find("material")
+                        if mat is not None:
+                            geom["material"] = material_ref(mat, name)
+                            vis_materials.append(geom["material"])
+                    items.append(geom)
         for child in el:
             if _local(child.tag) not in ("visual", "collision", "inertial"):
                 warnings.append(f"link '{name}': <{_local(child.tag)}> is dropped (the recipe has no place for it)")
@@ -340,12 +343,14 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
                 if recompute_inertials:
                     warnings.append(f"link '{name}' has no geometry to compute an inertial from; "
                                     "its inertial is kept as given")
+                wrong = inertia_policy.defects(given["mass"], _tensor(given["inertia"]))
+                if wrong:
+                    fixed = inertia_policy.repair(given["mass"], _tensor(given["inertia"]), given["mass"])
+                    t = fixed.inertia
+                    given = dict(given, inertia={k: float(v) + 0.0 for k, v in {"ixx": t[0, 0], "ixy": t[0, 1], "ixz": t[0, 2],
+                                                 "iyy": t[1, 1], "iyz": t[1, 2], "izz": t[2, 2]}.items()})
+                    out.repairs[name] = (f"the original's {'; '.join(wrong)}: repaired ({'; '.join(fixed.changes)})")
                 link["inertial"] = _explicit_dict(given)
-                problem = _inertia_problem(given)
-                if problem:
-                    out.invalid_inertias.add(name)
-                    warnings.append(f"link '{name}': the given inertia {problem}; the build will reject it: "
-                                    "correct it in the recipe or import with --recompute-inertials")
         else:
             if given is not None and given["mass"] < 0:
                 problems.add(f"link '{name}': negative mass {given['mass']!r}")
@@ -414,6 +419,9 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
                         f"urdf_extras: {', '.join(out.extras)}")
 
     problems.raise_if_any()
+    _give_moving_links_mass(links, joints, out)
+    for link, why in out.repairs.items():
+        warnings.append(f"link '{link}': {why}")
     recipe: dict = {"robot": robot_name, "units": "m", "density": density if density is not None else 1000.0}
     if materials:
         recipe["materials"] = materials
@@ -462,11 +470,15 @@ def _geometry(el: ET.Element, link: str, kind: str, index: int, resolver: MeshRe
     what = f"link '{link}' {kind}"
     geometry = el.find("geometry")
     shapes = [c for c in geometry] if geometry is not None else []
-    if len(shapes) != 1:
-        problems.add(f"{what}: <geometry> must hold exactly one shape (found {len(shapes)})")
+    if not shapes:
+        problems.add(f"{what}: <geometry> holds no shape")
         return None
-    shape = shapes[0]
+    shape = shapes[0]  # urdfdom reads the first element and ignores the rest
     tag = _local(shape.tag)
+    if len(shapes) > 1:
+        rest = ", ".join(f"<{_local(c.tag)}>" for c in shapes[1:])
+        warnings.append(f"{what}: <geometry> holds more than one element; the first (<{tag}>) is used, as "
+                        f"urdfdom does, and {rest} ignored")
     geom: dict = {}
     if tag == "mesh":
         uri = (shape.get("filename") or "").strip()
@@ -517,6 +529,18 @@ def _geometry(el: ET.Element, link: str, kind: str, index: int, resolver: MeshRe
             warnings.append(f"{what}: sphere of radius {radius!r} has no volume; dropped")
             return None
         geom["sphere"] = {"radius": radius}
+    elif tag == "capsule":  # PyBullet's extension: a cylinder along z with hemispherical ends
+        radius = _float(shape.get("radius"), f"{what} capsule radius", problems)
+        length = _float(shape.get("length"), f"{what} capsule length", problems)
+        if radius is None or length is None:
+            return None
+        if radius <= 0 or length < 0:
+            warnings.append(f"{what}: capsule of radius {radius!r} and length {length!r} has no volume; dropped")
+            return None
+        xyz, rpy = _origin(el.find("origin"), what, problems)
+        warnings.append(f"{what}: <capsule> (PyBullet's, not in the URDF standard) is written as a cylinder "
+                        "and two spheres, the same solid")
+        return _capsule(radius, length, xyz, rpy)
     else:
         problems.add(f"{what}: <{tag}> geometry is not supported (use mesh, box, cylinder or sphere)")
         return None
@@ -524,6 +548,30 @@ def _geometry(el: ET.Element, link: str, kind: str, index: int, resolver: MeshRe
     if origin:
         geom["origin"] = origin
     return geom
+
+
+def _capsule(radius: float, length: float, xyz, rpy) -> list[dict]:
+    """A capsule (the cylinder's ``length`` between the centres of its end spheres) as shapes."""
+    import numpy as np
+
+    from robotkit.model.robot import rpy_matrix
+
+    axis = rpy_matrix(rpy) @ np.array([0.0, 0.0, length / 2])
+    out = []
+    if length > 0:
+        cyl: dict = {"cylinder": {"radius": radius, "length": length}}
+        origin = _origin_dict(xyz, rpy)
+        if origin:
+            cyl["origin"] = origin
+        out.append(cyl)
+    for sign in ((1.0, -1.0) if length > 0 else (1.0,)):
+        centre = [float(c + sign * a) + 0.0 for c, a in zip(xyz, axis)]
+        sph: dict = {"sphere": {"radius": radius}}
+        origin = _origin_dict(centre, (0.0, 0.0, 0.0))
+        if origin:
+            sph["origin"] = origin
+        out.append(sph)
+    return out
 
 
 def _same_shapes(visuals: list[dict], collisions: list[dict]) -> bool:
@@ -574,6 +622,68 @@ def _explicit_dict(given: dict) -> dict:
             inertia[k] = t[k]
     out["inertia"] = inertia
     return out
+
+
+def _has_mass(link: dict) -> bool:
+    spec = link.get("inertial")
+    return isinstance(spec, dict) or (spec is None and bool(link.get("visual")))
+
+
+def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
+    """A link the build refuses for having no mass (it moves, or it is a root whose children
+    all move: MuJoCo refuses it, Gazebo drops it) gets one: computed from its geometry at the
+    recipe's density, or a point mass when it has none.  Each is recorded in ``out.repairs``."""
+    moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
+    children: dict[str, list[dict]] = {}
+    for j in joints.values():
+        children.setdefault(j["parent"], []).append(j)
+
+    def body_mass(name: str) -> bool:
+        todo, seen = [name], set()
+        while todo:
+            n = todo.pop()
+            if n in seen or n not in links:
+                continue
+            seen.add(n)
+            if _has_mass(links[n]):
+                return True
+            todo += [j["child"] for j in children.get(n, []) if j["type"] == "fixed"]
+        return False
+
+    refused: dict[str, str] = {}
+    for jname, j in joints.items():
+        if j["type"] in moving and j["child"] in links and not body_mass(j["child"]):
+            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): MuJoCo "
+                                           "refuses a moving body without mass and Gazebo drops it")
+    child_links = {j["child"] for j in joints.values()}
+    roots = [n for n in links if n not in child_links]
+    for root in roots:
+        below = children.get(root, [])
+        if (root != "world" and below and not _has_mass(links[root])
+                and not any(j["type"] == "fixed" for j in below)):
+            refused.setdefault(root, "no mass in the original, and it is the root with only moving joints below "
+                                     "it: Gazebo's URDF conversion drops it and everything below it")
+    given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
+    point = 1e-3 * min(given) if given else 1e-3
+    for name, why in refused.items():
+        link = links[name]
+        if link.get("visual"):
+            link.pop("inertial", None)
+            out.repairs[name] = f"{why}; computed from its visual geometry at the recipe's density"
+        elif isinstance(link.get("collision"), (dict, list)):
+            link["inertial"] = {"source": "collision"}
+            out.repairs[name] = f"{why}; computed from its collision geometry at the recipe's density"
+        else:
+            floor = inertia_policy.moment_floor(point)
+            link["inertial"] = {"mass": point, "inertia": {"ixx": floor, "iyy": floor, "izz": floor}}
+            out.repairs[name] = (f"{why}; it has no geometry: a point mass of {fmt(point)} kg (a thousandth of the "
+                                 f"lightest link) with the smallest inertia a repair leaves")
+
+
+def _tensor(t: dict):
+    import numpy as np
+
+    return np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
 
 
 def _inertia_problem(given: dict) -> str | None:
@@ -922,9 +1032,11 @@ def _dump_one(value) -> str:
                      allow_unicode=True).strip()
 
 
-def dump_recipe(recipe: dict, header: list[str] | None = None) -> str:
+def dump_recipe(recipe: dict, header: list[str] | None = None,
+                comments: dict[str, dict[str, str]] | None = None) -> str:
     """The recipe as readable YAML: top-level keys in order, a blank line between sections,
-    flow style for short vectors and mappings."""
+    flow style for short vectors and mappings; ``comments[section][name]`` goes above that
+    entry (e.g. what an import repaired on a link)."""
     import yaml
 
     parts = []
@@ -941,11 +1053,28 @@ def dump_recipe(recipe: dict, header: list[str] | None = None) -> str:
         if key == "materials":
             styled = {name: _styled(m, 200) for name, m in value.items()}
         elif key in ("links", "joints"):
+            notes = (comments or {}).get(key, {})
+            if notes:
+                text = [f"\n{key}:\n"]
+                for name, entry in value.items():
+                    for line in _wrap(notes.get(name, "")):
+                        text.append(f"  # {line}\n")
+                    entry_text = yaml.dump({name: _styled_entry(entry)}, **opts)
+                    text.append("".join(f"  {line}" if line.strip() else line
+                                        for line in entry_text.splitlines(keepends=True)))
+                parts.append("".join(text))
+                continue
             styled = {name: _styled_entry(entry) for name, entry in value.items()}
         else:
             styled = _styled(value, 100)
         parts.append("\n" + yaml.dump({key: styled}, **opts))
     return "".join(parts)
+
+
+def _wrap(text: str, width: int = 96) -> list[str]:
+    import textwrap
+
+    return textwrap.wrap(text, width, break_long_words=False, break_on_hyphens=False) if text else []
 
 
 def _styled_entry(entry: dict) -> dict:
