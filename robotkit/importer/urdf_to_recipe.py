@@ -659,10 +659,10 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
     roots = [n for n in links if n not in child_links]
     for root in roots:
         below = children.get(root, [])
-        if (root != "world" and below and not _has_mass(links[root])
-                and not any(j["type"] == "fixed" for j in below)):
-            refused.setdefault(root, "no mass in the original, and it is the root with only moving joints below "
-                                     "it: Gazebo's URDF conversion drops it and everything below it")
+        if root != "world" and below and not body_mass(root):
+            refused.setdefault(root, "no mass in the original (nor on the links fixed to it), and it is the root "
+                                     "with moving joints below it: Gazebo's URDF conversion drops it and "
+                                     "everything below it")
     given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
     point = 1e-3 * min(given) if given else 1e-3
     for name, why in refused.items():
