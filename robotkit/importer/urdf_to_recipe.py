@@ -630,8 +630,8 @@ def _has_mass(link: dict) -> bool:
 
 
 def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
-    """A link the build refuses for having no mass (it moves, or it is a root whose children
-    all move: MuJoCo refuses it, Gazebo drops it) gets one: computed from its geometry at the
+    """A link the build refuses or SDF misreads for having no mass (it moves, or it is a root
+    with moving joints below it and no mass welded to it) gets one: computed from its geometry at the
     recipe's density, or a point mass when it has none.  Each is recorded in ``out.repairs``."""
     moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
     children: dict[str, list[dict]] = {}
@@ -655,14 +655,24 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
         if j["type"] in moving and j["child"] in links and not body_mass(j["child"]):
             refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): MuJoCo "
                                            "refuses a moving body without mass and Gazebo drops it")
+        elif j["type"] in moving and j["child"] in links and not _has_mass(links[j["child"]]):
+            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): SDF keeps "
+                                           "it a link, which Gazebo and Drake give 1 kg without an inertial")
     child_links = {j["child"] for j in joints.values()}
     roots = [n for n in links if n not in child_links]
     for root in roots:
         below = children.get(root, [])
         if root != "world" and below and not body_mass(root):
-            refused.setdefault(root, "no mass in the original (nor on the links fixed to it), and it is the root "
-                                     "with moving joints below it: Gazebo's URDF conversion drops it and "
-                                     "everything below it")
+            # the mass goes on the first link with geometry welded to the root, else on the root
+            welded, todo = [], [root]
+            while todo:
+                welded += todo
+                todo = [j["child"] for n in todo for j in children.get(n, []) if j["type"] == "fixed"]
+            root = next((n for n in welded if links[n].get("visual") or isinstance(links[n].get("collision"),
+                                                                                     (dict, list))), root)
+            refused.setdefault(root, "no mass in the original (nor on the links welded to it), and it is (or is "
+                                     "welded to) the root with moving joints below it: Gazebo's URDF conversion "
+                                     "drops it and everything below it")
     given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
     point = 1e-3 * min(given) if given else 1e-3
     for name, why in refused.items():
