@@ -26,6 +26,7 @@ from robotkit.build import build
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.kinematics import compare, read_urdf
 from robotkit.importer import import_file
+from tests.conftest import run_cli
 from tests.validators import check_urdf, mujoco
 
 ROBOTS_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "assets" / "robots"
@@ -143,3 +144,103 @@ def test_the_repairs_are_the_expected_ones(corpus, name):
     result = corpus[name][0]
     for link, start in REPAIRED[name].items():
         assert result.repairs[link].startswith(start), result.repairs[link]
+
+
+# ---------------------------------------------------------------- what the corpus lacks: an edited copy
+
+
+def edited_kuka(folder: Path) -> Path:
+    """A copy of the corpus' KUKA iiwa (BSD-2, see LICENSES/) with the traits real files show and the
+    corpus lacks: a '/' in a link name, a revolute joint with lower == upper and effort 0 (meant
+    free), principal moments that break the triangle inequality, an ASCII STL as visual and
+    collision, a joint named like a link, a moving link without <inertial>, a mimic chain with a
+    multiplier and offset, and a mimic whose leader is a fixed joint."""
+    import shutil
+
+    import trimesh
+
+    src = ROBOTS_DIR / "kuka_iiwa"
+    shutil.copytree(src / "meshes", folder / "meshes")
+    t = (src / "model.urdf").read_text(encoding="utf-8")
+    t = t.replace('"lbr_iiwa_link_3"', '"lbr/iiwa_link_3"')
+    t = re.sub(r'(<joint name="lbr_iiwa_joint_4"[\s\S]*?)<limit[^>]*/>',
+               r'\1<limit effort="0" lower="0" upper="0" velocity="0"/>', t)
+    t = re.sub(r'(<link name="lbr_iiwa_link_5">[\s\S]*?)<inertia [^>]*/>',
+               r'\1<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/>', t)
+    t = re.sub(r'(<link name="lbr_iiwa_link_7">\s*)<inertial>[\s\S]*?</inertial>', r'\1', t)
+    t = t.replace('<joint name="lbr_iiwa_joint_5"', '<joint name="lbr_iiwa_link_5"')
+    for mesh in ("link_2.stl", "link_1.obj"):
+        t = t.replace(f'<mesh filename="meshes/{mesh}"/>', '<mesh filename="meshes/link_2_ascii.stl"/>')
+    for joint, mimic in (("lbr_iiwa_joint_2", '<mimic joint="lbr_iiwa_joint_1" multiplier="0.5" offset="0.1"/>'),
+                         ("lbr_iiwa_joint_3", '<mimic joint="lbr_iiwa_joint_2" multiplier="-1"/>'),
+                         ("lbr_iiwa_joint_7", '<mimic joint="tool_joint"/>')):
+        t = re.sub(rf'(<joint name="{joint}"[\s\S]*?)</joint>', rf'\1  {mimic}\n  </joint>', t, count=1)
+    t = t.replace("</robot>", '  <link name="tool"/>\n  <joint name="tool_joint" type="fixed">\n'
+                  '    <parent link="lbr_iiwa_link_7"/>\n    <child link="tool"/>\n    <origin xyz="0 0 0.1"/>\n'
+                  '  </joint>\n</robot>')
+    mesh = trimesh.load(src / "meshes" / "link_2.stl")
+    (folder / "meshes" / "link_2_ascii.stl").write_text(trimesh.exchange.stl.export_stl_ascii(mesh), encoding="ascii")
+    (folder / "model.urdf").write_text(t, encoding="utf-8")
+    return folder / "model.urdf"
+
+
+def _with_stated_joint_changes(text: str, notes: dict[str, str]) -> str:
+    root = ET.fromstring(text)
+    for el in root.iter("joint"):
+        note = notes.get(el.get("name"), "")
+        if note.startswith("mimicked fixed joint"):
+            el.remove(el.find("mimic"))
+        elif "lower == upper" in note:
+            el.set("type", "continuous")
+            for key in ("lower", "upper"):
+                el.find("limit").attrib.pop(key)
+    return ET.tostring(root, encoding="unicode")
+
+
+def test_an_edited_copy_imports_builds_and_loads(tmp_path):
+    from robotkit.check import check_urdf_file
+
+    mujoco()
+    source = edited_kuka(tmp_path / "kuka")
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    built = build([result.recipe_path], tmp_path / "build")
+    assert not built.errors, built.errors
+    robot_dir = tmp_path / "build" / result.robot
+    urdf = robot_dir / "urdf" / f"{result.robot}.urdf"
+    check_urdf(urdf)
+    assert result.joint_notes == {
+        "lbr_iiwa_joint_4": "limit lower == upper (0.0) in the original: read as no position limit (lower and "
+                            "upper default to 0 in URDF), the joint is continuous",
+        "lbr_iiwa_joint_7": "mimicked fixed joint 'tool_joint' in the original: a fixed joint has no position to "
+                            "follow, so the mimic is dropped and the joint moves on its own"}
+    assert result.repairs["lbr_iiwa_link_5"] == (
+        "the original's principal moments 0.01, 0.01, 0.05 violate the triangle inequality: repaired (principal "
+        "moments 0.01, 0.01, 0.05 moved to 0.02, 0.02, 0.04 to meet the triangle inequality)")
+    assert result.repairs["lbr_iiwa_link_7"].startswith("no mass in the original, and it moves (joint "
+                                                        "'lbr_iiwa_joint_7')")
+    recipe = result.recipe_path.read_text(encoding="utf-8")
+    assert "  # limit lower == upper (0.0) in the original" in recipe and "  lbr/iiwa_link_3:" in recipe
+    # equal to the original except what the recipe states
+    stated = _with_stated_repairs(source, urdf, result.repairs)
+    (tmp_path / "stated.urdf").write_text(_with_stated_joint_changes(stated, result.joint_notes), encoding="utf-8")
+    assert compare(read_urdf(tmp_path / "stated.urdf"), read_urdf(urdf), TOL, configs=20) == []
+    # MuJoCo reads only binary STL: the MJCF references a binary copy of the ASCII visual
+    mjcf = robot_dir / "mjcf" / f"{result.robot}.xml"
+    assert 'file="mjcf/link_2_ascii.stl"' in mjcf.read_text(encoding="utf-8")
+    findings, summary = consumer_findings(Build(result.robot, robot_dir, urdf, robot_dir / "model.sdf", mjcf),
+                                          configs=5)
+    assert [str(f) for f in findings if f.severity == "error"] == []
+    assert all(s["loaded"] for s in summary.values()), summary
+    # check names the real defects on the original
+    found = {(f.check, f.subject) for f in check_urdf_file(source, {}) if f.severity == "error"}
+    assert {("triangle-inequality", "link 'lbr_iiwa_link_5'"), ("massless-moving", "link 'lbr_iiwa_link_7'")} <= found
+
+
+def test_check_takes_xacro_and_names_moving_links_without_mass(tmp_path):
+    """The Motoman SDA10F has no <inertial> at all: MuJoCo refuses it, and check says so."""
+    spec = CORPUS["motoman_sda10f"]
+    proc = run_cli("check", spec["entry"], *[x for k, v in spec["packages"].items() for x in ("--package-path",
+                                                                                             f"{k}={v}")])
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    assert "  error: moves (joint 'arm_left_joint_1_s') but has no mass: MuJoCo refuses to load the robot and " \
+           "Gazebo drops the link with everything below it [massless-moving]" in proc.stdout.splitlines()

@@ -36,6 +36,8 @@ class ImportResult:
     """A label per element carried verbatim in ``urdf_extras``."""
     repairs: dict[str, str] = field(default_factory=dict)
     """Per link whose inertial the recipe changes from the original: what was wrong and what it does."""
+    joint_notes: dict[str, str] = field(default_factory=dict)
+    """Per joint the recipe changes from the original (a mimic of a fixed joint, lower == upper)."""
 
 
 def is_xacro(path: Path, text: str) -> bool:
@@ -110,7 +112,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
                       + ("at the recipe's density" if density is not None else "keeping each link's given mass"))
     else:
         header.append("inertials as given in the original (explicit)")
-    text_out = dump_recipe(recipe, header, {"links": conv.repairs})
+    text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text(text_out, encoding="utf-8")
@@ -122,7 +124,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     os.replace(tmp, out)
 
     result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
-                          repairs=dict(conv.repairs))
+                          repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes))
     if recompute_inertials:
         _report_recomputed(out, conv, result)
     return result

@@ -31,7 +31,7 @@ from pathlib import Path
 
 from robotkit.model import inertia_policy
 from robotkit.errors import Problem, RobotkitError, display_path
-from robotkit.recipe.schema import NAME_RE, UNITS
+from robotkit.recipe.schema import FRAME_NAME_RE, NAME_RE, UNITS
 
 GREY = [0.5, 0.5, 0.5, 1.0]
 TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "materials", "links", "joints", "urdf_extras")
@@ -58,6 +58,7 @@ class Converted:
     extras: list[str] = field(default_factory=list)  # a short label per verbatim element
     invalid_inertias: set[str] = field(default_factory=set)  # links whose given inertia the build rejects
     repairs: dict[str, str] = field(default_factory=dict)  # link -> what was wrong and what the recipe does
+    joint_notes: dict[str, str] = field(default_factory=dict)  # joint -> what the recipe changes from the original
 
 
 def no_inertial_form():
@@ -130,6 +131,11 @@ def _origin_dict(xyz, rpy) -> dict | None:
 
 def _valid_name(name: str | None) -> bool:
     return bool(name) and bool(NAME_RE.match(name))
+
+
+def _valid_frame_name(name: str | None) -> bool:
+    """Link and joint names may hold '/' between parts, as ROS frame names do."""
+    return bool(name) and bool(FRAME_NAME_RE.match(name))
 
 
 def _material_name(name: str, taken: set[str]) -> str:
@@ -291,7 +297,7 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         if _local(el.tag) != "link":
             continue
         name = el.get("name")
-        if not _valid_name(name):
+        if not _valid_frame_name(name):
             problems.add(f"link name '{name}' is not a valid recipe name ({_name_hint()})")
             continue
         if name in links:
@@ -371,7 +377,7 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         if _local(el.tag) != "joint":
             continue
         name = el.get("name")
-        if not _valid_name(name):
+        if not _valid_frame_name(name):
             problems.add(f"joint name '{name}' is not a valid recipe name ({_name_hint()})")
             continue
         if name in joints:
@@ -381,14 +387,24 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         if joint is None:
             continue
         for end in ("parent", "child"):
-            if joint[end] not in links and _valid_name(joint[end]):
+            if joint[end] not in links and _valid_frame_name(joint[end]):
                 problems.add(f"joint '{name}': {end} link '{joint[end]}' is not defined")
         joints[name] = joint
         joint_types[name] = joint["type"]
     for name, joint in joints.items():
+        note = joint.pop("__note", None)
+        if note:
+            out.joint_notes[name] = note
+    for name, joint in joints.items():
         mimic = joint.get("mimic")
         if mimic and mimic["joint"] not in joints:
             problems.add(f"joint '{name}': mimics joint '{mimic['joint']}', which is not defined")
+        elif mimic and joints[mimic["joint"]]["type"] == "fixed":
+            note = (f"mimicked fixed joint '{mimic['joint']}' in the original: a fixed joint has no position to "
+                    "follow, so the mimic is dropped and the joint moves on its own")
+            del joint["mimic"]
+            out.joint_notes[name] = note
+            warnings.append(f"joint '{name}': {note}")
 
     # ---- everything else: gazebo blocks (partly mapped), transmissions, ... verbatim
     extras: list[str] = []
@@ -437,9 +453,9 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
 
 
 def _name_hint() -> str:
-    from robotkit.recipe.schema import NAME_HINT
+    from robotkit.recipe.schema import FRAME_NAME_HINT
 
-    return NAME_HINT
+    return FRAME_NAME_HINT
 
 
 def _local(tag) -> str:
@@ -747,15 +763,25 @@ def _joint(el: ET.Element, name: str, problems: _Problems, warnings: list[str]) 
                     problems.add(f"{what}: <limit> needs {key} (URDF requires effort and velocity)")
                     return None
                 limit[key] = v
-            if limit["lower"] >= limit["upper"]:
+            if limit["lower"] == limit["upper"] and jtype == "revolute":
+                # urdfdom's default limits are lower = upper = 0: files that mean "free" write that
+                note = (f"limit lower == upper ({limit['lower']!r}) in the original: read as no position limit "
+                        "(lower and upper default to 0 in URDF), the joint is continuous")
+                warnings.append(f"{what}: {note}")
+                joint["type"] = "continuous"
+                joint["__note"] = note
+                kept = {k: abs(limit[k]) for k in ("effort", "velocity")}
+                joint["limit"] = kept
+            elif limit["lower"] >= limit["upper"]:
                 problems.add(f"{what}: limit lower ({limit['lower']!r}) is not below upper ({limit['upper']!r}); "
                              "a recipe cannot express a locked revolute or prismatic joint (make it fixed)")
                 return None
-            for key in ("effort", "velocity"):
-                if limit[key] < 0:
-                    warnings.append(f"{what}: negative {key} limit {limit[key]!r}; using its magnitude")
-                    limit[key] = -limit[key]
-            joint["limit"] = limit
+            else:
+                for key in ("effort", "velocity"):
+                    if limit[key] < 0:
+                        warnings.append(f"{what}: negative {key} limit {limit[key]!r}; using its magnitude")
+                        limit[key] = -limit[key]
+                joint["limit"] = limit
         elif jtype == "continuous":
             limit = {}
             for key in ("effort", "velocity"):

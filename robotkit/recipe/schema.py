@@ -31,6 +31,8 @@ from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_val
 
 NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*$")
 NAME_HINT = "a name starts with a letter or '_' and holds only letters, digits, '_', '-' and '.'"
+FRAME_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*(/[A-Za-z0-9_.\-]+)*$")
+FRAME_NAME_HINT = NAME_HINT + ", with '/' between parts (a ROS frame name such as arm/link_1)"
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 
@@ -85,6 +87,14 @@ def _scale_form(value) -> str | None:
 def check_name(value: str) -> str:
     if not NAME_RE.match(value):
         raise ValueError(f"invalid name {value!r}: {NAME_HINT}")
+    return value
+
+
+def check_frame_name(value: str) -> str:
+    """Link and joint names: as :func:`check_name`, and '/' between parts (ROS accepts them;
+    files named after them go through :func:`robotkit.paths.file_stem`)."""
+    if not FRAME_NAME_RE.match(value):
+        raise ValueError(f"invalid name {value!r}: {FRAME_NAME_HINT}")
     return value
 
 
@@ -698,9 +708,16 @@ class Recipe(Strict):
                 raise ValueError(f"urdf_extras[{i}] is not well-formed XML: {exc}") from None
         return v
 
-    @field_validator("materials", "links", "joints", "worlds", "sensors")
+    @field_validator("materials", "worlds", "sensors")
     @classmethod
     def _names(cls, v):
         for name in v:
             check_name(name)
+        return v
+
+    @field_validator("links", "joints")
+    @classmethod
+    def _frame_names(cls, v):
+        for name in v:
+            check_frame_name(name)
         return v
