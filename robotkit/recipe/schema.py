@@ -274,6 +274,8 @@ class Inertial(Strict):
     """Which of the link's geometries the mass properties are computed from."""
     open_mesh: Literal["error", "hull"] | None = None
     """What to do with a mesh that is not a closed volume after safe repair: ``error``, or use its convex ``hull`` (with a warning). Default: the recipe's ``open_mesh``."""
+    policy: Literal["keep", "repair"] | None = None
+    """For an explicit inertia: ``keep`` it as given (a tensor no real body has stops the build), or ``repair`` it with the smallest change that makes it physical (principal moments raised to a floor, then to the triangle inequality; axes kept). Default: the recipe's ``inertia_policy``."""
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -653,6 +655,8 @@ class Recipe(Strict):
     """Default units of mesh files (m, cm, mm, in)."""
     density: Positive = 1000.0
     """Default density in kg/m^3 for inertials computed from geometry."""
+    inertia_policy: Literal["keep", "repair"] = "keep"
+    """Explicit inertias: ``keep`` them as given, or ``repair`` those no real body has with the smallest change (per link: ``inertial.policy``)."""
     open_mesh: Literal["error", "hull"] = "error"
     """Default policy for meshes that are not closed volumes after safe repair."""
     meshes: MeshDefaults = MeshDefaults()
