@@ -72,7 +72,7 @@ def test_the_recipe_chooses_the_policy(tmp_path):
                                       ("link.yaml", "", ", policy: repair")):
         recipe = write_recipe(tmp_path, RECIPE.format(policy=policy, link_policy=link_policy), name)
         (_, robot), = load_robots([recipe])
-        arm = robot.link("arm").explicit
+        arm = robot.link("arm").inertial
         assert np.allclose(arm.tensor(), np.diag([0.02, 0.02, 0.04]), rtol=0, atol=1e-15), name
     # a link may keep what the recipe would repair
     mixed = write_recipe(tmp_path, RECIPE.format(policy="inertia_policy: repair", link_policy=", policy: keep"),
