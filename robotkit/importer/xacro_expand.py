@@ -59,8 +59,11 @@ DENIED_NAMES = frozenset({
     "getattr", "setattr", "delattr", "hasattr", "vars", "dir", "globals", "locals", "type",
     "object", "super", "memoryview", "classmethod", "staticmethod", "property",
 })
-# attributes that lead from a value to code, frames or arbitrary attributes
-DENIED_ATTRS = DENIED_NAMES | frozenset({
+# attributes that lead from a value to code, frames or arbitrary attributes (a YAML key such
+# as ``type`` or ``object`` read as ``cfg.joint.type`` is the file's own data)
+DENIED_ATTRS = frozenset({
+    "exec", "eval", "compile", "open", "breakpoint", "getattr", "setattr", "delattr", "globals", "locals", "vars",
+}) | frozenset({
     "format", "format_map", "mro", "gi_frame", "gi_code", "gi_yieldfrom", "cr_frame", "cr_code",
     "cr_await", "ag_frame", "ag_code", "ag_await", "f_back", "f_globals", "f_locals", "f_builtins",
     "f_code", "f_trace", "tb_frame", "tb_next", "co_code", "co_consts", "func_globals", "func_code",
@@ -314,7 +317,7 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
         return default
 
     def allowed(file: str) -> str:
-        problem = policy.problem(file)
+        problem = policy.problem(os.path.normpath(file))
         if problem is not None:
             state.blocked = f"reading {problem.message}"
             raise _Blocked(file)
@@ -346,6 +349,8 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
     def guarded_resolve(arg_str, context=None, filename=None):
         if arg_str and "$(find-pkg-share " in arg_str:
             arg_str = arg_str.replace("$(find-pkg-share ", "$(find ")
+        if context is not None and xacro.filestack:  # xacro 2.1 never tells $(dirname) the file
+            context["filename"] = xacro.filestack[-1]
         return original_resolve(arg_str, context, filename)
 
     def guarded_eval_all(node, macros, symbols):
