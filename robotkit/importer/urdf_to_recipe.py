@@ -29,23 +29,21 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from robotkit.importer.inertials import (  # noqa: F401  (no_inertial_form: used by the tests)
+    _explicit_dict, _give_moving_links_mass, _inertial, _tensor, no_inertial_form,
+)
+from robotkit.importer.meshes import MeshResolver, MeshUse
+from robotkit.importer.names import _material_name, _name_hint, _valid_frame_name, _valid_name
+from robotkit.importer.parsing import _Problems, _float, _floats, _fmt_list, _local, _origin, _origin_dict
+from robotkit.importer.recipe_writer import dump_recipe, fmt  # noqa: F401  (the import's writer)
 from robotkit.model import inertia_policy
 from robotkit.errors import Problem, RobotkitError, display_path
 from robotkit.recipe.schema import FRAME_NAME_RE, NAME_RE, UNITS
 
 GREY = [0.5, 0.5, 0.5, 1.0]
-TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "materials", "links", "joints", "urdf_extras")
-MESH_FORMATS = (".stl", ".obj", ".dae")
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
 
 
-@dataclass
-class MeshUse:
-    """One mesh file named by the URDF: where it is and where the recipe points."""
-
-    source: str  # absolute path of the file found
-    recipe_path: str  # absolute path the recipe names (source, or its copy)
-    scale: tuple[float, float, float]
 
 
 @dataclass
@@ -61,154 +59,30 @@ class Converted:
     joint_notes: dict[str, str] = field(default_factory=dict)  # joint -> what the recipe changes from the original
 
 
-def no_inertial_form():
-    """The recipe value that says "this link has no inertial", if the schema has one."""
-    from pydantic import ValidationError
-
-    from robotkit.recipe.schema import Link
-
-    for value in ("none",):
-        try:
-            Link.model_validate({"visual": {"box": {"size": [1, 1, 1]}}, "inertial": value})
-            return value
-        except ValidationError:
-            continue
-    return None
 
 
 # ---------------------------------------------------------------- parsing helpers
 
 
-class _Problems:
-    def __init__(self, file: str):
-        self.file = file
-        self.items: list[Problem] = []
-
-    def add(self, message: str):
-        self.items.append(Problem(message, file=self.file))
-
-    def raise_if_any(self):
-        if self.items:
-            raise RobotkitError(self.items)
 
 
-def _floats(text: str | None, n: int, what: str, problems: _Problems, default=None):
-    if text is None:
-        return list(default) if default is not None else None
-    parts = text.split()
-    try:
-        values = [float(p) for p in parts]
-    except ValueError:
-        values = []
-    if len(values) != n or not all(math.isfinite(v) for v in values):
-        problems.add(f"{what}: '{text}' is not {n} finite number{'s' if n > 1 else ''}")
-        return list(default) if default is not None else None
-    return [v + 0.0 for v in values]  # no -0.0
 
 
-def _float(text, what, problems, default=None):
-    values = _floats(text, 1, what, problems, None if default is None else [default])
-    return None if values is None else values[0]
 
 
-def _origin(el: ET.Element | None, what: str, problems: _Problems):
-    """(xyz, rpy) of an <origin> child, zeros when absent."""
-    if el is None:
-        return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
-    xyz = _floats(el.get("xyz"), 3, f"{what} origin xyz", problems, [0.0, 0.0, 0.0])
-    rpy = _floats(el.get("rpy"), 3, f"{what} origin rpy", problems, [0.0, 0.0, 0.0])
-    return xyz, rpy
 
 
-def _origin_dict(xyz, rpy) -> dict | None:
-    out = {}
-    if any(xyz):
-        out["xyz"] = list(xyz)
-    if any(rpy):
-        out["rpy"] = list(rpy)
-    return out or None
 
 
-def _valid_name(name: str | None) -> bool:
-    return bool(name) and bool(NAME_RE.match(name))
 
 
-def _valid_frame_name(name: str | None) -> bool:
-    """Link and joint names may hold '/' between parts, as ROS frame names do."""
-    return bool(name) and bool(FRAME_NAME_RE.match(name))
 
 
-def _material_name(name: str, taken: set[str]) -> str:
-    base = re.sub(r"[^A-Za-z0-9_.\-]", "_", name or "material")
-    if not re.match(r"[A-Za-z_]", base):
-        base = "_" + base
-    out, i = base, 2
-    while out in taken:
-        out, i = f"{base}_{i}", i + 1
-    return out
 
 
 # ---------------------------------------------------------------- mesh files
 
 
-class MeshResolver:
-    def __init__(self, source: Path, recipe_dir: Path, packages: dict[str, str], copy: bool):
-        self.source = source
-        self.recipe_dir = recipe_dir
-        self.packages = packages
-        self.copy = copy
-        self.copies: dict[str, str] = {}  # destination -> source
-        self._dest_of: dict[str, str] = {}
-
-    def locate(self, uri: str, link: str, problems: _Problems) -> str | None:
-        """Absolute path of the file ``uri`` names, or None with a problem."""
-        path = None
-        m = re.match(r"^(package|model)://([^/]+)/(.+)$", uri)
-        if m:
-            pkg, rest = m.group(2), m.group(3)
-            if pkg not in self.packages:
-                problems.add(f"link '{link}': mesh '{uri}': package '{pkg}' not found; "
-                             f"give --package-path {pkg}=DIR")
-                return None
-            path = os.path.join(self.packages[pkg], rest)
-        elif uri.startswith("file://"):
-            path = uri[len("file://"):]
-            if not os.path.isabs(path):
-                path = os.path.join(self.source.parent, path)
-        elif re.match(r"^[A-Za-z][A-Za-z0-9+.\-]*://", uri):
-            problems.add(f"link '{link}': mesh '{uri}': unsupported URI scheme "
-                         "(use package://, file:// or a path)")
-            return None
-        else:
-            path = uri if os.path.isabs(uri) else os.path.join(self.source.parent, uri)
-        path = os.path.normpath(path)
-        if not os.path.isfile(path):
-            problems.add(f"link '{link}': mesh '{uri}' not found (looked for {display_path(path)})")
-            return None
-        if os.path.splitext(path)[1].lower() not in MESH_FORMATS:
-            problems.add(f"link '{link}': mesh '{uri}' has an unsupported format (robotkit reads STL, OBJ and DAE)")
-            return None
-        return path
-
-    def destination(self, path: str, uri: str) -> str:
-        """Where the recipe points for the file at ``path`` (a copy below the recipe, or it)."""
-        if not self.copy:
-            return path
-        if path in self._dest_of:
-            return self._dest_of[path]
-        m = re.match(r"^(package|model)://(.+)$", uri)
-        rel = m.group(2) if m else os.path.basename(path)
-        dest = os.path.normpath(os.path.join(self.recipe_dir, "meshes", rel))
-        stem, ext = os.path.splitext(dest)
-        i = 2
-        while dest in self.copies and self.copies[dest] != path:
-            dest, i = f"{stem}_{i}{ext}", i + 1
-        self.copies[dest] = path
-        self._dest_of[path] = dest
-        return dest
-
-    def recipe_text(self, dest: str) -> str:
-        return Path(os.path.relpath(dest, self.recipe_dir)).as_posix()
 
 
 # ---------------------------------------------------------------- the conversion
@@ -452,20 +326,10 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
     return out
 
 
-def _name_hint() -> str:
-    from robotkit.recipe.schema import FRAME_NAME_HINT
-
-    return FRAME_NAME_HINT
 
 
-def _local(tag) -> str:
-    if not isinstance(tag, str):
-        return "#comment"
-    return tag.rsplit("}", 1)[-1]
 
 
-def _fmt_list(values) -> str:
-    return "[" + ", ".join(fmt(v) for v in values) + "]"
 
 
 def _rgba(el: ET.Element, what: str, problems: _Problems, warnings: list[str]):
@@ -597,136 +461,16 @@ def _same_shapes(visuals: list[dict], collisions: list[dict]) -> bool:
     return all(strip(v) == strip(c) for v, c in zip(visuals, collisions))
 
 
-def _inertial(el: ET.Element, link: str, problems: _Problems) -> dict | None:
-    what = f"link '{link}' inertial"
-    mass_el = el.find("mass")
-    mass = _float(mass_el.get("value") if mass_el is not None else None, f"{what} mass", problems, 0.0)
-    xyz, rpy = _origin(el.find("origin"), what, problems)
-    t = el.find("inertia")
-    keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-    values = {k: 0.0 for k in keys}
-    if t is not None:
-        for k in keys:
-            v = _float(t.get(k), f"{what} {k}", problems, 0.0)
-            values[k] = v if v is not None else 0.0
-    if any(rpy):
-        import numpy as np
-
-        from robotkit.model.robot import rpy_matrix
-
-        I = np.array([[values["ixx"], values["ixy"], values["ixz"]],
-                      [values["ixy"], values["iyy"], values["iyz"]],
-                      [values["ixz"], values["iyz"], values["izz"]]])
-        R = rpy_matrix(rpy)
-        I = R @ I @ R.T
-        I = 0.5 * (I + I.T)
-        scale = float(np.abs(I).max())
-        I[np.abs(I) < 1e-14 * scale] = 0.0
-        values = {"ixx": I[0, 0], "ixy": I[0, 1], "ixz": I[0, 2], "iyy": I[1, 1], "iyz": I[1, 2], "izz": I[2, 2]}
-        values = {k: float(v) + 0.0 for k, v in values.items()}
-    return {"mass": mass if mass is not None else 0.0, "com": xyz, "inertia": values, "rpy": rpy}
 
 
-def _explicit_dict(given: dict) -> dict:
-    out: dict = {"mass": given["mass"]}
-    if any(given["com"]):
-        out["com"] = list(given["com"])
-    t = given["inertia"]
-    inertia = {k: t[k] for k in ("ixx", "iyy", "izz")}
-    for k in ("ixy", "ixz", "iyz"):
-        if t[k] != 0.0:
-            inertia[k] = t[k]
-    out["inertia"] = inertia
-    return out
 
 
-def _has_mass(link: dict) -> bool:
-    spec = link.get("inertial")
-    return isinstance(spec, dict) or (spec is None and bool(link.get("visual")))
 
 
-def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
-    """A link the build refuses or SDF misreads for having no mass (it moves, or it is a root
-    with moving joints below it and no mass welded to it) gets one: computed from its geometry at the
-    recipe's density, or a point mass when it has none.  Each is recorded in ``out.repairs``."""
-    moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
-    children: dict[str, list[dict]] = {}
-    for j in joints.values():
-        children.setdefault(j["parent"], []).append(j)
-
-    def body_mass(name: str) -> bool:
-        todo, seen = [name], set()
-        while todo:
-            n = todo.pop()
-            if n in seen or n not in links:
-                continue
-            seen.add(n)
-            if _has_mass(links[n]):
-                return True
-            todo += [j["child"] for j in children.get(n, []) if j["type"] == "fixed"]
-        return False
-
-    refused: dict[str, str] = {}
-    for jname, j in joints.items():
-        if j["type"] in moving and j["child"] in links and not body_mass(j["child"]):
-            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): MuJoCo "
-                                           "refuses a moving body without mass and Gazebo drops it")
-        elif j["type"] in moving and j["child"] in links and not _has_mass(links[j["child"]]):
-            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): SDF keeps "
-                                           "it a link, which Gazebo and Drake give 1 kg without an inertial")
-    child_links = {j["child"] for j in joints.values()}
-    roots = [n for n in links if n not in child_links]
-    for root in roots:
-        below = children.get(root, [])
-        if root != "world" and below and not body_mass(root):
-            # the mass goes on the first link with geometry welded to the root, else on the root
-            welded, todo = [], [root]
-            while todo:
-                welded += todo
-                todo = [j["child"] for n in todo for j in children.get(n, []) if j["type"] == "fixed"]
-            root = next((n for n in welded if links[n].get("visual") or isinstance(links[n].get("collision"),
-                                                                                     (dict, list))), root)
-            refused.setdefault(root, "no mass in the original (nor on the links welded to it), and it is (or is "
-                                     "welded to) the root with moving joints below it: Gazebo's URDF conversion "
-                                     "drops it and everything below it")
-    given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
-    point = 1e-3 * min(given) if given else 1e-3
-    for name, why in refused.items():
-        link = links[name]
-        if link.get("visual"):
-            link.pop("inertial", None)
-            out.repairs[name] = f"{why}; computed from its visual geometry at the recipe's density"
-        elif isinstance(link.get("collision"), (dict, list)):
-            link["inertial"] = {"source": "collision"}
-            out.repairs[name] = f"{why}; computed from its collision geometry at the recipe's density"
-        else:
-            floor = inertia_policy.moment_floor(point)
-            link["inertial"] = {"mass": point, "inertia": {"ixx": floor, "iyy": floor, "izz": floor}}
-            out.repairs[name] = (f"{why}; it has no geometry: a point mass of {fmt(point)} kg (a thousandth of the "
-                                 f"lightest link) with the smallest inertia a repair leaves")
 
 
-def _tensor(t: dict):
-    import numpy as np
-
-    return np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
 
 
-def _inertia_problem(given: dict) -> str | None:
-    """Why robotkit's resolver would reject the tensor (see model.resolve._check_explicit)."""
-    import numpy as np
-
-    t = given["inertia"]
-    I = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
-    if not np.all(np.isfinite(I)):
-        return "is not finite"
-    eig = np.linalg.eigvalsh(I)
-    if eig.min() <= 0:
-        return "is not positive definite"
-    a, b, c = eig
-    if a + b < c * (1 - 1e-9):
-        return "violates the triangle inequality"
-    return None
 
 
 def _joint(el: ET.Element, name: str, problems: _Problems, warnings: list[str]) -> dict | None:
@@ -995,124 +739,19 @@ def _all_attr_names(node):
 # ---------------------------------------------------------------- YAML
 
 
-def fmt(x: float) -> str:
-    """Shortest text that reads back as the same float64 (integral values without '.0')."""
-    x = float(x)
-    if x == 0:
-        return "0"
-    if x.is_integer() and abs(x) < 1e16:
-        return str(int(x))
-    text = repr(x)
-    if "e" in text and "." not in text.split("e")[0]:
-        mantissa, exp = text.split("e")
-        text = f"{mantissa}.0e{exp}"
-    return text
 
 
-class _FlowList(list):
-    pass
 
 
-class _FlowMap(dict):
-    pass
 
 
-def _dumper():
-    import yaml
-
-    class Dumper(yaml.SafeDumper):
-        pass
-
-    def float_rep(dumper, value):
-        text = fmt(value)
-        tag = "tag:yaml.org,2002:int" if re.fullmatch(r"-?\d+", text) else "tag:yaml.org,2002:float"
-        return dumper.represent_scalar(tag, text)
-
-    def str_rep(dumper, value):
-        if "\n" in value:
-            return dumper.represent_scalar("tag:yaml.org,2002:str", value, style="|")
-        return dumper.represent_scalar("tag:yaml.org,2002:str", value)
-
-    Dumper.add_representer(float, float_rep)
-    Dumper.add_representer(str, str_rep)
-    Dumper.add_representer(_FlowList, lambda d, v: d.represent_sequence("tag:yaml.org,2002:seq", v, flow_style=True))
-    Dumper.add_representer(_FlowMap, lambda d, v: d.represent_mapping("tag:yaml.org,2002:map", v.items(),
-                                                                      flow_style=True))
-    Dumper.add_representer(dict, lambda d, v: d.represent_mapping("tag:yaml.org,2002:map", v.items(),
-                                                                  flow_style=False))
-    Dumper.ignore_aliases = lambda self, data: True
-    return Dumper
 
 
-def _styled(value, width: int):
-    """Flow style for number lists and for mappings short enough to read on one line."""
-    if isinstance(value, list):
-        if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-            return _FlowList(value)
-        return [_styled(v, width - 2) for v in value]
-    if isinstance(value, dict):
-        inner = {k: _styled(v, width - 2) for k, v in value.items()}
-        flat = all(not isinstance(v, (dict, list)) or isinstance(v, (_FlowList, _FlowMap)) for v in inner.values())
-        if flat and all(not (isinstance(v, str) and "\n" in v) for v in inner.values()):
-            candidate = _FlowMap(inner)
-            if len(_dump_one(candidate)) <= width:
-                return candidate
-        return inner
-    return value
 
 
-def _dump_one(value) -> str:
-    import yaml
-
-    return yaml.dump(value, Dumper=_dumper(), default_flow_style=False, sort_keys=False, width=10**9,
-                     allow_unicode=True).strip()
 
 
-def dump_recipe(recipe: dict, header: list[str] | None = None,
-                comments: dict[str, dict[str, str]] | None = None) -> str:
-    """The recipe as readable YAML: top-level keys in order, a blank line between sections,
-    flow style for short vectors and mappings; ``comments[section][name]`` goes above that
-    entry (e.g. what an import repaired on a link)."""
-    import yaml
-
-    parts = []
-    for line in header or []:
-        parts.append(f"# {line}".rstrip() + "\n")
-    keys = [k for k in TOP_KEYS if k in recipe] + [k for k in recipe if k not in TOP_KEYS]
-    scalars = [k for k in keys if not isinstance(recipe[k], (dict, list))]
-    sections = [k for k in keys if k not in scalars]
-    dumper = _dumper()
-    opts = dict(Dumper=dumper, default_flow_style=False, sort_keys=False, width=10**9, allow_unicode=True)
-    parts.append(yaml.dump({k: recipe[k] for k in scalars}, **opts))
-    for key in sections:
-        value = recipe[key]
-        if key == "materials":
-            styled = {name: _styled(m, 200) for name, m in value.items()}
-        elif key in ("links", "joints"):
-            notes = (comments or {}).get(key, {})
-            if notes:
-                text = [f"\n{key}:\n"]
-                for name, entry in value.items():
-                    for line in _wrap(notes.get(name, "")):
-                        text.append(f"  # {line}\n")
-                    entry_text = yaml.dump({name: _styled_entry(entry)}, **opts)
-                    text.append("".join(f"  {line}" if line.strip() else line
-                                        for line in entry_text.splitlines(keepends=True)))
-                parts.append("".join(text))
-                continue
-            styled = {name: _styled_entry(entry) for name, entry in value.items()}
-        else:
-            styled = _styled(value, 100)
-        parts.append("\n" + yaml.dump({key: styled}, **opts))
-    return "".join(parts)
 
 
-def _wrap(text: str, width: int = 96) -> list[str]:
-    import textwrap
-
-    return textwrap.wrap(text, width, break_long_words=False, break_on_hyphens=False) if text else []
 
 
-def _styled_entry(entry: dict) -> dict:
-    """A link or joint: its own keys in block style, each value as compact as reads well."""
-    return {k: _styled(v, 110 - len(k)) for k, v in entry.items()}
