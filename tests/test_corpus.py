@@ -212,7 +212,10 @@ def test_an_edited_copy_imports_builds_and_loads(tmp_path):
         "lbr_iiwa_joint_4": "limit lower == upper (0.0) in the original: read as no position limit (lower and "
                             "upper default to 0 in URDF), the joint is continuous",
         "lbr_iiwa_joint_7": "mimicked fixed joint 'tool_joint' in the original: a fixed joint has no position to "
-                            "follow, so the mimic is dropped and the joint moves on its own"}
+                            "follow, so the mimic is dropped and the joint moves on its own",
+        "lbr_iiwa_link_5": "named like a link in the original: SDF, where links and joints share names, calls it "
+                           "'lbr_iiwa_link_5_joint'"}
+    assert '<joint name="lbr_iiwa_link_5_joint" type="revolute">' in (robot_dir / "model.sdf").read_text()
     assert result.repairs["lbr_iiwa_link_5"] == (
         "the original's principal moments 0.01, 0.01, 0.05 violate the triangle inequality: repaired (principal "
         "moments 0.01, 0.01, 0.05 moved to 0.02, 0.02, 0.04 to meet the triangle inequality)")

@@ -65,15 +65,20 @@ def extras_losses(robot: Robot, where: str) -> list[str]:
 def joint_names(robot: Robot) -> dict[str, str]:
     """SDF name of each joint: links, joints and frames share one namespace in an SDF model,
     so a joint named like a link (ANYmal's ``LF_HAA``) gets ``_joint`` appended (then a number)."""
-    taken = {link.name for link in robot.links}
+    return names_apart([link.name for link in robot.links], [j.name for j in robot.joints])
+
+
+def names_apart(links, joints) -> dict[str, str]:
+    """:func:`joint_names` on bare names (the import reports the renaming with them)."""
+    taken = set(links)
     out = {}
-    for j in robot.joints:
-        name, n = j.name, 1
+    for joint in joints:
+        name, n = joint, 1
         while name in taken:
-            name = f"{j.name}_joint" + (str(n) if n > 1 else "")
+            name = f"{joint}_joint" + (str(n) if n > 1 else "")
             n += 1
         taken.add(name)
-        out[j.name] = name
+        out[joint] = name
     return out
 
 

@@ -269,6 +269,13 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         note = joint.pop("__note", None)
         if note:
             out.joint_notes[name] = note
+    from robotkit.emit.sdf import names_apart
+
+    for name, sdf_name in names_apart(links, joints).items():
+        if sdf_name != name:  # ROS accepts it; an SDF model has one namespace for links and joints
+            note = f"named like a link in the original: SDF, where links and joints share names, calls it '{sdf_name}'"
+            out.joint_notes[name] = "; ".join(filter(None, (out.joint_notes.get(name), note)))
+            warnings.append(f"joint '{name}': {note}")
     for name, joint in joints.items():
         mimic = joint.get("mimic")
         if mimic and mimic["joint"] not in joints:
