@@ -101,16 +101,18 @@ def test_turret_bot_recipe_is_readable(tmp_path):
     result = import_file(ASSETS / "turret_bot/urdf/turret_bot.urdf", tmp_path / "turret_bot.yaml", PACKAGES, {})
     text = result.recipe_path.read_text(encoding="utf-8")
     data = yaml.safe_load(text)
-    assert [k for k in data] == ["robot", "units", "density", "materials", "links", "joints", "urdf_extras"]
+    assert [k for k in data] == ["robot", "units", "density", "values", "materials", "links", "joints", "urdf_extras"]
     # inertials as given, flow style for short vectors, no identity origins, shortest floats
     assert "    inertial: {mass: 16, com: [0, 0.5, 0], inertia: {ixx: 1.376, iyy: 0.317, izz: 1.607}}\n" in text
     assert "    origin: {xyz: [0, 0.05, 0.475]}\n" in text
     assert "origin: {xyz: [0, 0, 0]" not in text and "rpy: [0, 0, 0]" not in text
     assert "    limit: {lower: -3.14, upper: 3.14, effort: 1000, velocity: 50}\n" in text
     assert "collision" not in data["links"]["base"]  # same as the visual: the default
-    # mesh paths relative to the recipe
-    mesh = data["links"]["base"]["visual"]["mesh"]
-    assert not os.path.isabs(mesh) and (tmp_path / mesh).resolve() == (ASSETS / "turret_bot/meshes/base.stl").resolve()
+    # mesh paths relative to the recipe, their shared folder named once
+    assert data["links"]["base"]["visual"]["mesh"] == "${turret_bot_meshes}/base.stl"
+    folder = data["values"]["turret_bot_meshes"]
+    assert not os.path.isabs(folder) and (tmp_path / folder / "base.stl").resolve() == \
+        (ASSETS / "turret_bot/meshes/base.stl").resolve()
     # gazebo materials map onto the recipe's materials (the original paints base red, Gazebo/Green)
     assert data["materials"]["red"] == {"rgba": [0.8, 0, 0, 1], "gazebo": "Gazebo/Green"}
     # transmissions and the plugin block: verbatim, and listed in a warning

@@ -88,6 +88,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     """
     from robotkit.importer.meshes import _open_meshes
     from robotkit.importer.package_xml import package_metadata
+    from robotkit.importer.recipe_writer import name_mesh_folders
     from robotkit.importer.urdf_to_recipe import dump_recipe, urdf_to_recipe
     from robotkit.importer.xacro_expand import check_package_paths
 
@@ -122,6 +123,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     if ros == "ros1":  # ros2 is the default
         recipe["ros"] = ros
     _open_meshes(conv, recipe, warnings, recompute_inertials)
+    name_mesh_folders(recipe)
     _validate(recipe, source)
 
     copied = []

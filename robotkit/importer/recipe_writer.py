@@ -5,10 +5,12 @@ round-trips, and a comment above each link or joint the import changed from the 
 from __future__ import annotations
 
 import math
+import posixpath
 import re
+from collections import Counter
 
 
-TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "materials", "links", "joints", "urdf_extras")
+TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "values", "materials", "links", "joints", "urdf_extras")
 
 
 def fmt(x: float) -> str:
@@ -102,7 +104,9 @@ def dump_recipe(recipe: dict, header: list[str] | None = None,
     parts.append(yaml.dump({k: recipe[k] for k in scalars}, **opts))
     for key in sections:
         value = recipe[key]
-        if key == "materials":
+        if key == "values":
+            styled = dict(value)
+        elif key == "materials":
             styled = {name: _styled(m, 200) for name, m in value.items()}
         elif key in ("links", "joints"):
             notes = (comments or {}).get(key, {})
@@ -132,3 +136,40 @@ def _wrap(text: str, width: int = 96) -> list[str]:
 def _styled_entry(entry: dict) -> dict:
     """A link or joint: its own keys in block style, each value as compact as reads well."""
     return {k: _styled(v, 110 - len(k)) for k, v in entry.items()}
+
+
+def name_mesh_folders(recipe: dict) -> dict[str, str]:
+    """Each mesh folder that two or more meshes share becomes a named value (``values:
+    {kuka_iiwa_meshes: ../kuka_iiwa/meshes}``) and those meshes ``${kuka_iiwa_meshes}/link_0.stl``:
+    the folder is written once.  Names come from the folder's last two parts, numbered apart.
+    Returns name -> folder (added to ``recipe["values"]``)."""
+    uses = []
+    for link in recipe.get("links", {}).values():
+        for key in ("visual", "collision"):
+            value = link.get(key)
+            for g in value if isinstance(value, list) else [value]:
+                if isinstance(g, dict) and isinstance(g.get("mesh"), str) and "${" not in g["mesh"]:
+                    uses.append(g)
+    folders = Counter(posixpath.dirname(g["mesh"]) for g in uses)
+    taken = set(recipe.get("values", {})) | set(recipe.get("args", {}))
+    names: dict[str, str] = {}
+    for folder, count in sorted(folders.items()):
+        if count < 2 or not folder:
+            continue
+        parts = [part for part in folder.split("/") if part not in ("", ".", "..")]
+        base = re.sub(r"[^A-Za-z0-9_]", "_", "_".join(parts[-2:])) or "meshes"
+        if not re.match(r"[A-Za-z_]", base):
+            base = "_" + base
+        name, n = base, 2
+        while name in taken:
+            name, n = f"{base}_{n}", n + 1
+        taken.add(name)
+        names[folder] = name
+    for g in uses:
+        folder, file = posixpath.split(g["mesh"])
+        if folder in names:
+            g["mesh"] = f"${{{names[folder]}}}/{file}"
+    added = {name: folder for folder, name in names.items()}
+    if added:
+        recipe.setdefault("values", {}).update(added)
+    return added
