@@ -146,7 +146,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text(text_out, encoding="utf-8")
     try:
-        _check_resolves(tmp, out, conv.invalid_inertias)
+        _check_resolves(tmp, out)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
@@ -184,10 +184,9 @@ def _validate(recipe: dict, source: Path) -> None:
         raise RobotkitError(problems) from None
 
 
-def _check_resolves(recipe_file: Path, final: Path, invalid_inertias: set[str]) -> None:
-    """Load and resolve the written recipe as the build will.  Given inertias that the
-    build rejects were reported as warnings already: the recipe is still written, so that
-    the user can correct them in it."""
+def _check_resolves(recipe_file: Path, final: Path) -> None:
+    """Load and resolve the written recipe as the build will (given inertias that no real body
+    has were repaired by the import, each stated in the recipe)."""
     from dataclasses import replace
 
     from robotkit.tasks import load_robots
@@ -195,24 +194,5 @@ def _check_resolves(recipe_file: Path, final: Path, invalid_inertias: set[str]) 
     try:
         load_robots([recipe_file])
     except RobotkitError as exc:
-        keys = {f"links.{name}.inertial.inertia" for name in invalid_inertias}
-        rest = [replace(p, file=str(final) if p.file == str(recipe_file) else p.file)
-                for p in exc.problems if p.key not in keys]
-        if rest:
-            raise RobotkitError(rest) from None
-
-
-# ---------------------------------------------------------------- meshes that are not closed
-
-
-
-
-
-
-
-
-# ---------------------------------------------------------------- recomputed inertials
-
-
-
-
+        raise RobotkitError([replace(p, file=str(final) if p.file == str(recipe_file) else p.file)
+                             for p in exc.problems]) from None

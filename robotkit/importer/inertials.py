@@ -144,23 +144,6 @@ def _tensor(t: dict):
     return np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
 
 
-def _inertia_problem(given: dict) -> str | None:
-    """Why robotkit's resolver would reject the tensor (see model.resolve._check_explicit)."""
-    import numpy as np
-
-    t = given["inertia"]
-    I = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
-    if not np.all(np.isfinite(I)):
-        return "is not finite"
-    eig = np.linalg.eigvalsh(I)
-    if eig.min() <= 0:
-        return "is not positive definite"
-    a, b, c = eig
-    if a + b < c * (1 - 1e-9):
-        return "violates the triangle inequality"
-    return None
-
-
 
 def _facts(mesh) -> dict:
     """Unit-density mass properties of one mesh, as robotkit's mesh task records them."""

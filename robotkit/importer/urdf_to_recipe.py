@@ -54,7 +54,6 @@ class Converted:
     meshes: dict[tuple[str, str, int], MeshUse] = field(default_factory=dict)  # (link, kind, i)
     explicit: dict[str, dict] = field(default_factory=dict)  # link -> the given inertial
     extras: list[str] = field(default_factory=list)  # a short label per verbatim element
-    invalid_inertias: set[str] = field(default_factory=set)  # links whose given inertia the build rejects
     repairs: dict[str, str] = field(default_factory=dict)  # link -> what was wrong and what the recipe does
     joint_notes: dict[str, str] = field(default_factory=dict)  # joint -> what the recipe changes from the original
 
