@@ -13,10 +13,12 @@ The policies:
   moment when that is smaller), then the triangle inequality restored by moving
   the largest moment down and the other two up by a third of the excess each (the least
   change in the Frobenius norm).  The principal axes are kept.
-- ``recompute`` (import): from the link's geometry, keeping the given mass
-  (``inertial: {mass: M}`` in a recipe).
-- ``estimate`` (import): from the link's bounding box at the given mass, for a link whose
-  geometry is not a closed volume or that has none.
+- ``recompute``: from the link's geometry, keeping the given mass (a recipe's
+  ``inertial: {mass: M}``; ``robotkit import --recompute-inertials``).
+
+A link without mass that moves (or a massless root body with moving joints below it) gets one
+on import: from its geometry at the recipe's density, or, without geometry, a point mass of a
+thousandth of the lightest link with the floor's inertia (robotkit.importer.inertials).
 """
 
 from __future__ import annotations
@@ -24,8 +26,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-POLICIES = ("keep", "repair", "recompute", "estimate")
 
 MIN_RADIUS = 1e-3
 """The principal-moment floor is that of a solid sphere of this radius (m) at the link's mass."""
@@ -110,9 +110,3 @@ def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
     out[np.abs(out) < 1e-15 * scale] = 0.0  # products of inertia that are rounding only
     return Repaired(float(mass), out + 0.0, tuple(changes))
 
-
-def box_inertia(mass: float, extents) -> np.ndarray:
-    """The inertia of a solid box of ``extents`` (m) at ``mass`` about its centre; an extent
-    below :data:`MIN_RADIUS` counts as that."""
-    x, y, z = (max(float(e), MIN_RADIUS) for e in extents)
-    return mass / 12.0 * np.diag([y * y + z * z, x * x + z * z, x * x + y * y])
