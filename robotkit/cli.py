@@ -63,11 +63,13 @@ def _parser() -> argparse.ArgumentParser:
                        description="Run the validators, the URDF/SDF/MJCF equivalence check and a MuJoCo "
                                    "smoke test. Exit 0 when clean, 1 when problems are found, 2 for bad input "
                                    "(reported in every format too).")
-    c.add_argument("paths", nargs="+", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
+    c.add_argument("paths", nargs="+", metavar="PATH",
+                   help="recipe .yaml, build folder, or .urdf/.xacro/.sdf/.xml file")
     c.add_argument("--format", choices=["text", "json", "junit", "github"], default="text",
                    help="report format: text for people, json, junit (CI test reporters), github (annotations)")
     c.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
-                   help="where package://PKG/ meshes of a URDF are (repeatable)")
+                   help="folder of ROS package PKG: package://PKG/ meshes of a URDF, $(find PKG) in a xacro "
+                        "file (repeatable)")
     c.add_argument("--fail-on", choices=["error", "warning"], default="error",
                    help="lowest severity that makes the exit status 1 (default: error)")
     c.add_argument("--junit", metavar="FILE", help="also write the JUnit report to FILE (whatever --format says)")
@@ -97,7 +99,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="folder for report.html and its pictures (default: <build folder>/report)")
     r.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
     r.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
-                   help="where package://PKG/ meshes of a URDF are (repeatable)")
+                   help="folder of ROS package PKG: package://PKG/ meshes of a URDF, $(find PKG) in a xacro "
+                        "file (repeatable)")
 
     v = sub.add_parser("view", help="show the robot in the browser, rebuilt live as its recipe changes",
                        description="Serve a 3D view of the robot (joint sliders, visual/collision/inertia/"

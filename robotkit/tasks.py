@@ -24,6 +24,7 @@ from robotkit import actions
 from robotkit.emit import TEMPLATES, ros
 from robotkit.emit.env import template_dirs
 from robotkit.model.robot import Robot
+from robotkit.paths import file_stem
 
 STATE = ".robotkit"  # below the output folder: doit's database and intermediate JSON
 
@@ -190,7 +191,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             continue
         keys = sorted({g.shape.mesh.key for g in link.source_geoms() if g.shape.mesh is not None})
         deps = {k: facts[k] for k in keys}
-        target = str(state / "inertial" / f"{link.name}.json")
+        target = str(state / "inertial" / f"{file_stem(link.name)}.json")
         inertials[link.name] = target
         tasks.append({
             "name": f"{robot.name}:inertial:{link.name}",

@@ -101,16 +101,18 @@ def test_turret_bot_recipe_is_readable(tmp_path):
     result = import_file(ASSETS / "turret_bot/urdf/turret_bot.urdf", tmp_path / "turret_bot.yaml", PACKAGES, {})
     text = result.recipe_path.read_text(encoding="utf-8")
     data = yaml.safe_load(text)
-    assert [k for k in data] == ["robot", "units", "density", "materials", "links", "joints", "urdf_extras"]
+    assert [k for k in data] == ["robot", "units", "density", "values", "materials", "links", "joints", "urdf_extras"]
     # inertials as given, flow style for short vectors, no identity origins, shortest floats
     assert "    inertial: {mass: 16, com: [0, 0.5, 0], inertia: {ixx: 1.376, iyy: 0.317, izz: 1.607}}\n" in text
     assert "    origin: {xyz: [0, 0.05, 0.475]}\n" in text
     assert "origin: {xyz: [0, 0, 0]" not in text and "rpy: [0, 0, 0]" not in text
     assert "    limit: {lower: -3.14, upper: 3.14, effort: 1000, velocity: 50}\n" in text
     assert "collision" not in data["links"]["base"]  # same as the visual: the default
-    # mesh paths relative to the recipe
-    mesh = data["links"]["base"]["visual"]["mesh"]
-    assert not os.path.isabs(mesh) and (tmp_path / mesh).resolve() == (ASSETS / "turret_bot/meshes/base.stl").resolve()
+    # mesh paths relative to the recipe, their shared folder named once
+    assert data["links"]["base"]["visual"]["mesh"] == "${turret_bot_meshes}/base.stl"
+    folder = data["values"]["turret_bot_meshes"]
+    assert not os.path.isabs(folder) and (tmp_path / folder / "base.stl").resolve() == \
+        (ASSETS / "turret_bot/meshes/base.stl").resolve()
     # gazebo materials map onto the recipe's materials (the original paints base red, Gazebo/Green)
     assert data["materials"]["red"] == {"rgba": [0.8, 0, 0, 1], "gazebo": "Gazebo/Green"}
     # transmissions and the plugin block: verbatim, and listed in a warning
@@ -677,7 +679,7 @@ def test_untrusted_expressions_fail_clearly(tmp_path, monkeypatch, case):
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "evil.yaml", {}, {})
     lines = info.value.lines()
-    assert len(lines) == 1 and lines[0].startswith("evil.urdf.xacro: ")
+    assert len(lines) == 1 and lines[0].startswith("evil.urdf.xacro:3: ")
     if case != "getattr-string":  # python['vars'] is not there at all: xacro's own error
         assert "refusing to evaluate xacro expression" in lines[0], lines[0]
     assert not target.exists() and not (tmp_path / "evil.yaml").exists()
@@ -694,7 +696,7 @@ def test_untrusted_yaml_is_safe_loaded(tmp_path, monkeypatch):
     """)
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "y.yaml", {}, {})
-    assert info.value.lines()[0].startswith("y.urdf.xacro: xacro: ")
+    assert info.value.lines()[0].startswith("y.urdf.xacro:3: xacro: ")
     assert not (tmp_path / "PWNED").exists()
 
 
@@ -727,7 +729,7 @@ def test_missing_package_in_xacro(tmp_path, monkeypatch):
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "r.yaml", {}, {})
     assert info.value.lines() == [
-        "robot.urdf.xacro: package 'foo_description' not found; give --package-path foo_description=DIR"]
+        "robot.urdf.xacro:2: package 'foo_description' not found; give --package-path foo_description=DIR"]
     assert not (tmp_path / "r.yaml").exists()
 
 
@@ -738,7 +740,7 @@ def test_missing_package_in_an_included_file(tmp_path, monkeypatch, gripper_arm)
     with pytest.raises(RobotkitError) as info:
         import_file(top, tmp_path / "r.yaml", packages, ARM_ARGS)
     assert info.value.lines() == [
-        "src/gripper_arm_description/urdf/gripper_arm.urdf.xacro: package 'hand_description' not found; "
+        "src/gripper_arm_description/urdf/gripper_arm.urdf.xacro:9: package 'hand_description' not found; "
         "give --package-path hand_description=DIR"]
 
 
@@ -773,7 +775,7 @@ def test_missing_xacro_argument_and_bad_package_path(tmp_path, monkeypatch):
     """)
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "a.yaml", {}, {})
-    assert info.value.lines() == ["a.xacro: xacro argument 'link_name' is not set; give --arg link_name:=VALUE"]
+    assert info.value.lines() == ["a.xacro:2: xacro argument 'link_name' is not set; give --arg link_name:=VALUE"]
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "a.yaml", {"p": str(tmp_path / "nowhere")}, {"link_name": "b"})
     assert info.value.lines() == [f"--package-path p={tmp_path / 'nowhere'}: no such folder"]

@@ -40,6 +40,38 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     return locate(findings, path)
 
 
+def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, str]) -> list[Finding]:
+    """A xacro file expanded in the import's sandbox (``$(find)`` through ``package_paths``,
+    ``args`` as xacro arguments), then checked as the URDF it expands to; findings name the
+    xacro file."""
+    import re
+    import tempfile
+
+    from robotkit.importer.xacro_expand import check_package_paths, expand
+
+    packages = check_package_paths(package_paths)
+    text = expand(path, packages, args).text
+
+    def absolute(m: re.Match) -> str:  # relative mesh paths stay relative to the xacro file
+        uri = m.group(2)
+        if "://" in uri or Path(uri).is_absolute():
+            return m.group(0)
+        return f'{m.group(1)}{(path.parent / uri).absolute().as_posix()}{m.group(3)}'
+
+    text = re.sub(r'(<mesh\b[^>]*?\bfilename=")([^"]*)(")', absolute, text)
+    stem = path.name.removesuffix(".xacro").removesuffix(".urdf")
+    with tempfile.TemporaryDirectory(prefix="robotkit-check-") as tmp:
+        urdf = Path(tmp) / f"{stem}.urdf"
+        urdf.write_text(text, encoding="utf-8")
+        findings = check_urdf_file(urdf, packages)
+    # the expanded file vanishes: findings in it are placed in the xacro file (on the element
+    # when the name is written there literally)
+    moved = [replace(f, subject=str(path) if f.subject == str(urdf) else f.subject,
+                     file=None if f.file == str(urdf) else f.file, line=None if f.file == str(urdf) else f.line)
+             for f in findings]
+    return locate(moved, path)
+
+
 def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list[Finding]:
     """Every stage on a build folder: lints, validators, equivalence of the formats, what each
     consuming program sees, and the MuJoCo scene's own simulation.  Every stage always runs."""
@@ -136,11 +168,14 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
         return check_recipe(p, out_dir, args, report)
     if suffix == ".urdf":
         return check_urdf_file(p, package_paths)
+    if suffix == ".xacro":
+        return check_xacro_file(p, package_paths, args or {})
     if suffix in (".sdf", ".world"):
         return locate(validate_sdf(p) + _inertial_lints(p, "sdf"), p)
     if suffix == ".xml":
         return locate(validate_mjcf(p) or _inertial_lints(p, "mjcf"), p)
-    raise RobotkitError(Problem("unknown kind of file (expected a recipe .yaml, .urdf, .sdf or MJCF .xml)", file=path))
+    raise RobotkitError(Problem("unknown kind of file (expected a recipe .yaml, .urdf, .xacro, .sdf or MJCF .xml)",
+                                file=path))
 
 
 def _inertial_lints(path: Path, kind: str) -> list[Finding]:
@@ -200,6 +235,8 @@ def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None)
         return [c for loaded in load_recipes(p, args) for c in folder(Path(out_dir) / loaded.recipe.robot)]
     if suffix == ".urdf":
         return [("check_urdf", str(p)), ("consumer", f"robot '{p.stem}'")] + described(p)
+    if suffix == ".xacro":
+        return [("check_urdf", str(p)), ("consumer", f"robot '{p.name.removesuffix('.xacro').removesuffix('.urdf')}'")]
     if suffix in (".sdf", ".world"):
         return [("ign sdf -k", str(p))]
     return [("mujoco", str(p))]

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from robotkit.check.findings import Finding
+from robotkit.model import inertia_policy
 from robotkit.check.kinematics import NEGLIGIBLE
 from robotkit.errors import Problem, RobotkitError
 
@@ -64,6 +65,8 @@ class JointFacts:
     effort: float | None = None
     velocity: float | None = None
     mimic: str | None = None
+    parent: str | None = None
+    child: str | None = None
 
 
 # ---------------------------------------------------------------- reading a URDF
@@ -221,8 +224,10 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
         def num(attr):
             return float(lim.get(attr)) if lim is not None and lim.get(attr) is not None else None
 
+        ends = {end: (el.find(end).get("link") if el.find(end) is not None else None) for end in ("parent", "child")}
         joints.append(JointFacts(el.get("name"), el.get("type"), num("lower"), num("upper"), num("effort"),
-                                 num("velocity"), mimic.get("joint") if mimic is not None else None))
+                                 num("velocity"), mimic.get("joint") if mimic is not None else None,
+                                 ends["parent"], ends["child"]))
     return links, joints, problems
 
 
@@ -234,6 +239,7 @@ def lint(links: list[LinkFacts], joints: list[JointFacts], declared_mass: float 
     for link in links:
         out += lint_link(link)
     out += lint_joints(joints)
+    out += lint_massless_moving(links, joints)
     if declared_mass is not None:
         total = sum(l.mass or 0.0 for l in links)
         if abs(total - declared_mass) > MASS_TOLERANCE * declared_mass:
@@ -275,15 +281,17 @@ def lint_link(link: LinkFacts) -> list[Finding]:
         add("error", "inertia", "inertia is not a finite tensor")
         return out
     eig = np.linalg.eigvalsh(0.5 * (I + I.T))
-    if eig.min() <= 0:
-        add("error", "inertia", "inertia is not positive definite (principal moments "
-            + ", ".join(f"{e:.4g}" for e in eig) + ")", "compute it from the geometry instead of typing it")
-        return out
-    a, b, c = eig
-    if a + b < c * (1 - 1e-9):
-        add("error", "triangle-inequality", f"principal moments {a:.4g}, {b:.4g}, {c:.4g} violate "
-            "the triangle inequality (I1 + I2 >= I3): no real body has them",
-            "compute the inertia from the geometry instead of typing it")
+    if inertia_policy.defects(link.mass, I):  # the rules the import's repair follows
+        fixed = inertia_policy.repair(link.mass, I, link.mass)
+        hint = ("compute it from the geometry instead of typing it; the smallest repair (robotkit import "
+                "writes it): " + "; ".join(fixed.changes))
+        if eig.min() <= 0:
+            add("error", "inertia", "inertia is not positive definite (principal moments "
+                + ", ".join(f"{e:.4g}" for e in eig) + ")", hint)
+        else:
+            a, b, c = eig
+            add("error", "triangle-inequality", f"principal moments {a:.4g}, {b:.4g}, {c:.4g} violate "
+                "the triangle inequality (I1 + I2 >= I3): no real body has them", hint)
         return out
     volume = _link_volume(link)
     if volume:
@@ -412,6 +420,40 @@ def _box_check(link: LinkFacts, eig, points: np.ndarray, s: str) -> list[Finding
                     f"the equivalent inertia box ({' x '.join(f'{d:.3g}' for d in dims)} m) is {worst:.3g}x "
                     f"larger than the geometry ({' x '.join(f'{e:.3g}' for e in extent)} m) along a principal axis",
                     "the inertia does not fit the part: hand-typed or in the wrong units?")]
+
+
+MOVING = ("revolute", "continuous", "prismatic", "planar", "floating")
+
+
+def lint_massless_moving(links: list[LinkFacts], joints: list[JointFacts]) -> list[Finding]:
+    """A link that moves with no mass on it or on the links welded to it: MuJoCo refuses the
+    robot and Gazebo drops the link with everything below it."""
+    mass = {link.name: (link.mass or 0.0) for link in links}
+    given = {link.name for link in links if link.mass is not None}  # a mass <= 0 is the mass rule's
+    fixed_below: dict[str, list[str]] = {}
+    for j in joints:
+        if j.type == "fixed" and j.parent is not None and j.child is not None:
+            fixed_below.setdefault(j.parent, []).append(j.child)
+
+    def body_mass(name: str) -> float:
+        total, todo, seen = 0.0, [name], set()
+        while todo:
+            n = todo.pop()
+            if n in seen:
+                continue
+            seen.add(n)
+            total += mass.get(n, 0.0)
+            todo += fixed_below.get(n, [])
+        return total
+
+    out = []
+    for j in joints:
+        if j.type in MOVING and j.child in mass and j.child not in given and not body_mass(j.child) > 0:
+            out.append(Finding("error", "massless-moving", f"link '{j.child}'",
+                               f"moves (joint '{j.name}') but has no mass: MuJoCo refuses to load the robot and "
+                               "Gazebo drops the link with everything below it",
+                               "give it an <inertial>; robotkit import computes one from its geometry"))
+    return out
 
 
 def lint_joints(joints: list[JointFacts]) -> list[Finding]:

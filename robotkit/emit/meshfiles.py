@@ -3,7 +3,7 @@
 Shared by the emitters (URDF, SDF, MJCF) and the tasks that write the files:
 
 - visual geometry references the copied (or processed) visual file, except in MJCF, which
-  reads no COLLADA: a DAE becomes ``meshes/mjcf/<stem>.stl``;
+  reads no COLLADA and only binary STL: a DAE or an ASCII STL becomes ``meshes/mjcf/<stem>.stl``;
 - collision geometry references an OBJ in every format: Drake takes convex meshes only as
   OBJ, VTK or glTF; MuJoCo, Gazebo and RViz read OBJ too.  Collision pieces are written as OBJ
   by their task; any other mesh used for collision is converted to ``meshes/collision/<stem>.obj``.
@@ -19,10 +19,27 @@ import os
 MJCF_VISUAL_EXT = (".stl", ".obj")
 
 
+def is_ascii_stl(path: str) -> bool:
+    """Whether the STL file is ASCII: not the binary layout (84 bytes + 50 per triangle), whatever
+    its header says (binary files whose header starts with ``solid`` exist)."""
+    import struct
+
+    try:
+        size = os.path.getsize(path)
+        with open(path, "rb") as f:
+            head = f.read(84)
+    except OSError:
+        return False
+    if len(head) == 84 and size == 84 + 50 * struct.unpack("<I", head[80:84])[0]:
+        return False
+    return head.lstrip()[:5].lower() == b"solid"
+
+
 def visual_file(mesh, fmt: str) -> str:
     """Path below ``meshes/`` of the file a visual geom of format ``fmt`` references."""
     stem, ext = os.path.splitext(mesh.file_name)
-    if fmt == "mjcf" and ext.lower() not in MJCF_VISUAL_EXT:
+    if fmt == "mjcf" and (ext.lower() not in MJCF_VISUAL_EXT
+                          or ext.lower() == ".stl" and not mesh.processed and is_ascii_stl(mesh.source)):
         return f"mjcf/{stem}.stl"
     return mesh.path
 

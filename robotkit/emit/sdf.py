@@ -2,18 +2,19 @@
 
 Frames mirror URDF exactly: a joint's pose is relative to its parent link, a child link's
 pose is the joint frame (``relative_to`` the joint), the axis is expressed in the joint
-frame.  Fixed joints stay joints.  Massless links are ``<frame>``s, never links (an SDF link
-without an inertial weighs 1 kg in Gazebo and Drake): a massless link fixed to another is a
-frame attached to it and its geometry and sensors move into the link that carries it; a
-massless root with a fixed child is a frame on that child.  Joints named like a link are
+frame.  Fixed joints stay joints.  Massless links are ``<frame>``s where they can be (an SDF
+link without an inertial weighs 1 kg in Gazebo and Drake): a massless link fixed to another is
+a frame attached to it and its geometry and sensors move into the link that carries it; a
+massless root with a fixed child is a frame on that child.  A massless link that must stay a
+link (welded to the world, or moved by a joint) gets the URDF's explicit massless inertial.  Joints named like a link are
 renamed (:func:`joint_names`).  What SDF 1.9 cannot express is listed by :func:`losses`.
 """
 
 from __future__ import annotations
 
 from robotkit.emit.env import render
-from robotkit.emit.urdf import geom_context
-from robotkit.model.robot import Robot
+from robotkit.emit.urdf import MASSLESS, geom_context
+from robotkit.model.robot import Inertial, Robot
 
 SDF_VERSION = "1.9"
 JOINT_TYPES = {"revolute": "revolute", "continuous": "continuous", "prismatic": "prismatic", "fixed": "fixed"}
@@ -64,15 +65,20 @@ def extras_losses(robot: Robot, where: str) -> list[str]:
 def joint_names(robot: Robot) -> dict[str, str]:
     """SDF name of each joint: links, joints and frames share one namespace in an SDF model,
     so a joint named like a link (ANYmal's ``LF_HAA``) gets ``_joint`` appended (then a number)."""
-    taken = {link.name for link in robot.links}
+    return names_apart([link.name for link in robot.links], [j.name for j in robot.joints])
+
+
+def names_apart(links, joints) -> dict[str, str]:
+    """:func:`joint_names` on bare names (the import reports the renaming with them)."""
+    taken = set(links)
     out = {}
-    for j in robot.joints:
-        name, n = j.name, 1
+    for joint in joints:
+        name, n = joint, 1
         while name in taken:
-            name = f"{j.name}_joint" + (str(n) if n > 1 else "")
+            name = f"{joint}_joint" + (str(n) if n > 1 else "")
             n += 1
         taken.add(name)
-        out[j.name] = name
+        out[joint] = name
     return out
 
 
@@ -124,7 +130,10 @@ def context(robot: Robot) -> dict:
                              material=materials.get(g.material)) for g in visuals],
             "collisions": [dict(geom_context(robot, g, "collision"), uri=_uri(robot, g, "collision"))
                            for g in collisions],
-            "inertial": link.inertial,
+            # a massless link SDF must keep a link (welded to the world, or moved by a joint): the
+            # URDF emitter's explicit massless inertial, else Gazebo and Drake give it 1 kg
+            "inertial": link.inertial if link.inertial is not None else Inertial(MASSLESS, (0.0, 0.0, 0.0),
+                                                                                   (0.0,) * 6),
             "contact": link.contact,
         })
     joints = [{"j": j, "name": names[j.name], "type": JOINT_TYPES.get(j.type)} for j in robot.joints

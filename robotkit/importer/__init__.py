@@ -34,10 +34,44 @@ class ImportResult:
     """With ``recompute_inertials``: per link, the given and the recomputed inertial."""
     extras: list[str] = field(default_factory=list)
     """A label per element carried verbatim in ``urdf_extras``."""
+    repairs: dict[str, str] = field(default_factory=dict)
+    """Per link whose inertial the recipe changes from the original: what was wrong and what it does."""
+    joint_notes: dict[str, str] = field(default_factory=dict)
+    """Per joint the recipe changes from the original (a mimic of a fixed joint, lower == upper)."""
 
 
 def is_xacro(path: Path, text: str) -> bool:
     return path.name.endswith(".xacro") or any(ns in text for ns in XACRO_NAMESPACES)
+
+
+@dataclass
+class Read:
+    """What a reader makes of an input file: the URDF it describes, the other files it read."""
+
+    urdf: str
+    includes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+
+
+def _read_xacro(source: Path, raw: str, packages: dict[str, str], args: dict[str, str]) -> Read:
+    from robotkit.importer.xacro_expand import expand
+
+    expanded = expand(source, packages, args)
+    return Read(expanded.text, list(expanded.includes), list(expanded.warnings))
+
+
+def _read_urdf(source: Path, raw: str, packages: dict[str, str], args: dict[str, str]) -> Read:
+    warnings = [f"{display_path(source)} is not a xacro file; --arg {', '.join(args)} ignored"] if args else []
+    return Read(raw, [], warnings)
+
+
+READERS = {
+    "xacro": (is_xacro, _read_xacro),
+    "urdf": (lambda path, text: True, _read_urdf),
+}
+"""Input formats, tried in order: name -> (accepts(path, text), read(path, text, packages, args)).
+A reader turns its format into URDF text, which :mod:`robotkit.importer.urdf_to_recipe` maps
+onto the recipe; another format is another entry here."""
 
 
 def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_paths: dict[str, str] | None = None,
@@ -52,9 +86,11 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     ``copy_meshes`` copies the meshes below the recipe's folder (``meshes/``) instead of
     referencing them where they are.
     """
+    from robotkit.importer.meshes import _open_meshes
     from robotkit.importer.package_xml import package_metadata
+    from robotkit.importer.recipe_writer import name_mesh_folders
     from robotkit.importer.urdf_to_recipe import dump_recipe, urdf_to_recipe
-    from robotkit.importer.xacro_expand import check_package_paths, expand
+    from robotkit.importer.xacro_expand import check_package_paths
 
     if density is not None and not density > 0:
         raise RobotkitError(Problem(f"density must be > 0 (got {density!r})"))
@@ -69,15 +105,11 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         raise RobotkitError(Problem(f"cannot read file: {exc}", file=str(source))) from None
     warnings: list[str] = []
     inputs = [str(source)]
-    if is_xacro(source, raw):
-        expanded = expand(source, packages, args or {})
-        text = expanded.text
-        warnings.extend(expanded.warnings)
-        inputs.extend(expanded.includes)
-    else:
-        text = raw
-        if args:
-            warnings.append(f"{display_path(source)} is not a xacro file; --arg {', '.join(args)} ignored")
+    read = next(reader for accepts, reader in READERS.values() if accepts(source, raw))
+    got = read(source, raw, packages, args or {})
+    text = got.urdf
+    warnings.extend(got.warnings)
+    inputs.extend(got.includes)
 
     conv = urdf_to_recipe(text, source, out, packages, copy_meshes=copy_meshes,
                           recompute_inertials=recompute_inertials, density=density)
@@ -91,6 +123,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     if ros == "ros1":  # ros2 is the default
         recipe["ros"] = ros
     _open_meshes(conv, recipe, warnings, recompute_inertials)
+    name_mesh_folders(recipe)
     _validate(recipe, source)
 
     copied = []
@@ -108,18 +141,21 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
                       + ("at the recipe's density" if density is not None else "keeping each link's given mass"))
     else:
         header.append("inertials as given in the original (explicit)")
-    text_out = dump_recipe(recipe, header)
+    text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text(text_out, encoding="utf-8")
     try:
-        _check_resolves(tmp, out, conv.invalid_inertias)
+        _check_resolves(tmp, out)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
     os.replace(tmp, out)
 
-    result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras))
+    from robotkit.importer.inertials import _report_recomputed
+
+    result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
+                          repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes))
     if recompute_inertials:
         _report_recomputed(out, conv, result)
     return result
@@ -148,10 +184,9 @@ def _validate(recipe: dict, source: Path) -> None:
         raise RobotkitError(problems) from None
 
 
-def _check_resolves(recipe_file: Path, final: Path, invalid_inertias: set[str]) -> None:
-    """Load and resolve the written recipe as the build will.  Given inertias that the
-    build rejects were reported as warnings already: the recipe is still written, so that
-    the user can correct them in it."""
+def _check_resolves(recipe_file: Path, final: Path) -> None:
+    """Load and resolve the written recipe as the build will (given inertias that no real body
+    has were repaired by the import, each stated in the recipe)."""
     from dataclasses import replace
 
     from robotkit.tasks import load_robots
@@ -159,116 +194,5 @@ def _check_resolves(recipe_file: Path, final: Path, invalid_inertias: set[str]) 
     try:
         load_robots([recipe_file])
     except RobotkitError as exc:
-        keys = {f"links.{name}.inertial.inertia" for name in invalid_inertias}
-        rest = [replace(p, file=str(final) if p.file == str(recipe_file) else p.file)
-                for p in exc.problems if p.key not in keys]
-        if rest:
-            raise RobotkitError(rest) from None
-
-
-# ---------------------------------------------------------------- meshes that are not closed
-
-
-_CLOSED: dict[tuple, bool] = {}
-
-
-def mesh_is_closed(source: str, scale) -> bool:
-    """Whether robotkit's mesh task accepts the mesh without ``open_mesh: hull``."""
-    from robotkit.errors import MeshError
-    from robotkit.mesh.io import load_mesh, volume_mesh
-
-    st = os.stat(source)
-    key = (source, tuple(scale), st.st_mtime_ns, st.st_size)
-    if key not in _CLOSED:
-        try:
-            volume_mesh(load_mesh(source, scale), "error", os.path.basename(source))
-            _CLOSED[key] = True
-        except MeshError:
-            _CLOSED[key] = False
-    return _CLOSED[key]
-
-
-def _open_meshes(conv, recipe: dict, warnings: list[str], recompute: bool) -> None:
-    """A mesh that is not a closed volume needs ``open_mesh: hull`` only where an inertial is
-    computed from it (robotkit accepts open meshes that are only drawn and collided)."""
-    open_by_link: dict[str, list[tuple[str, str]]] = {}
-    for (link, kind, _i), use in conv.meshes.items():
-        if not mesh_is_closed(use.source, use.scale):
-            names = open_by_link.setdefault(link, [])
-            if (kind, os.path.basename(use.source)) not in names:
-                names.append((kind, os.path.basename(use.source)))
-    top_level = []
-    for link, found in open_by_link.items():
-        spec = recipe["links"][link].get("inertial")
-        if spec == "none" or (isinstance(spec, dict) and "inertia" in spec):
-            continue  # no inertial is computed from the link's geometry
-        source = spec.get("source", "visual") if isinstance(spec, dict) else "visual"
-        read = [name for kind, name in found if kind == source]
-        if not read:
-            continue
-        files = ", ".join(dict.fromkeys(read))
-        if isinstance(spec, dict):
-            spec["open_mesh"] = "hull"
-            warnings.append(f"link '{link}': mesh {files} is not a closed volume; its recomputed inertial "
-                            "uses the convex hull (open_mesh: hull)")
-        else:
-            top_level.append(f"{link} ({files})")
-    if top_level:
-        recipe["open_mesh"] = "hull"
-        warnings.append("meshes that are not closed volumes on links whose inertial is computed from them: "
-                        f"{'; '.join(top_level)}; the recipe sets open_mesh: hull")
-
-
-# ---------------------------------------------------------------- recomputed inertials
-
-
-def _facts(mesh) -> dict:
-    """Unit-density mass properties of one mesh, as robotkit's mesh task records them."""
-    import numpy as np
-
-    from robotkit.mesh.inertia import mesh_mass_properties
-    from robotkit.mesh.io import load_mesh, volume_mesh
-
-    m = load_mesh(mesh.source, mesh.scale)
-    bbox_min, bbox_max = m.bounds
-    vol, _, _, _ = volume_mesh(m, mesh.open_mesh, os.path.basename(mesh.source))
-    props = mesh_mass_properties(vol.vertices, vol.faces)
-    return {"volume": props.volume, "com": [float(v) for v in props.com],
-            "inertia": [[float(v) for v in row] for row in np.asarray(props.inertia)],
-            "bbox_min": [float(v) for v in bbox_min], "bbox_max": [float(v) for v in bbox_max]}
-
-
-def _report_recomputed(recipe_file: Path, conv, result: ImportResult) -> None:
-    import numpy as np
-
-    from robotkit.model.resolve import finalize_link_inertial
-    from robotkit.tasks import load_robots
-
-    (_, robot), = load_robots([recipe_file])
-    facts: dict[str, dict] = {}
-    for link in robot.links:
-        if link.inertial_spec.mode not in ("mass", "density") or link.name not in conv.explicit:
-            continue
-        for g in link.source_geoms():
-            if g.shape.mesh is not None and g.shape.mesh.key not in facts:
-                facts[g.shape.mesh.key] = _facts(g.shape.mesh)
-        new = finalize_link_inertial(link, facts)
-        given = conv.explicit[link.name]
-        t = given["inertia"]
-        I0 = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
-        I1 = new.tensor()
-        com_shift = float(np.linalg.norm(np.asarray(new.com) - np.asarray(given["com"])))
-        rel = float(np.linalg.norm(I1 - I0) / max(np.linalg.norm(I0), 1e-300))
-        result.inertials[link.name] = {
-            "given": {"mass": given["mass"], "com": list(given["com"]), "inertia": I0.tolist()},
-            "computed": {"mass": new.mass, "com": list(new.com), "inertia": I1.tolist()},
-            "com_shift": com_shift, "inertia_rel_diff": rel,
-        }
-        mass = (f"mass {new.mass:.6g} kg (given {given['mass']:.6g})" if link.inertial_spec.mode == "density"
-                else f"mass {new.mass:.6g} kg kept")
-        d0 = ", ".join(f"{v:.4g}" for v in np.diag(I0))
-        d1 = ", ".join(f"{v:.4g}" for v in np.diag(I1))
-        result.warnings.append(
-            f"link '{link.name}': recomputed inertial from its {link.inertial_spec.source} geometry: {mass}; "
-            f"centre of mass moved {com_shift * 1000:.3g} mm; inertia tensor differs by {rel * 100:.3g}% "
-            f"(diagonal given {d0}, now {d1} kg m^2)")
+        raise RobotkitError([replace(p, file=str(final) if p.file == str(recipe_file) else p.file)
+                             for p in exc.problems]) from None

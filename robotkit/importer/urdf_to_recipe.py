@@ -29,22 +29,21 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from robotkit.importer.inertials import (  # noqa: F401  (no_inertial_form: used by the tests)
+    _explicit_dict, _give_moving_links_mass, _inertial, _tensor, no_inertial_form,
+)
+from robotkit.importer.meshes import MeshResolver, MeshUse
+from robotkit.importer.names import _material_name, _name_hint, _valid_frame_name, _valid_name
+from robotkit.importer.parsing import _Problems, _float, _floats, _fmt_list, _local, _origin, _origin_dict
+from robotkit.importer.recipe_writer import dump_recipe, fmt  # noqa: F401  (the import's writer)
+from robotkit.model import inertia_policy
 from robotkit.errors import Problem, RobotkitError, display_path
-from robotkit.recipe.schema import NAME_RE, UNITS
+from robotkit.recipe.schema import FRAME_NAME_RE, NAME_RE, UNITS
 
 GREY = [0.5, 0.5, 0.5, 1.0]
-TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "materials", "links", "joints", "urdf_extras")
-MESH_FORMATS = (".stl", ".obj", ".dae")
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
 
 
-@dataclass
-class MeshUse:
-    """One mesh file named by the URDF: where it is and where the recipe points."""
-
-    source: str  # absolute path of the file found
-    recipe_path: str  # absolute path the recipe names (source, or its copy)
-    scale: tuple[float, float, float]
 
 
 @dataclass
@@ -55,152 +54,34 @@ class Converted:
     meshes: dict[tuple[str, str, int], MeshUse] = field(default_factory=dict)  # (link, kind, i)
     explicit: dict[str, dict] = field(default_factory=dict)  # link -> the given inertial
     extras: list[str] = field(default_factory=list)  # a short label per verbatim element
-    invalid_inertias: set[str] = field(default_factory=set)  # links whose given inertia the build rejects
+    repairs: dict[str, str] = field(default_factory=dict)  # link -> what was wrong and what the recipe does
+    joint_notes: dict[str, str] = field(default_factory=dict)  # joint -> what the recipe changes from the original
 
 
-def no_inertial_form():
-    """The recipe value that says "this link has no inertial", if the schema has one."""
-    from pydantic import ValidationError
-
-    from robotkit.recipe.schema import Link
-
-    for value in ("none",):
-        try:
-            Link.model_validate({"visual": {"box": {"size": [1, 1, 1]}}, "inertial": value})
-            return value
-        except ValidationError:
-            continue
-    return None
 
 
 # ---------------------------------------------------------------- parsing helpers
 
 
-class _Problems:
-    def __init__(self, file: str):
-        self.file = file
-        self.items: list[Problem] = []
-
-    def add(self, message: str):
-        self.items.append(Problem(message, file=self.file))
-
-    def raise_if_any(self):
-        if self.items:
-            raise RobotkitError(self.items)
 
 
-def _floats(text: str | None, n: int, what: str, problems: _Problems, default=None):
-    if text is None:
-        return list(default) if default is not None else None
-    parts = text.split()
-    try:
-        values = [float(p) for p in parts]
-    except ValueError:
-        values = []
-    if len(values) != n or not all(math.isfinite(v) for v in values):
-        problems.add(f"{what}: '{text}' is not {n} finite number{'s' if n > 1 else ''}")
-        return list(default) if default is not None else None
-    return [v + 0.0 for v in values]  # no -0.0
 
 
-def _float(text, what, problems, default=None):
-    values = _floats(text, 1, what, problems, None if default is None else [default])
-    return None if values is None else values[0]
 
 
-def _origin(el: ET.Element | None, what: str, problems: _Problems):
-    """(xyz, rpy) of an <origin> child, zeros when absent."""
-    if el is None:
-        return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
-    xyz = _floats(el.get("xyz"), 3, f"{what} origin xyz", problems, [0.0, 0.0, 0.0])
-    rpy = _floats(el.get("rpy"), 3, f"{what} origin rpy", problems, [0.0, 0.0, 0.0])
-    return xyz, rpy
 
 
-def _origin_dict(xyz, rpy) -> dict | None:
-    out = {}
-    if any(xyz):
-        out["xyz"] = list(xyz)
-    if any(rpy):
-        out["rpy"] = list(rpy)
-    return out or None
 
 
-def _valid_name(name: str | None) -> bool:
-    return bool(name) and bool(NAME_RE.match(name))
 
 
-def _material_name(name: str, taken: set[str]) -> str:
-    base = re.sub(r"[^A-Za-z0-9_.\-]", "_", name or "material")
-    if not re.match(r"[A-Za-z_]", base):
-        base = "_" + base
-    out, i = base, 2
-    while out in taken:
-        out, i = f"{base}_{i}", i + 1
-    return out
+
+
 
 
 # ---------------------------------------------------------------- mesh files
 
 
-class MeshResolver:
-    def __init__(self, source: Path, recipe_dir: Path, packages: dict[str, str], copy: bool):
-        self.source = source
-        self.recipe_dir = recipe_dir
-        self.packages = packages
-        self.copy = copy
-        self.copies: dict[str, str] = {}  # destination -> source
-        self._dest_of: dict[str, str] = {}
-
-    def locate(self, uri: str, link: str, problems: _Problems) -> str | None:
-        """Absolute path of the file ``uri`` names, or None with a problem."""
-        path = None
-        m = re.match(r"^(package|model)://([^/]+)/(.+)$", uri)
-        if m:
-            pkg, rest = m.group(2), m.group(3)
-            if pkg not in self.packages:
-                problems.add(f"link '{link}': mesh '{uri}': package '{pkg}' not found; "
-                             f"give --package-path {pkg}=DIR")
-                return None
-            path = os.path.join(self.packages[pkg], rest)
-        elif uri.startswith("file://"):
-            path = uri[len("file://"):]
-            if not os.path.isabs(path):
-                path = os.path.join(self.source.parent, path)
-        elif re.match(r"^[A-Za-z][A-Za-z0-9+.\-]*://", uri):
-            problems.add(f"link '{link}': mesh '{uri}': unsupported URI scheme "
-                         "(use package://, file:// or a path)")
-            return None
-        else:
-            path = uri if os.path.isabs(uri) else os.path.join(self.source.parent, uri)
-        path = os.path.normpath(path)
-        if not os.path.isfile(path):
-            problems.add(f"link '{link}': mesh '{uri}' not found (looked for {display_path(path)})")
-            return None
-        if os.path.splitext(path)[1].lower() not in MESH_FORMATS:
-            problems.add(f"link '{link}': mesh '{uri}' has an unsupported format (robotkit reads STL, OBJ and DAE)")
-            return None
-        return path
-
-    def destination(self, path: str, uri: str) -> str:
-        """Where the recipe points for the file at ``path`` (a copy below the recipe, or it)."""
-        if not self.copy:
-            return path
-        if path in self._dest_of:
-            return self._dest_of[path]
-        m = re.match(r"^(package|model)://(.+)$", uri)
-        rel = m.group(2) if m else os.path.basename(path)
-        dest = os.path.normpath(os.path.join(self.recipe_dir, "meshes", rel))
-        stem, ext = os.path.splitext(dest)
-        i = 2
-        while dest in self.copies and self.copies[dest] != path:
-            dest, i = f"{stem}_{i}{ext}", i + 1
-        self.copies[dest] = path
-        self._dest_of[path] = dest
-        return dest
-
-    def recipe_text(self, dest: str) -> str:
-        return Path(os.path.relpath(dest, self.recipe_dir)).as_posix()
 
 
 # ---------------------------------------------------------------- the conversion
@@ -289,7 +170,7 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         if _local(el.tag) != "link":
             continue
         name = el.get("name")
-        if not _valid_name(name):
+        if not _valid_frame_name(name):
             problems.add(f"link name '{name}' is not a valid recipe name ({_name_hint()})")
             continue
         if name in links:
@@ -299,15 +180,16 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         visuals, collisions, vis_materials = [], [], []
         for kind, items in (("visual", visuals), ("collision", collisions)):
             for i, g_el in enumerate(el.findall(kind)):
-                geom = _geometry(g_el, name, kind, len(items), resolver, problems, warnings, out)
-                if geom is None:
+                made = _geometry(g_el, name, kind, len(items), resolver, problems, warnings, out)
+                if made is None:
                     continue
-                if kind == "visual":
-                    mat = g_el.find("material")
-                    if mat is not None:
-                        geom["material"] = material_ref(mat, name)
-                        vis_materials.append(geom["material"])
-                items.append(geom)
+                for geom in made if isinstance(made, list) else [made]:
+                    if kind == "visual":
+                        mat = g_el.find("material")
+                        if mat is not None:
+                            geom["material"] = material_ref(mat, name)
+                            vis_materials.append(geom["material"])
+                    items.append(geom)
         for child in el:
             if _local(child.tag) not in ("visual", "collision", "inertial"):
                 warnings.append(f"link '{name}': <{_local(child.tag)}> is dropped (the recipe has no place for it)")
@@ -340,12 +222,14 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
                 if recompute_inertials:
                     warnings.append(f"link '{name}' has no geometry to compute an inertial from; "
                                     "its inertial is kept as given")
+                wrong = inertia_policy.defects(given["mass"], _tensor(given["inertia"]))
+                if wrong:
+                    fixed = inertia_policy.repair(given["mass"], _tensor(given["inertia"]), given["mass"])
+                    t = fixed.inertia
+                    given = dict(given, inertia={k: float(v) + 0.0 for k, v in {"ixx": t[0, 0], "ixy": t[0, 1], "ixz": t[0, 2],
+                                                 "iyy": t[1, 1], "iyz": t[1, 2], "izz": t[2, 2]}.items()})
+                    out.repairs[name] = (f"the original's {'; '.join(wrong)}: repaired ({'; '.join(fixed.changes)})")
                 link["inertial"] = _explicit_dict(given)
-                problem = _inertia_problem(given)
-                if problem:
-                    out.invalid_inertias.add(name)
-                    warnings.append(f"link '{name}': the given inertia {problem}; the build will reject it: "
-                                    "correct it in the recipe or import with --recompute-inertials")
         else:
             if given is not None and given["mass"] < 0:
                 problems.add(f"link '{name}': negative mass {given['mass']!r}")
@@ -366,7 +250,7 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         if _local(el.tag) != "joint":
             continue
         name = el.get("name")
-        if not _valid_name(name):
+        if not _valid_frame_name(name):
             problems.add(f"joint name '{name}' is not a valid recipe name ({_name_hint()})")
             continue
         if name in joints:
@@ -376,14 +260,31 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         if joint is None:
             continue
         for end in ("parent", "child"):
-            if joint[end] not in links and _valid_name(joint[end]):
+            if joint[end] not in links and _valid_frame_name(joint[end]):
                 problems.add(f"joint '{name}': {end} link '{joint[end]}' is not defined")
         joints[name] = joint
         joint_types[name] = joint["type"]
     for name, joint in joints.items():
+        note = joint.pop("__note", None)
+        if note:
+            out.joint_notes[name] = note
+    from robotkit.emit.sdf import names_apart
+
+    for name, sdf_name in names_apart(links, joints).items():
+        if sdf_name != name:  # ROS accepts it; an SDF model has one namespace for links and joints
+            note = f"named like a link in the original: SDF, where links and joints share names, calls it '{sdf_name}'"
+            out.joint_notes[name] = "; ".join(filter(None, (out.joint_notes.get(name), note)))
+            warnings.append(f"joint '{name}': {note}")
+    for name, joint in joints.items():
         mimic = joint.get("mimic")
         if mimic and mimic["joint"] not in joints:
             problems.add(f"joint '{name}': mimics joint '{mimic['joint']}', which is not defined")
+        elif mimic and joints[mimic["joint"]]["type"] == "fixed":
+            note = (f"mimicked fixed joint '{mimic['joint']}' in the original: a fixed joint has no position to "
+                    "follow, so the mimic is dropped and the joint moves on its own")
+            del joint["mimic"]
+            out.joint_notes[name] = note
+            warnings.append(f"joint '{name}': {note}")
 
     # ---- everything else: gazebo blocks (partly mapped), transmissions, ... verbatim
     extras: list[str] = []
@@ -414,6 +315,9 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
                         f"urdf_extras: {', '.join(out.extras)}")
 
     problems.raise_if_any()
+    _give_moving_links_mass(links, joints, out)
+    for link, why in out.repairs.items():
+        warnings.append(f"link '{link}': {why}")
     recipe: dict = {"robot": robot_name, "units": "m", "density": density if density is not None else 1000.0}
     if materials:
         recipe["materials"] = materials
@@ -428,20 +332,10 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
     return out
 
 
-def _name_hint() -> str:
-    from robotkit.recipe.schema import NAME_HINT
-
-    return NAME_HINT
 
 
-def _local(tag) -> str:
-    if not isinstance(tag, str):
-        return "#comment"
-    return tag.rsplit("}", 1)[-1]
 
 
-def _fmt_list(values) -> str:
-    return "[" + ", ".join(fmt(v) for v in values) + "]"
 
 
 def _rgba(el: ET.Element, what: str, problems: _Problems, warnings: list[str]):
@@ -462,11 +356,15 @@ def _geometry(el: ET.Element, link: str, kind: str, index: int, resolver: MeshRe
     what = f"link '{link}' {kind}"
     geometry = el.find("geometry")
     shapes = [c for c in geometry] if geometry is not None else []
-    if len(shapes) != 1:
-        problems.add(f"{what}: <geometry> must hold exactly one shape (found {len(shapes)})")
+    if not shapes:
+        problems.add(f"{what}: <geometry> holds no shape")
         return None
-    shape = shapes[0]
+    shape = shapes[0]  # urdfdom reads the first element and ignores the rest
     tag = _local(shape.tag)
+    if len(shapes) > 1:
+        rest = ", ".join(f"<{_local(c.tag)}>" for c in shapes[1:])
+        warnings.append(f"{what}: <geometry> holds more than one element; the first (<{tag}>) is used, as "
+                        f"urdfdom does, and {rest} ignored")
     geom: dict = {}
     if tag == "mesh":
         uri = (shape.get("filename") or "").strip()
@@ -517,6 +415,18 @@ def _geometry(el: ET.Element, link: str, kind: str, index: int, resolver: MeshRe
             warnings.append(f"{what}: sphere of radius {radius!r} has no volume; dropped")
             return None
         geom["sphere"] = {"radius": radius}
+    elif tag == "capsule":  # PyBullet's extension: a cylinder along z with hemispherical ends
+        radius = _float(shape.get("radius"), f"{what} capsule radius", problems)
+        length = _float(shape.get("length"), f"{what} capsule length", problems)
+        if radius is None or length is None:
+            return None
+        if radius <= 0 or length < 0:
+            warnings.append(f"{what}: capsule of radius {radius!r} and length {length!r} has no volume; dropped")
+            return None
+        xyz, rpy = _origin(el.find("origin"), what, problems)
+        warnings.append(f"{what}: <capsule> (PyBullet's, not in the URDF standard) is written as a cylinder "
+                        "and two spheres, the same solid")
+        return _capsule(radius, length, xyz, rpy)
     else:
         problems.add(f"{what}: <{tag}> geometry is not supported (use mesh, box, cylinder or sphere)")
         return None
@@ -526,6 +436,30 @@ def _geometry(el: ET.Element, link: str, kind: str, index: int, resolver: MeshRe
     return geom
 
 
+def _capsule(radius: float, length: float, xyz, rpy) -> list[dict]:
+    """A capsule (the cylinder's ``length`` between the centres of its end spheres) as shapes."""
+    import numpy as np
+
+    from robotkit.model.robot import rpy_matrix
+
+    axis = rpy_matrix(rpy) @ np.array([0.0, 0.0, length / 2])
+    out = []
+    if length > 0:
+        cyl: dict = {"cylinder": {"radius": radius, "length": length}}
+        origin = _origin_dict(xyz, rpy)
+        if origin:
+            cyl["origin"] = origin
+        out.append(cyl)
+    for sign in ((1.0, -1.0) if length > 0 else (1.0,)):
+        centre = [float(c + sign * a) + 0.0 for c, a in zip(xyz, axis)]
+        sph: dict = {"sphere": {"radius": radius}}
+        origin = _origin_dict(centre, (0.0, 0.0, 0.0))
+        if origin:
+            sph["origin"] = origin
+        out.append(sph)
+    return out
+
+
 def _same_shapes(visuals: list[dict], collisions: list[dict]) -> bool:
     if not visuals or len(visuals) != len(collisions):
         return False
@@ -533,64 +467,16 @@ def _same_shapes(visuals: list[dict], collisions: list[dict]) -> bool:
     return all(strip(v) == strip(c) for v, c in zip(visuals, collisions))
 
 
-def _inertial(el: ET.Element, link: str, problems: _Problems) -> dict | None:
-    what = f"link '{link}' inertial"
-    mass_el = el.find("mass")
-    mass = _float(mass_el.get("value") if mass_el is not None else None, f"{what} mass", problems, 0.0)
-    xyz, rpy = _origin(el.find("origin"), what, problems)
-    t = el.find("inertia")
-    keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-    values = {k: 0.0 for k in keys}
-    if t is not None:
-        for k in keys:
-            v = _float(t.get(k), f"{what} {k}", problems, 0.0)
-            values[k] = v if v is not None else 0.0
-    if any(rpy):
-        import numpy as np
-
-        from robotkit.model.robot import rpy_matrix
-
-        I = np.array([[values["ixx"], values["ixy"], values["ixz"]],
-                      [values["ixy"], values["iyy"], values["iyz"]],
-                      [values["ixz"], values["iyz"], values["izz"]]])
-        R = rpy_matrix(rpy)
-        I = R @ I @ R.T
-        I = 0.5 * (I + I.T)
-        scale = float(np.abs(I).max())
-        I[np.abs(I) < 1e-14 * scale] = 0.0
-        values = {"ixx": I[0, 0], "ixy": I[0, 1], "ixz": I[0, 2], "iyy": I[1, 1], "iyz": I[1, 2], "izz": I[2, 2]}
-        values = {k: float(v) + 0.0 for k, v in values.items()}
-    return {"mass": mass if mass is not None else 0.0, "com": xyz, "inertia": values, "rpy": rpy}
 
 
-def _explicit_dict(given: dict) -> dict:
-    out: dict = {"mass": given["mass"]}
-    if any(given["com"]):
-        out["com"] = list(given["com"])
-    t = given["inertia"]
-    inertia = {k: t[k] for k in ("ixx", "iyy", "izz")}
-    for k in ("ixy", "ixz", "iyz"):
-        if t[k] != 0.0:
-            inertia[k] = t[k]
-    out["inertia"] = inertia
-    return out
 
 
-def _inertia_problem(given: dict) -> str | None:
-    """Why robotkit's resolver would reject the tensor (see model.resolve._check_explicit)."""
-    import numpy as np
 
-    t = given["inertia"]
-    I = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
-    if not np.all(np.isfinite(I)):
-        return "is not finite"
-    eig = np.linalg.eigvalsh(I)
-    if eig.min() <= 0:
-        return "is not positive definite"
-    a, b, c = eig
-    if a + b < c * (1 - 1e-9):
-        return "violates the triangle inequality"
-    return None
+
+
+
+
+
 
 
 def _joint(el: ET.Element, name: str, problems: _Problems, warnings: list[str]) -> dict | None:
@@ -627,15 +513,25 @@ def _joint(el: ET.Element, name: str, problems: _Problems, warnings: list[str]) 
                     problems.add(f"{what}: <limit> needs {key} (URDF requires effort and velocity)")
                     return None
                 limit[key] = v
-            if limit["lower"] >= limit["upper"]:
+            if limit["lower"] == limit["upper"] and jtype == "revolute":
+                # urdfdom's default limits are lower = upper = 0: files that mean "free" write that
+                note = (f"limit lower == upper ({limit['lower']!r}) in the original: read as no position limit "
+                        "(lower and upper default to 0 in URDF), the joint is continuous")
+                warnings.append(f"{what}: {note}")
+                joint["type"] = "continuous"
+                joint["__note"] = note
+                kept = {k: abs(limit[k]) for k in ("effort", "velocity")}
+                joint["limit"] = kept
+            elif limit["lower"] >= limit["upper"]:
                 problems.add(f"{what}: limit lower ({limit['lower']!r}) is not below upper ({limit['upper']!r}); "
                              "a recipe cannot express a locked revolute or prismatic joint (make it fixed)")
                 return None
-            for key in ("effort", "velocity"):
-                if limit[key] < 0:
-                    warnings.append(f"{what}: negative {key} limit {limit[key]!r}; using its magnitude")
-                    limit[key] = -limit[key]
-            joint["limit"] = limit
+            else:
+                for key in ("effort", "velocity"):
+                    if limit[key] < 0:
+                        warnings.append(f"{what}: negative {key} limit {limit[key]!r}; using its magnitude")
+                        limit[key] = -limit[key]
+                joint["limit"] = limit
         elif jtype == "continuous":
             limit = {}
             for key in ("effort", "velocity"):
@@ -849,105 +745,19 @@ def _all_attr_names(node):
 # ---------------------------------------------------------------- YAML
 
 
-def fmt(x: float) -> str:
-    """Shortest text that reads back as the same float64 (integral values without '.0')."""
-    x = float(x)
-    if x == 0:
-        return "0"
-    if x.is_integer() and abs(x) < 1e16:
-        return str(int(x))
-    text = repr(x)
-    if "e" in text and "." not in text.split("e")[0]:
-        mantissa, exp = text.split("e")
-        text = f"{mantissa}.0e{exp}"
-    return text
 
 
-class _FlowList(list):
-    pass
 
 
-class _FlowMap(dict):
-    pass
 
 
-def _dumper():
-    import yaml
-
-    class Dumper(yaml.SafeDumper):
-        pass
-
-    def float_rep(dumper, value):
-        text = fmt(value)
-        tag = "tag:yaml.org,2002:int" if re.fullmatch(r"-?\d+", text) else "tag:yaml.org,2002:float"
-        return dumper.represent_scalar(tag, text)
-
-    def str_rep(dumper, value):
-        if "\n" in value:
-            return dumper.represent_scalar("tag:yaml.org,2002:str", value, style="|")
-        return dumper.represent_scalar("tag:yaml.org,2002:str", value)
-
-    Dumper.add_representer(float, float_rep)
-    Dumper.add_representer(str, str_rep)
-    Dumper.add_representer(_FlowList, lambda d, v: d.represent_sequence("tag:yaml.org,2002:seq", v, flow_style=True))
-    Dumper.add_representer(_FlowMap, lambda d, v: d.represent_mapping("tag:yaml.org,2002:map", v.items(),
-                                                                      flow_style=True))
-    Dumper.add_representer(dict, lambda d, v: d.represent_mapping("tag:yaml.org,2002:map", v.items(),
-                                                                  flow_style=False))
-    Dumper.ignore_aliases = lambda self, data: True
-    return Dumper
 
 
-def _styled(value, width: int):
-    """Flow style for number lists and for mappings short enough to read on one line."""
-    if isinstance(value, list):
-        if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-            return _FlowList(value)
-        return [_styled(v, width - 2) for v in value]
-    if isinstance(value, dict):
-        inner = {k: _styled(v, width - 2) for k, v in value.items()}
-        flat = all(not isinstance(v, (dict, list)) or isinstance(v, (_FlowList, _FlowMap)) for v in inner.values())
-        if flat and all(not (isinstance(v, str) and "\n" in v) for v in inner.values()):
-            candidate = _FlowMap(inner)
-            if len(_dump_one(candidate)) <= width:
-                return candidate
-        return inner
-    return value
 
 
-def _dump_one(value) -> str:
-    import yaml
-
-    return yaml.dump(value, Dumper=_dumper(), default_flow_style=False, sort_keys=False, width=10**9,
-                     allow_unicode=True).strip()
 
 
-def dump_recipe(recipe: dict, header: list[str] | None = None) -> str:
-    """The recipe as readable YAML: top-level keys in order, a blank line between sections,
-    flow style for short vectors and mappings."""
-    import yaml
-
-    parts = []
-    for line in header or []:
-        parts.append(f"# {line}".rstrip() + "\n")
-    keys = [k for k in TOP_KEYS if k in recipe] + [k for k in recipe if k not in TOP_KEYS]
-    scalars = [k for k in keys if not isinstance(recipe[k], (dict, list))]
-    sections = [k for k in keys if k not in scalars]
-    dumper = _dumper()
-    opts = dict(Dumper=dumper, default_flow_style=False, sort_keys=False, width=10**9, allow_unicode=True)
-    parts.append(yaml.dump({k: recipe[k] for k in scalars}, **opts))
-    for key in sections:
-        value = recipe[key]
-        if key == "materials":
-            styled = {name: _styled(m, 200) for name, m in value.items()}
-        elif key in ("links", "joints"):
-            styled = {name: _styled_entry(entry) for name, entry in value.items()}
-        else:
-            styled = _styled(value, 100)
-        parts.append("\n" + yaml.dump({key: styled}, **opts))
-    return "".join(parts)
 
 
-def _styled_entry(entry: dict) -> dict:
-    """A link or joint: its own keys in block style, each value as compact as reads well."""
-    return {k: _styled(v, 110 - len(k)) for k, v in entry.items()}
+
+

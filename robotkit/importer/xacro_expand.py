@@ -1,28 +1,33 @@
-"""Expand a xacro file in-process, with ``$(find PKG)`` resolved through a package map,
-and with xacro's expression evaluation locked down for untrusted input.
+"""Expand a xacro file in-process, sandboxed for untrusted input.
 
 xacro (2.1.1, the ROS 2 flavour from PyPI) is used as a library (LIBRARIES.md section 2):
 ``process_file``, never ``process()``; its state is module-global, so one expansion runs
 at a time (a lock) and every patch is undone afterwards.
 
-Untrusted files.  xacro evaluates ``${...}`` with Python's ``eval`` over a table of exposed
-names and rejects names that start with ``__``; ``$(eval ...)`` only rejects the text
-``__`` and then evaluates with Python's *full* builtins, so a xacro file can run
-``exec('import os; ...', {})`` (measured: it creates files).  While a file is expanded
-here:
+The sandbox blocks only what would run code, read outside the allowed folders or never end;
+ordinary xacro (any macro parameter or property name, block parameters, namespaces,
+``xacro.load_yaml``, ``$(dirname)``, ``$(arg)``, math) works as with ``xacro`` itself.
 
-- every expression (``${...}``, ``$(eval ...)``, the ``!degrees``-style YAML units) is
-  parsed and refused unless it is a plain expression over names and attributes that do
-  not start with ``_`` and that are not introspection or code-execution hooks (``exec``,
-  ``eval``, ``open``, ``getattr``, ``vars``, ``type``, ``format``, frame and code
-  attributes, ...);
-- ``$(eval ...)`` runs with a small set of harmless builtins instead of all of them;
-- the symbol table of ``${...}`` lacks ``python.vars`` and ``python.type``.
+- **Code.** xacro evaluates ``${...}`` with Python's ``eval`` over its symbol table (no
+  builtins) and ``$(eval ...)`` with Python's *full* builtins, so a xacro file can run
+  ``exec('import os; ...', {})``.  Here every expression is parsed first and refused when it
+  names a dunder (``__x``) or reaches an attribute that leads to code, frames or arbitrary
+  attributes (``x._y``, ``.format``, ``.mro``, ...); ``$(eval ...)`` runs with a small set
+  of harmless builtins; ``python.type`` and ``python.vars`` are removed from the symbols.
+  A name is looked up only in the file's own symbols, so a macro parameter called ``type``
+  or a property ``_tokens_`` is fine.
+- **Reads.** Includes, ``xacro.load_yaml`` and every file opened go through
+  :class:`robotkit.paths.ReadPolicy`: the input's project folder and the declared package
+  paths.  ``$(find PKG)`` and ``$(find-pkg-share PKG)`` resolve only declared packages.
+- **Environment.** ``$(optenv NAME default)`` gives its default and ``$(env NAME)`` is an
+  error: an imported recipe does not depend on the environment of whoever imported it
+  (pass such values as ``--arg``).
+- **Limits.** An expansion stops after :data:`TIME_LIMIT` seconds; integer powers, shifts and
+  repetitions with results above :data:`MAX_BITS` bits or :data:`MAX_ITEMS` items, and
+  ranges longer than :data:`MAX_ITEMS`, are refused (``${9**9**9}``).
 
-What stays possible is what xacro's own restricted evaluation allows: arithmetic, the
-math functions, ``xacro.load_yaml`` (YAML safe-loaded), reading files through
-``xacro:include`` and ``$(env ...)``.  A file can still make expansion slow or large
-(``${9**9**9}``); run imports of untrusted files with a time limit.
+Every error names the file and the line of the element being expanded (xacro itself only
+names the file): the parser records each element's line, kept through macro cloning.
 """
 
 from __future__ import annotations
@@ -30,8 +35,10 @@ from __future__ import annotations
 import ast
 import contextlib
 import io
+import math
 import os
 import threading
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -39,14 +46,24 @@ from robotkit.errors import Problem, RobotkitError
 
 _LOCK = threading.Lock()
 
+TIME_LIMIT = 60.0
+"""Seconds one expansion may take."""
+MAX_BITS = 1 << 16
+"""Largest integer (in bits) an expression may compute."""
+MAX_ITEMS = 1 << 22
+"""Longest string, list or range an expression may build."""
+
 # names that must never be called or reached from an expression
 DENIED_NAMES = frozenset({
     "exec", "eval", "compile", "open", "input", "breakpoint", "help", "exit", "quit",
     "getattr", "setattr", "delattr", "hasattr", "vars", "dir", "globals", "locals", "type",
     "object", "super", "memoryview", "classmethod", "staticmethod", "property",
 })
-# attributes that lead from a value to code, frames or arbitrary attributes
-DENIED_ATTRS = DENIED_NAMES | frozenset({
+# attributes that lead from a value to code, frames or arbitrary attributes (a YAML key such
+# as ``type`` or ``object`` read as ``cfg.joint.type`` is the file's own data)
+DENIED_ATTRS = frozenset({
+    "exec", "eval", "compile", "open", "breakpoint", "getattr", "setattr", "delattr", "globals", "locals", "vars",
+}) | frozenset({
     "format", "format_map", "mro", "gi_frame", "gi_code", "gi_yieldfrom", "cr_frame", "cr_code",
     "cr_await", "ag_frame", "ag_code", "ag_await", "f_back", "f_globals", "f_locals", "f_builtins",
     "f_code", "f_trace", "tb_frame", "tb_next", "co_code", "co_consts", "func_globals", "func_code",
@@ -70,8 +87,12 @@ class _MissingPackage(Exception):
         self.package = package
 
 
-def check_expression(expr: str) -> None:
-    """Raise :class:`UnsafeExpression` unless ``expr`` is a harmless Python expression."""
+def check_expression(expr: str, defined=lambda name: False) -> None:
+    """Raise :class:`UnsafeExpression` unless ``expr`` is a harmless Python expression.
+
+    ``defined(name)`` says whether the file itself defines ``name`` (a property, a macro
+    parameter, an argument): such a name is the file's own value, whatever it is called.
+    """
     try:
         tree = ast.parse(expr.strip(), mode="eval")
     except SyntaxError:
@@ -80,6 +101,8 @@ def check_expression(expr: str) -> None:
     for node in ast.walk(tree):
         if isinstance(node, ast.Name):
             name = node.id
+            if not name.startswith("__") and defined(name):
+                continue
         elif isinstance(node, ast.Attribute):
             name = node.attr
         elif isinstance(node, ast.NamedExpr):
@@ -94,6 +117,74 @@ def check_expression(expr: str) -> None:
             found.append((where, f"{name!r} is not allowed"))
     if found:
         raise UnsafeExpression(min(found)[1])
+
+
+class ExpansionLimit(Exception):
+    """The expansion would take too long or build too large a value."""
+
+
+class _Limits:
+    """Arithmetic that refuses huge results, and the expansion's deadline."""
+
+    def __init__(self, seconds: float):
+        self.deadline = time.monotonic() + seconds
+        self.seconds = seconds
+
+    def tick(self):
+        if time.monotonic() > self.deadline:
+            raise ExpansionLimit(f"the expansion takes longer than {self.seconds:g} s")
+
+    @staticmethod
+    def _bits(x) -> float:
+        return abs(x).bit_length() if isinstance(x, int) and not isinstance(x, bool) else 0
+
+    def pow(self, a, b):
+        if isinstance(a, int) and isinstance(b, int) and b > 0 and abs(a) > 1:
+            if b * math.log2(abs(a)) > MAX_BITS:
+                raise ExpansionLimit(f"{a}**{b} has more than {MAX_BITS} bits")
+        return a ** b
+
+    def mul(self, a, b):
+        for seq, n in ((a, b), (b, a)):
+            if isinstance(seq, (str, list, tuple, bytes)) and isinstance(n, int) and len(seq) * n > MAX_ITEMS:
+                raise ExpansionLimit(f"a repetition of more than {MAX_ITEMS} items")
+        if self._bits(a) + self._bits(b) > MAX_BITS:
+            raise ExpansionLimit(f"a product of more than {MAX_BITS} bits")
+        return a * b
+
+    def lshift(self, a, b):
+        if isinstance(b, int) and b + self._bits(a) > MAX_BITS:
+            raise ExpansionLimit(f"a shift beyond {MAX_BITS} bits")
+        return a << b
+
+    def range(self, *args):
+        r = range(*args)
+        if len(r) > MAX_ITEMS:
+            raise ExpansionLimit(f"a range of more than {MAX_ITEMS} items")
+        return r
+
+
+_OPS = {ast.Pow: "__rk_pow", ast.Mult: "__rk_mul", ast.LShift: "__rk_lshift"}
+
+
+class _Guard(ast.NodeTransformer):
+    """``a ** b``, ``a * b``, ``a << b`` become calls of the :class:`_Limits` checks."""
+
+    def visit_BinOp(self, node):
+        self.generic_visit(node)
+        fn = _OPS.get(type(node.op))
+        if fn is None:
+            return node
+        return ast.copy_location(ast.Call(ast.Name(fn, ast.Load()), [node.left, node.right], []), node)
+
+
+def _compile_guarded(expr: str):
+    tree = _Guard().visit(ast.parse(expr.strip(), mode="eval"))
+    return compile(ast.fix_missing_locations(tree), "<expression>", "eval")
+
+
+def _guard_symbols(limits: _Limits) -> dict:
+    return {"__rk_pow": limits.pow, "__rk_mul": limits.mul, "__rk_lshift": limits.lshift}
 
 
 @dataclass
@@ -111,6 +202,62 @@ class Expanded:
 class _State:
     missing: str | None = None
     unsafe: tuple[str, str] | None = None  # (expression, reason)
+    blocked: str | None = None  # a read or an environment variable the sandbox refused
+    location: tuple[str, int] | None = None  # (file, line) of the element being expanded
+
+
+class _Blocked(Exception):
+    pass
+
+
+_LOC = "robotkit.location"
+
+
+class _KeepOnClone:
+    """minidom user-data handler: a cloned or imported node keeps the source location."""
+
+    def handle(self, operation, key, data, src, dst):
+        if dst is not None:
+            dst.setUserData(key, data, self)
+
+
+_KEEP = _KeepOnClone()
+
+
+def _parse_with_lines(source, file: str):
+    """minidom parse that records (file, line) on every element (xacro's own parse does not)."""
+    from xml.dom import expatbuilder
+
+    class Builder(expatbuilder.ExpatBuilderNS):
+        def start_element_handler(self, name, attributes):
+            super().start_element_handler(name, attributes)
+            self.curNode.setUserData(_LOC, (file, self._parser.CurrentLineNumber), _KEEP)
+
+    builder = Builder()
+    if isinstance(source, str):
+        return builder.parseString(source)
+    return builder.parseFile(source)
+
+
+def _node_location(node) -> tuple[str, int] | None:
+    while node is not None:
+        get = getattr(node, "getUserData", None)
+        loc = get(_LOC) if get is not None else None
+        if loc is not None:
+            return loc
+        node = getattr(node, "parentNode", None)
+    return None
+
+
+def _failing_location(tb, eval_all_code) -> tuple[str, int] | None:
+    """The element xacro was expanding when it failed: ``node`` in the innermost ``eval_all``."""
+    loc = None
+    while tb is not None:
+        if tb.tb_frame.f_code is eval_all_code:
+            found = _node_location(tb.tb_frame.f_locals.get("node"))
+            loc = found or loc
+        tb = tb.tb_next
+    return loc
 
 
 def check_package_paths(package_paths: dict[str, str]) -> dict[str, str]:
@@ -127,11 +274,14 @@ def check_package_paths(package_paths: dict[str, str]) -> dict[str, str]:
     return out
 
 
-def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[str, str] | None = None) -> Expanded:
+def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[str, str] | None = None,
+           roots=(), time_limit: float | None = None) -> Expanded:
     """Expand the xacro file ``path``; ``$(find PKG)`` looks PKG up in ``package_paths``.
 
-    Raises RobotkitError (one line, naming the file) for a missing package, a missing
-    argument, an unsafe expression or any other xacro error.
+    Files are read only inside ``path``'s project, ``roots`` and the package folders
+    (:class:`robotkit.paths.ReadPolicy`).  Raises RobotkitError (one line, naming the file
+    and line) for a missing package, a missing argument, an unsafe expression, a blocked read,
+    a limit, or any other xacro error.
     """
     import xml.parsers.expat
 
@@ -139,12 +289,17 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
     import xacro.substitution_args as sa
     import yaml
 
+    from robotkit.paths import ReadPolicy
+
     path = Path(path).absolute()
     if not path.is_file():
         raise RobotkitError(Problem("file not found", file=str(path)))
     packages = dict(package_paths)
     args = dict(args or {})
     state = _State()
+    policy = ReadPolicy.for_file(path, extra_roots=roots, packages=packages)
+    limits = _Limits(TIME_LIMIT if time_limit is None else time_limit)
+    guards = _guard_symbols(limits)
 
     def find(pkg):
         try:
@@ -153,23 +308,69 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
             state.missing = pkg
             raise _MissingPackage(pkg) from None
 
-    original_safe_eval = xacro.safe_eval
+    def env(name):
+        state.blocked = (f"$(env {name}) is blocked: an imported file does not read the environment "
+                         f"(give the value as an argument, or use $(optenv {name} DEFAULT))")
+        raise _Blocked(name)
+
+    def optenv(name, default=""):
+        return default
+
+    def allowed(file: str) -> str:
+        problem = policy.problem(os.path.normpath(file))
+        if problem is not None:
+            state.blocked = f"reading {problem.message}"
+            raise _Blocked(file)
+        return file
+
+    original_abs = xacro.abs_filename_spec
+    original_parse = xacro.parse
+    original_resolve = sa.resolve_args
+    original_eval_all = xacro.eval_all
+
+    def guarded_abs(spec):
+        return allowed(original_abs(spec))
+
+    def guarded_parse(inp, filename=None):
+        if inp is None:
+            full = os.path.join(xacro.root_dir or "", filename) if not os.path.isabs(filename) else filename
+            allowed(full)
+            try:
+                f = open(full, "rb")
+            except OSError as e:
+                xacro.filestack.pop()
+                raise xacro.XacroException(f"{e.strerror}: {e.filename}", exc=e) from None
+            with f:
+                return _parse_with_lines(f, full)
+        if isinstance(inp, str):
+            return _parse_with_lines(inp, xacro.filestack[-1] if xacro.filestack else str(path))
+        return original_parse(inp, filename)
+
+    def guarded_resolve(arg_str, context=None, filename=None):
+        if arg_str and "$(find-pkg-share " in arg_str:
+            arg_str = arg_str.replace("$(find-pkg-share ", "$(find ")
+        if context is not None and xacro.filestack:  # xacro 2.1 never tells $(dirname) the file
+            context["filename"] = xacro.filestack[-1]
+        return original_resolve(arg_str, context, filename)
+
+    def guarded_eval_all(node, macros, symbols):
+        limits.tick()
+        return original_eval_all(node, macros, symbols)
 
     def guarded_safe_eval(expr, globals, locals=None):
+        limits.tick()
         try:
-            check_expression(expr)
+            check_expression(expr, lambda name: name in globals)
         except UnsafeExpression as exc:
             state.unsafe = (expr.strip(), str(exc))
             raise
-        return original_safe_eval(expr, globals, locals)
+        code = _compile_guarded(expr)
+        dict.update(globals, __builtins__={}, **guards)  # disable default builtins (as xacro does)
+        return eval(code, globals, locals)
 
     def guarded_eval(s, context):
         # xacro's own version evaluates with Python's full builtins (see the module docstring)
-        try:
-            check_expression(s)
-        except UnsafeExpression as exc:
-            state.unsafe = (s.strip(), str(exc))
-            raise
+        limits.tick()
         if "arg" not in context:
             context["arg"] = {}
 
@@ -181,22 +382,39 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
 
         functions = {"arg": arg, "dirname": dirname}
         functions.update({k: v for k, v in sa._eval_dict.items() if not k.startswith("_")})
-        functions["find"] = find
-        return str(eval(s, {"__builtins__": dict(SAFE_BUILTINS)}, sa._DictWrapper(context["arg"], functions)))
+        functions.update(find=find, env=env, optenv=optenv)
+        names = sa._DictWrapper(context["arg"], functions)
+        try:
+            check_expression(s, lambda name: name in context["arg"] or name in functions)
+        except UnsafeExpression as exc:
+            state.unsafe = (s.strip(), str(exc))
+            raise
+        builtins = dict(SAFE_BUILTINS, range=limits.range)
+        return str(eval(_compile_guarded(s), {"__builtins__": builtins, **guards}, names))
 
     symbols = xacro.create_global_symbols()
     python_ns = symbols.get("python")
     if python_ns is not None:
         for name in ("vars", "type"):
             dict.pop(python_ns, name, None)
+        if "range" in python_ns:
+            dict.__setitem__(python_ns, "range", limits.range)
+    if "range" in symbols:
+        symbols["range"] = limits.range
 
     saved = {
         (xacro, "safe_eval"): xacro.safe_eval,
         (xacro, "_global_symbols"): xacro._global_symbols,
+        (xacro, "abs_filename_spec"): original_abs,
+        (xacro, "parse"): original_parse,
+        (xacro, "eval_all"): original_eval_all,
         (sa, "_eval"): sa._eval,
         (sa, "_eval_find"): sa._eval_find,
+        (sa, "_eval_env"): sa._eval_env,
+        (sa, "_eval_optenv"): sa._eval_optenv,
+        (sa, "resolve_args"): original_resolve,
     }
-    saved_find_fn = sa._eval_dict.get("find")
+    saved_dict = {k: sa._eval_dict.get(k) for k in ("find", "env", "optenv")}
     # xacro.load_yaml registers its unit tags (!degrees...) on yaml.SafeLoader, in place
     own = yaml.SafeLoader.__dict__.get("yaml_constructors")
     saved_constructors = dict(own) if own is not None else None
@@ -205,25 +423,35 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
         try:
             xacro.safe_eval = guarded_safe_eval
             xacro._global_symbols = symbols
+            xacro.abs_filename_spec = guarded_abs
+            xacro.parse = guarded_parse
+            xacro.eval_all = guarded_eval_all
             sa._eval = guarded_eval
             sa._eval_find = find
-            sa._eval_dict["find"] = find
+            sa._eval_env = env
+            sa._eval_optenv = optenv
+            sa.resolve_args = guarded_resolve
+            sa._eval_dict.update(find=find, env=env, optenv=optenv)
             xacro.all_includes.clear()
             with contextlib.redirect_stderr(stderr):
                 try:
                     doc = xacro.process_file(str(path), mappings=args)
                 except (xacro.XacroException, sa.SubstitutionException, _MissingPackage, UnsafeExpression,
-                        xml.parsers.expat.ExpatError, OSError, NameError, KeyError, TypeError, ValueError,
-                        SyntaxError, AttributeError, ZeroDivisionError, IndexError, yaml.YAMLError,
-                        RecursionError) as exc:
+                        _Blocked, ExpansionLimit, xml.parsers.expat.ExpatError, OSError, NameError, KeyError,
+                        TypeError, ValueError, SyntaxError, AttributeError, ZeroDivisionError, IndexError,
+                        OverflowError, MemoryError, yaml.YAMLError, RecursionError) as exc:
                     where = xacro.filestack[-1] if xacro.filestack and xacro.filestack[-1] else str(path)
+                    state.location = _failing_location(exc.__traceback__, original_eval_all.__code__)
                     raise RobotkitError(_problem(exc, state, where, path)) from None
             includes = sorted({os.path.abspath(f) for f in xacro.all_includes})
         finally:
             for (module, name), value in saved.items():
                 setattr(module, name, value)
-            if saved_find_fn is not None:
-                sa._eval_dict["find"] = saved_find_fn
+            for k, v in saved_dict.items():
+                if v is None:
+                    sa._eval_dict.pop(k, None)
+                else:
+                    sa._eval_dict[k] = v
             if saved_constructors is None:
                 if "yaml_constructors" in yaml.SafeLoader.__dict__:
                     del yaml.SafeLoader.yaml_constructors
@@ -248,34 +476,43 @@ def _show(path) -> str:
 def _problem(exc: BaseException, state: _State, where: str, top: Path) -> Problem:
     import xml.parsers.expat
 
+    line, parsing = None, where  # xacro's file stack: the file being parsed
+    if state.location is not None:
+        where, line = state.location
+    limit = exc if isinstance(exc, ExpansionLimit) else getattr(exc, "exc", None)
+    if isinstance(limit, ExpansionLimit):
+        return Problem(f"xacro: expansion stopped: {limit}", file=where, line=line)
+    if state.blocked is not None:
+        return Problem(state.blocked, file=where, line=line)
+
     if state.unsafe is not None:
         expr, reason = state.unsafe
         if len(expr) > 80:
             expr = expr[:77] + "..."
         return Problem(f"refusing to evaluate xacro expression '{expr}': {reason} "
-                       "(an imported file may only compute values)", file=where)
+                       "(an imported file may only compute values)", file=where, line=line)
     if state.missing is not None:
         pkg = state.missing
-        return Problem(f"package '{pkg}' not found; give --package-path {pkg}=DIR", file=where)
+        return Problem(f"package '{pkg}' not found; give --package-path {pkg}=DIR", file=where, line=line)
     if isinstance(exc, xml.parsers.expat.ExpatError):
         return Problem(f"not well-formed XML: {xml.parsers.expat.ErrorString(exc.code)}",
-                       file=where, line=exc.lineno)
+                       file=parsing, line=exc.lineno)
     if isinstance(exc, FileNotFoundError):
         missing = exc.filename or str(exc)
         if os.path.abspath(str(missing)) == str(top):
             return Problem("file not found", file=str(top))
-        return Problem(f"file not found: {_show(missing)}", file=where)
+        return Problem(f"file not found: {_show(missing)}", file=where, line=line)
     if isinstance(exc, RecursionError):
-        return Problem("xacro: expansion recurses without end (a macro that calls itself?)", file=where)
+        return Problem("xacro: expansion recurses without end (a macro that calls itself?)", file=where, line=line)
     inner = getattr(exc, "exc", None)
     import xacro.substitution_args as sa
 
     if isinstance(exc, sa.ArgException) or isinstance(inner, sa.ArgException):
         name = str(inner or exc)
-        return Problem(f"xacro argument '{name}' is not set; give --arg {name}:=VALUE", file=where)
+        return Problem(f"xacro argument '{name}' is not set; give --arg {name}:=VALUE", file=where, line=line)
     if isinstance(inner, FileNotFoundError):
-        return Problem(f"file not found: {_show(inner.filename or str(inner))}", file=where)
+        return Problem(f"file not found: {_show(inner.filename or str(inner))}", file=where, line=line)
     message = " ".join(str(exc).split())
     if not message:
         message = type(exc).__name__
-    return Problem(f"xacro: {message}", file=where)
+    return Problem(f"xacro: {message}", file=where, line=line)

@@ -19,6 +19,7 @@ from dataclasses import replace
 import numpy as np
 
 from robotkit.errors import Problem, RecipeError
+from robotkit.model import inertia_policy
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
     Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World, matrix_rpy, rpy_matrix,
@@ -172,7 +173,12 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                 problems.append(marks.problem(lp + ("inertial",),
                                               f"computing the inertial needs {spec.source} geometry, and the link has none"))
         if spec.mode == "explicit":
-            problems.extend(_check_explicit(spec.explicit, marks, lp + ("inertial",)))
+            if (ispec.policy or r.inertia_policy) == "repair":
+                fixed = inertia_policy.repair(spec.explicit.mass, spec.explicit.tensor(), spec.explicit.mass)
+                if fixed.changes:
+                    spec = replace(spec, explicit=Inertial.from_tensor(fixed.mass, spec.explicit.com, fixed.inertia))
+            else:
+                problems.extend(_check_explicit(spec.explicit, marks, lp + ("inertial",)))
         # meshes no inertial is computed from may be open: they are only drawn and collided
         computed = spec.mode in ("density", "mass")
         old = [g.shape.mesh for g in visuals]

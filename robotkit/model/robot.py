@@ -325,12 +325,21 @@ class Robot:
         return out
 
     def anchor(self) -> str | None:
-        """The link a massless root is attached to when the root is only a frame (its first
-        child by a fixed joint, e.g. ``base_link`` below ``base_footprint``); None otherwise."""
+        """The link a massless root is attached to when the root is only a frame (the nearest
+        link with mass welded to it by fixed joints, e.g. ``base_link`` below
+        ``base_footprint``); None otherwise."""
         root = self.root
         if root == "world" or self.link(root).inertial is not None:
             return None
-        return next((j.child for j in self.joints if j.parent == root and j.type == "fixed"), None)
+        by_name = {link.name: link for link in self.links}
+        todo = [root]  # breadth first: the nearest link with mass welded to the root
+        while todo:
+            below = [j.child for name in todo for j in self.joints if j.parent == name and j.type == "fixed"]
+            found = next((c for c in below if by_name[c].inertial is not None), None)
+            if found is not None:
+                return found
+            todo = below
+        return None
 
     def body_mass(self, name: str) -> float:
         """Mass of ``name`` and of everything welded to it by fixed joints below it: what a

@@ -31,6 +31,8 @@ from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_val
 
 NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*$")
 NAME_HINT = "a name starts with a letter or '_' and holds only letters, digits, '_', '-' and '.'"
+FRAME_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*(/[A-Za-z0-9_.\-]+)*$")
+FRAME_NAME_HINT = NAME_HINT + ", with '/' between parts (a ROS frame name such as arm/link_1)"
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 
@@ -85,6 +87,14 @@ def _scale_form(value) -> str | None:
 def check_name(value: str) -> str:
     if not NAME_RE.match(value):
         raise ValueError(f"invalid name {value!r}: {NAME_HINT}")
+    return value
+
+
+def check_frame_name(value: str) -> str:
+    """Link and joint names: as :func:`check_name`, and '/' between parts (ROS accepts them;
+    files named after them go through :func:`robotkit.paths.file_stem`)."""
+    if not FRAME_NAME_RE.match(value):
+        raise ValueError(f"invalid name {value!r}: {FRAME_NAME_HINT}")
     return value
 
 
@@ -264,6 +274,8 @@ class Inertial(Strict):
     """Which of the link's geometries the mass properties are computed from."""
     open_mesh: Literal["error", "hull"] | None = None
     """What to do with a mesh that is not a closed volume after safe repair: ``error``, or use its convex ``hull`` (with a warning). Default: the recipe's ``open_mesh``."""
+    policy: Literal["keep", "repair"] | None = None
+    """For an explicit inertia: ``keep`` it as given (a tensor no real body has stops the build), or ``repair`` it with the smallest change that makes it physical (principal moments raised to a floor, then to the triangle inequality; axes kept). Default: the recipe's ``inertia_policy``."""
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -643,6 +655,8 @@ class Recipe(Strict):
     """Default units of mesh files (m, cm, mm, in)."""
     density: Positive = 1000.0
     """Default density in kg/m^3 for inertials computed from geometry."""
+    inertia_policy: Literal["keep", "repair"] = "keep"
+    """Explicit inertias: ``keep`` them as given, or ``repair`` those no real body has with the smallest change (per link: ``inertial.policy``)."""
     open_mesh: Literal["error", "hull"] = "error"
     """Default policy for meshes that are not closed volumes after safe repair."""
     meshes: MeshDefaults = MeshDefaults()
@@ -698,9 +712,16 @@ class Recipe(Strict):
                 raise ValueError(f"urdf_extras[{i}] is not well-formed XML: {exc}") from None
         return v
 
-    @field_validator("materials", "links", "joints", "worlds", "sensors")
+    @field_validator("materials", "worlds", "sensors")
     @classmethod
     def _names(cls, v):
         for name in v:
             check_name(name)
+        return v
+
+    @field_validator("links", "joints")
+    @classmethod
+    def _frame_names(cls, v):
+        for name in v:
+            check_frame_name(name)
         return v

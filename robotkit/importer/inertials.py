@@ -1,0 +1,197 @@
+"""Inertia decisions of the importer, on the shared policy (robotkit.model.inertia_policy):
+what a URDF <inertial> says, which given tensors are kept and which repaired, which links the
+build would refuse for having no mass and what they get instead (each change recorded, with
+the reason, for the recipe's comments), and the report of ``--recompute-inertials``."""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from robotkit.importer.parsing import _Problems, _float, _origin
+from robotkit.importer.recipe_writer import fmt
+from robotkit.model import inertia_policy
+
+
+def no_inertial_form():
+    """The recipe value that says "this link has no inertial", if the schema has one."""
+    from pydantic import ValidationError
+
+    from robotkit.recipe.schema import Link
+
+    for value in ("none",):
+        try:
+            Link.model_validate({"visual": {"box": {"size": [1, 1, 1]}}, "inertial": value})
+            return value
+        except ValidationError:
+            continue
+    return None
+
+
+def _inertial(el: ET.Element, link: str, problems: _Problems) -> dict | None:
+    what = f"link '{link}' inertial"
+    mass_el = el.find("mass")
+    mass = _float(mass_el.get("value") if mass_el is not None else None, f"{what} mass", problems, 0.0)
+    xyz, rpy = _origin(el.find("origin"), what, problems)
+    t = el.find("inertia")
+    keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+    values = {k: 0.0 for k in keys}
+    if t is not None:
+        for k in keys:
+            v = _float(t.get(k), f"{what} {k}", problems, 0.0)
+            values[k] = v if v is not None else 0.0
+    if any(rpy):
+        import numpy as np
+
+        from robotkit.model.robot import rpy_matrix
+
+        I = np.array([[values["ixx"], values["ixy"], values["ixz"]],
+                      [values["ixy"], values["iyy"], values["iyz"]],
+                      [values["ixz"], values["iyz"], values["izz"]]])
+        R = rpy_matrix(rpy)
+        I = R @ I @ R.T
+        I = 0.5 * (I + I.T)
+        scale = float(np.abs(I).max())
+        I[np.abs(I) < 1e-14 * scale] = 0.0
+        values = {"ixx": I[0, 0], "ixy": I[0, 1], "ixz": I[0, 2], "iyy": I[1, 1], "iyz": I[1, 2], "izz": I[2, 2]}
+        values = {k: float(v) + 0.0 for k, v in values.items()}
+    return {"mass": mass if mass is not None else 0.0, "com": xyz, "inertia": values, "rpy": rpy}
+
+
+def _explicit_dict(given: dict) -> dict:
+    out: dict = {"mass": given["mass"]}
+    if any(given["com"]):
+        out["com"] = list(given["com"])
+    t = given["inertia"]
+    inertia = {k: t[k] for k in ("ixx", "iyy", "izz")}
+    for k in ("ixy", "ixz", "iyz"):
+        if t[k] != 0.0:
+            inertia[k] = t[k]
+    out["inertia"] = inertia
+    return out
+
+
+def _has_mass(link: dict) -> bool:
+    spec = link.get("inertial")
+    return isinstance(spec, dict) or (spec is None and bool(link.get("visual")))
+
+
+def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
+    """A link the build refuses or SDF misreads for having no mass (it moves, or it is a root
+    with moving joints below it and no mass welded to it) gets one: computed from its geometry at the
+    recipe's density, or a point mass when it has none.  Each is recorded in ``out.repairs``."""
+    moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
+    children: dict[str, list[dict]] = {}
+    for j in joints.values():
+        children.setdefault(j["parent"], []).append(j)
+
+    def body_mass(name: str) -> bool:
+        todo, seen = [name], set()
+        while todo:
+            n = todo.pop()
+            if n in seen or n not in links:
+                continue
+            seen.add(n)
+            if _has_mass(links[n]):
+                return True
+            todo += [j["child"] for j in children.get(n, []) if j["type"] == "fixed"]
+        return False
+
+    refused: dict[str, str] = {}
+    for jname, j in joints.items():
+        if j["type"] in moving and j["child"] in links and not body_mass(j["child"]):
+            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): MuJoCo "
+                                           "refuses a moving body without mass and Gazebo drops it")
+        elif j["type"] in moving and j["child"] in links and not _has_mass(links[j["child"]]):
+            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): SDF keeps "
+                                           "it a link, which Gazebo and Drake give 1 kg without an inertial")
+    child_links = {j["child"] for j in joints.values()}
+    roots = [n for n in links if n not in child_links]
+    for root in roots:
+        below = children.get(root, [])
+        if root != "world" and below and not body_mass(root):
+            # the mass goes on the first link with geometry welded to the root, else on the root
+            welded, todo = [], [root]
+            while todo:
+                welded += todo
+                todo = [j["child"] for n in todo for j in children.get(n, []) if j["type"] == "fixed"]
+            root = next((n for n in welded if links[n].get("visual") or isinstance(links[n].get("collision"),
+                                                                                     (dict, list))), root)
+            refused.setdefault(root, "no mass in the original (nor on the links welded to it), and it is (or is "
+                                     "welded to) the root with moving joints below it: Gazebo's URDF conversion "
+                                     "drops it and everything below it")
+    given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
+    point = 1e-3 * min(given) if given else 1e-3
+    for name, why in refused.items():
+        link = links[name]
+        if link.get("visual"):
+            link.pop("inertial", None)
+            out.repairs[name] = f"{why}; computed from its visual geometry at the recipe's density"
+        elif isinstance(link.get("collision"), (dict, list)):
+            link["inertial"] = {"source": "collision"}
+            out.repairs[name] = f"{why}; computed from its collision geometry at the recipe's density"
+        else:
+            floor = inertia_policy.moment_floor(point)
+            link["inertial"] = {"mass": point, "inertia": {"ixx": floor, "iyy": floor, "izz": floor}}
+            out.repairs[name] = (f"{why}; it has no geometry: a point mass of {fmt(point)} kg (a thousandth of the "
+                                 f"lightest link) with the smallest inertia a repair leaves")
+
+
+def _tensor(t: dict):
+    import numpy as np
+
+    return np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
+
+
+
+def _facts(mesh) -> dict:
+    """Unit-density mass properties of one mesh, as robotkit's mesh task records them."""
+    import numpy as np
+
+    from robotkit.mesh.inertia import mesh_mass_properties
+    from robotkit.mesh.io import load_mesh, volume_mesh
+
+    m = load_mesh(mesh.source, mesh.scale)
+    bbox_min, bbox_max = m.bounds
+    vol, _, _, _ = volume_mesh(m, mesh.open_mesh, os.path.basename(mesh.source))
+    props = mesh_mass_properties(vol.vertices, vol.faces)
+    return {"volume": props.volume, "com": [float(v) for v in props.com],
+            "inertia": [[float(v) for v in row] for row in np.asarray(props.inertia)],
+            "bbox_min": [float(v) for v in bbox_min], "bbox_max": [float(v) for v in bbox_max]}
+
+
+def _report_recomputed(recipe_file: Path, conv, result: ImportResult) -> None:
+    import numpy as np
+
+    from robotkit.model.resolve import finalize_link_inertial
+    from robotkit.tasks import load_robots
+
+    (_, robot), = load_robots([recipe_file])
+    facts: dict[str, dict] = {}
+    for link in robot.links:
+        if link.inertial_spec.mode not in ("mass", "density") or link.name not in conv.explicit:
+            continue
+        for g in link.source_geoms():
+            if g.shape.mesh is not None and g.shape.mesh.key not in facts:
+                facts[g.shape.mesh.key] = _facts(g.shape.mesh)
+        new = finalize_link_inertial(link, facts)
+        given = conv.explicit[link.name]
+        t = given["inertia"]
+        I0 = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
+        I1 = new.tensor()
+        com_shift = float(np.linalg.norm(np.asarray(new.com) - np.asarray(given["com"])))
+        rel = float(np.linalg.norm(I1 - I0) / max(np.linalg.norm(I0), 1e-300))
+        result.inertials[link.name] = {
+            "given": {"mass": given["mass"], "com": list(given["com"]), "inertia": I0.tolist()},
+            "computed": {"mass": new.mass, "com": list(new.com), "inertia": I1.tolist()},
+            "com_shift": com_shift, "inertia_rel_diff": rel,
+        }
+        mass = (f"mass {new.mass:.6g} kg (given {given['mass']:.6g})" if link.inertial_spec.mode == "density"
+                else f"mass {new.mass:.6g} kg kept")
+        d0 = ", ".join(f"{v:.4g}" for v in np.diag(I0))
+        d1 = ", ".join(f"{v:.4g}" for v in np.diag(I1))
+        result.warnings.append(
+            f"link '{link.name}': recomputed inertial from its {link.inertial_spec.source} geometry: {mass}; "
+            f"centre of mass moved {com_shift * 1000:.3g} mm; inertia tensor differs by {rel * 100:.3g}% "
+            f"(diagonal given {d0}, now {d1} kg m^2)")

@@ -1,0 +1,135 @@
+"""Mesh resolution for the importer: ``package://`` and relative URIs to files (through the
+declared package paths), where the recipe references them or copies them, and which meshes
+need ``open_mesh: hull`` because an inertial is computed from a mesh that is not closed."""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from robotkit.errors import display_path
+from robotkit.importer.parsing import _Problems
+
+MESH_FORMATS = (".stl", ".obj", ".dae")
+
+
+@dataclass
+class MeshUse:
+    """One mesh file named by the URDF: where it is and where the recipe points."""
+
+    source: str  # absolute path of the file found
+    recipe_path: str  # absolute path the recipe names (source, or its copy)
+    scale: tuple[float, float, float]
+
+
+class MeshResolver:
+    def __init__(self, source: Path, recipe_dir: Path, packages: dict[str, str], copy: bool):
+        self.source = source
+        self.recipe_dir = recipe_dir
+        self.packages = packages
+        self.copy = copy
+        self.copies: dict[str, str] = {}  # destination -> source
+        self._dest_of: dict[str, str] = {}
+
+    def locate(self, uri: str, link: str, problems: _Problems) -> str | None:
+        """Absolute path of the file ``uri`` names, or None with a problem."""
+        path = None
+        m = re.match(r"^(package|model)://([^/]+)/(.+)$", uri)
+        if m:
+            pkg, rest = m.group(2), m.group(3)
+            if pkg not in self.packages:
+                problems.add(f"link '{link}': mesh '{uri}': package '{pkg}' not found; "
+                             f"give --package-path {pkg}=DIR")
+                return None
+            path = os.path.join(self.packages[pkg], rest)
+        elif uri.startswith("file://"):
+            path = uri[len("file://"):]
+            if not os.path.isabs(path):
+                path = os.path.join(self.source.parent, path)
+        elif re.match(r"^[A-Za-z][A-Za-z0-9+.\-]*://", uri):
+            problems.add(f"link '{link}': mesh '{uri}': unsupported URI scheme "
+                         "(use package://, file:// or a path)")
+            return None
+        else:
+            path = uri if os.path.isabs(uri) else os.path.join(self.source.parent, uri)
+        path = os.path.normpath(path)
+        if not os.path.isfile(path):
+            problems.add(f"link '{link}': mesh '{uri}' not found (looked for {display_path(path)})")
+            return None
+        if os.path.splitext(path)[1].lower() not in MESH_FORMATS:
+            problems.add(f"link '{link}': mesh '{uri}' has an unsupported format (robotkit reads STL, OBJ and DAE)")
+            return None
+        return path
+
+    def destination(self, path: str, uri: str) -> str:
+        """Where the recipe points for the file at ``path`` (a copy below the recipe, or it)."""
+        if not self.copy:
+            return path
+        if path in self._dest_of:
+            return self._dest_of[path]
+        m = re.match(r"^(package|model)://(.+)$", uri)
+        rel = m.group(2) if m else os.path.basename(path)
+        dest = os.path.normpath(os.path.join(self.recipe_dir, "meshes", rel))
+        stem, ext = os.path.splitext(dest)
+        i = 2
+        while dest in self.copies and self.copies[dest] != path:
+            dest, i = f"{stem}_{i}{ext}", i + 1
+        self.copies[dest] = path
+        self._dest_of[path] = dest
+        return dest
+
+    def recipe_text(self, dest: str) -> str:
+        return Path(os.path.relpath(dest, self.recipe_dir)).as_posix()
+
+
+
+_CLOSED: dict[tuple, bool] = {}
+
+
+def mesh_is_closed(source: str, scale) -> bool:
+    """Whether robotkit's mesh task accepts the mesh without ``open_mesh: hull``."""
+    from robotkit.errors import MeshError
+    from robotkit.mesh.io import load_mesh, volume_mesh
+
+    st = os.stat(source)
+    key = (source, tuple(scale), st.st_mtime_ns, st.st_size)
+    if key not in _CLOSED:
+        try:
+            volume_mesh(load_mesh(source, scale), "error", os.path.basename(source))
+            _CLOSED[key] = True
+        except MeshError:
+            _CLOSED[key] = False
+    return _CLOSED[key]
+
+
+def _open_meshes(conv, recipe: dict, warnings: list[str], recompute: bool) -> None:
+    """A mesh that is not a closed volume needs ``open_mesh: hull`` only where an inertial is
+    computed from it (robotkit accepts open meshes that are only drawn and collided)."""
+    open_by_link: dict[str, list[tuple[str, str]]] = {}
+    for (link, kind, _i), use in conv.meshes.items():
+        if not mesh_is_closed(use.source, use.scale):
+            names = open_by_link.setdefault(link, [])
+            if (kind, os.path.basename(use.source)) not in names:
+                names.append((kind, os.path.basename(use.source)))
+    top_level = []
+    for link, found in open_by_link.items():
+        spec = recipe["links"][link].get("inertial")
+        if spec == "none" or (isinstance(spec, dict) and "inertia" in spec):
+            continue  # no inertial is computed from the link's geometry
+        source = spec.get("source", "visual") if isinstance(spec, dict) else "visual"
+        read = [name for kind, name in found if kind == source]
+        if not read:
+            continue
+        files = ", ".join(dict.fromkeys(read))
+        if isinstance(spec, dict):
+            spec["open_mesh"] = "hull"
+            warnings.append(f"link '{link}': mesh {files} is not a closed volume; its recomputed inertial "
+                            "uses the convex hull (open_mesh: hull)")
+        else:
+            top_level.append(f"{link} ({files})")
+    if top_level:
+        recipe["open_mesh"] = "hull"
+        warnings.append("meshes that are not closed volumes on links whose inertial is computed from them: "
+                        f"{'; '.join(top_level)}; the recipe sets open_mesh: hull")

@@ -1,0 +1,112 @@
+"""What is wrong with a link's mass properties, and the smallest change that makes them physical.
+
+One rule set, used where an inertial is read: ``robotkit import`` (writes each repair into
+the recipe with a comment), the build (a recipe's ``inertia_policy: repair``, whole recipe or
+per link) and ``robotkit check``'s lints (which name each defect on the original).
+
+The policies:
+
+- ``keep``: the inertial as given; a defect stops the build.
+- ``repair``: the smallest change that makes it physical: the mass raised to a floor when it
+  is not positive; the tensor's principal moments raised to a floor (that of a solid sphere of
+  radius :data:`MIN_RADIUS` at the link's mass, or :data:`RELATIVE_FLOOR` of the largest
+  moment when that is smaller), then the triangle inequality restored by moving
+  the largest moment down and the other two up by a third of the excess each (the least
+  change in the Frobenius norm).  The principal axes are kept.
+- ``recompute``: from the link's geometry, keeping the given mass (a recipe's
+  ``inertial: {mass: M}``; ``robotkit import --recompute-inertials``).
+
+A link without mass that moves (or a massless root body with moving joints below it) gets one
+on import: from its geometry at the recipe's density, or, without geometry, a point mass of a
+thousandth of the lightest link with the floor's inertia (robotkit.importer.inertials).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+MIN_RADIUS = 1e-3
+"""The principal-moment floor is that of a solid sphere of this radius (m) at the link's mass."""
+
+RELATIVE_FLOOR = 1e-3
+"""The floor is at most this fraction of the largest principal moment (a thin part stays thin)."""
+
+TRIANGLE_TOL = 1e-9
+"""Relative slack of the triangle inequality (what the build accepts)."""
+
+
+def _moments(values) -> str:
+    return ", ".join(f"{v:.6g}" for v in values)
+
+
+def defects(mass: float, inertia: np.ndarray) -> list[str]:
+    """Why ``mass`` and ``inertia`` (about the centre of mass) cannot belong to a real body;
+    empty when they can."""
+    I = np.asarray(inertia, dtype=float)
+    if not np.isfinite(mass):
+        return [f"mass is {mass!r}"]
+    out = []
+    if mass <= 0:
+        out.append(f"mass is {mass:.6g} kg" if mass else "mass is 0")
+    if not np.all(np.isfinite(I)):
+        return out + ["inertia is not finite"]
+    if not I.any():
+        return out + ["inertia is zero"]
+    eig = np.linalg.eigvalsh(0.5 * (I + I.T))
+    if eig.min() <= 0:
+        out.append(f"inertia is not positive definite (principal moments {_moments(eig)})")
+    else:
+        a, b, c = eig
+        if a + b < c * (1 - TRIANGLE_TOL):
+            out.append(f"principal moments {_moments(eig)} violate the triangle inequality")
+    return out
+
+
+@dataclass(frozen=True)
+class Repaired:
+    mass: float
+    inertia: np.ndarray
+    changes: tuple[str, ...]
+    """What was changed, one phrase each (empty: nothing was wrong)."""
+
+
+def moment_floor(mass: float, largest: float = 0.0) -> float:
+    """The smallest principal moment a repair leaves (see the module docstring)."""
+    sphere = 0.4 * mass * MIN_RADIUS ** 2
+    return min(sphere, RELATIVE_FLOOR * largest) if largest > 0 else sphere
+
+
+def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
+    """The smallest change that makes ``mass`` and ``inertia`` physical (see the module
+    docstring); ``min_mass`` replaces a mass that is not positive."""
+    I = np.asarray(inertia, dtype=float)
+    I = 0.5 * (I + I.T)
+    changes = []
+    if not (np.isfinite(mass) and mass > 0):
+        changes.append(f"mass {mass:.6g} kg raised to {min_mass:.6g} kg")
+        mass = float(min_mass)
+    if not np.all(np.isfinite(I)):
+        I = np.zeros((3, 3))
+    eig, vecs = np.linalg.eigh(I)
+    floor = moment_floor(mass, float(eig.max()))
+    new = np.maximum(eig, floor)
+    if (new != eig).any():
+        changes.append(f"principal moments {_moments(eig)} raised to at least {floor:.6g} kg m^2")
+    a, b, c = new
+    excess = c - (a + b)
+    if excess > c * TRIANGLE_TOL:
+        new = np.array([a + excess / 3, b + excess / 3, c - excess / 3])
+        changes.append(f"principal moments {_moments((a, b, c))} moved to {_moments(new)} "
+                       "to meet the triangle inequality")
+    if not changes:
+        return Repaired(float(mass), I, ())
+    if not I.any():
+        vecs = np.eye(3)
+    out = vecs @ np.diag(new) @ vecs.T
+    out = 0.5 * (out + out.T)
+    scale = float(np.abs(out).max())
+    out[np.abs(out) < 1e-15 * scale] = 0.0  # products of inertia that are rounding only
+    return Repaired(float(mass), out + 0.0, tuple(changes))
+
