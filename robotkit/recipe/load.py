@@ -321,7 +321,9 @@ def _unwrap(tp):
 
 
 def _num(x) -> str:
-    return f"{x:g}" if isinstance(x, float) else str(x)
+    from robotkit.recipe.schema import _g
+
+    return _g(x) if isinstance(x, float) else str(x)
 
 
 def _message(err: dict) -> str:
@@ -341,7 +343,9 @@ def _message(err: dict) -> str:
         return f"must be < {ctx['lt']}"
     if kind == "less_than_equal":
         return f"must be <= {ctx['le']}"
-    if kind in ("float_parsing", "float_type", "int_parsing", "int_type", "finite_number"):
+    if kind == "finite_number":
+        return f"must be a finite number (got {got!r})"
+    if kind in ("float_parsing", "float_type", "int_parsing", "int_type"):
         return f"must be a number (got {got!r})"
     if kind == "string_type":
         return f"must be a string (got {got!r})"
