@@ -80,14 +80,17 @@ class ReadPolicy:
     def allows(self, path: str | os.PathLike) -> bool:
         return any(inside(path, r) for r in (*self.roots, *self.packages.values()))
 
-    def problem(self, path: str | os.PathLike, *, file=None, line=None, key=None) -> Problem | None:
-        """A :class:`Problem` naming ``key`` when ``path`` is outside every allowed root, else None."""
+    def refusal(self, path: str | os.PathLike) -> str | None:
+        """Why ``path`` may not be read (to follow the path's own name), or None when it may."""
         if self.allows(path):
             return None
-        return Problem(
-            f"{os.fspath(path)!s} is outside the project {display_path(self.roots[0])}: robotkit reads only "
-            f"the project and declared package paths (widen on purpose with --root DIR or {ROOT_ENV})",
-            file, line, key)
+        return (f"is outside the project {display_path(self.roots[0])}: robotkit reads only the project and "
+                f"declared package paths (widen on purpose with --root DIR or {ROOT_ENV})")
+
+    def problem(self, path: str | os.PathLike, *, file=None, line=None, key=None) -> Problem | None:
+        """A :class:`Problem` naming ``key`` when ``path`` is outside every allowed root, else None."""
+        why = self.refusal(path)
+        return None if why is None else Problem(f"{os.fspath(path)!s} {why}", file, line, key)
 
     def check(self, path: str | os.PathLike, *, file=None, line=None, key=None) -> str:
         """``path`` itself when allowed; raises :class:`RobotkitError` otherwise."""
@@ -95,6 +98,12 @@ class ReadPolicy:
         if p is not None:
             raise RobotkitError(p)
         return os.fspath(path)
+
+
+def recipe_policy(recipe: str | os.PathLike) -> ReadPolicy:
+    """The reads a recipe may make: its project, the roots widened on purpose, and robotkit's
+    own data (the presets' meshes)."""
+    return ReadPolicy.for_file(recipe, extra_roots=(Path(__file__).resolve().parent / "presets",))
 
 
 def out_join(out_dir: str | os.PathLike, *parts: str, key: str | None = None) -> Path:

@@ -24,6 +24,7 @@ from robotkit import actions
 from robotkit.emit import TEMPLATES, ros
 from robotkit.emit.env import template_dirs
 from robotkit.model.robot import Robot
+from robotkit.paths import file_stem, out_join
 
 STATE = ".robotkit"  # below the output folder: doit's database and intermediate JSON
 
@@ -72,7 +73,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     """
     where = where or {}
     out_dir = Path(out_dir).absolute()
-    root = out_dir / robot.name
+    root = out_join(out_dir, robot.name, key="robot")
     state = out_dir / STATE / robot.name
     where = where or {}
     tasks: list[dict] = []
@@ -188,7 +189,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             continue
         keys = sorted({g.shape.mesh.key for g in link.source_geoms() if g.shape.mesh is not None})
         deps = {k: facts[k] for k in keys}
-        target = str(state / "inertial" / f"{link.name}.json")
+        target = str(state / "inertial" / f"{file_stem(link.name)}.json")
         inertials[link.name] = target
         tasks.append({
             "name": f"{robot.name}:inertial:{link.name}",
@@ -284,7 +285,7 @@ def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
     out_dir = Path(out_dir).absolute()
     tasks = []
     for w in robot.worlds:
-        root = out_dir / w.name
+        root = out_join(out_dir, w.name, key=f"worlds.{w.name}")
         targets = [root / "model.config", root / "model.sdf", root / "meshes" / f"{w.name}.stl",
                    root / f"{w.name}.world", root / "scene.xml"]
         spawn = None
@@ -322,10 +323,17 @@ def _map_image(map_yaml: str) -> list[str]:
     """The image a map YAML names (cheap: the YAML only), when it exists; the task reports the rest."""
     import yaml
 
+    from robotkit.recipe.load import MAX_YAML_BYTES, yaml_limits
+
     try:
+        if os.path.getsize(map_yaml) > MAX_YAML_BYTES:
+            return []
         with open(map_yaml, encoding="utf-8") as f:
-            image = (yaml.safe_load(f) or {}).get("image")
-    except (OSError, yaml.YAMLError, AttributeError):
+            text = f.read()
+        if yaml_limits(text) is not None:  # the world task reports it
+            return []
+        image = (yaml.safe_load(text) or {}).get("image")
+    except (OSError, UnicodeDecodeError, yaml.YAMLError, AttributeError):
         return []
     path = Path(map_yaml).parent / str(image)
     return [str(path)] if image and path.is_file() else []

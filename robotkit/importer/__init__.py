@@ -93,6 +93,13 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     _open_meshes(conv, recipe, warnings, recompute_inertials)
     _validate(recipe, source)
 
+    from robotkit.paths import inside
+
+    outside = [Problem(f"mesh '{display_path(src)}' would be copied to {display_path(dest)}, outside the "
+                       f"recipe's folder {display_path(out.parent)}", file=str(source))
+               for dest, src in sorted(conv.copies.items()) if not inside(dest, out.parent)]
+    if outside:  # a package:// path climbing out with ../: nothing is written
+        raise RobotkitError(outside)
     copied = []
     for dest, src in sorted(conv.copies.items()):
         if not (os.path.isfile(dest) and _same_bytes(src, dest)):

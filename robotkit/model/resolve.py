@@ -68,15 +68,25 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
             for geom in _geoms(getattr(link, kind)):
                 if geom.mesh:
                     sources.setdefault(geom.mesh, "")
+    from robotkit.paths import file_stem
+
+    def safe_name(src: str) -> str:  # a mesh file's own name, safe as an output file name
+        stem, ext = os.path.splitext(os.path.basename(src))
+        return file_stem(stem) + (ext if file_stem(ext[1:]) == ext[1:] else "")
+
     taken: dict[str, int] = {}
     for src in sources:
-        taken[os.path.basename(src)] = taken.get(os.path.basename(src), 0) + 1
+        taken[safe_name(src)] = taken.get(safe_name(src), 0) + 1
     for src in sources:
-        name = os.path.basename(src)
+        name = safe_name(src)
         if taken[name] > 1:
             stem, ext = os.path.splitext(name)
             name = f"{stem}-{_h(os.path.relpath(src, base_dir))}{ext}"
         sources[src] = name
+
+    from robotkit.paths import recipe_policy
+
+    reads = recipe_policy(loaded.file)
 
     def make_geom(g, path, link_name, policy, role="visual") -> Geom | None:
         if g.material is not None and g.material not in material_names:
@@ -89,6 +99,9 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
         elif g.sphere is not None:
             shape = Shape("sphere", radius=float(g.sphere.radius))
         else:
+            if (why := reads.refusal(g.mesh)) is not None:
+                problems.append(marks.problem(path + ("mesh",), f"mesh file '{_show(g.mesh)}' {why}"))
+                return None
             if not os.path.isfile(g.mesh):
                 problems.append(marks.problem(path + ("mesh",), f"mesh file '{_show(g.mesh)}' does not exist"))
                 return None
@@ -96,7 +109,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                 problems.append(marks.problem(path + ("mesh",),
                                               f"mesh file '{_show(g.mesh)}' has an unsupported format (use STL, OBJ or DAE)"))
                 return None
-            sources.setdefault(g.mesh, os.path.basename(g.mesh))
+            sources.setdefault(g.mesh, safe_name(g.mesh))
             if g.scale is not None:
                 s = g.scale if isinstance(g.scale, list) else [g.scale] * 3
                 scale = _t(s)
@@ -258,7 +271,9 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
             actuators.append(Actuator(name, a.interface, float(a.p), float(a.i), float(a.d)))
     worlds = []
     for name, w in r.worlds.items():
-        if not os.path.isfile(w.map):
+        if (why := reads.refusal(w.map)) is not None:
+            problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' {why}"))
+        elif not os.path.isfile(w.map):
             problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' does not exist"))
         spawn = Pose(_t(w.spawn.xyz), _t(w.spawn.rpy)) if w.spawn is not None else None
         worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall, spawn))

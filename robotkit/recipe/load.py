@@ -193,8 +193,13 @@ def _construct(node, path, file, marks, problems, constructor):
 MERGED_SECTIONS = ("materials", "links", "joints")
 
 
-def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = ()):
-    """Read ``file`` and, recursively, the files it includes; merge their sections."""
+def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = (), reads=None):
+    """Read ``file`` and, recursively, the files it includes (inside ``reads``, a
+    :class:`robotkit.paths.ReadPolicy`); merge their sections."""
+    if reads is None:
+        from robotkit.paths import recipe_policy
+
+        reads = recipe_policy(file)
     data, marks = _read_yaml(file, problems)
     if data is None:
         return None, marks
@@ -213,11 +218,14 @@ def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = ()):
             problems.append(Problem(f"'{inc}' includes itself (include cycle)", file=where[0],
                                     line=where[1], key=f"include[{i}]"))
             continue
+        if (why := reads.refusal(inc_path)) is not None:
+            problems.append(Problem(f"included file '{inc}' {why}", file=where[0], line=where[1], key=f"include[{i}]"))
+            continue
         if not inc_path.is_file():
             problems.append(Problem(f"included file '{inc}' does not exist", file=where[0],
                                     line=where[1], key=f"include[{i}]"))
             continue
-        sub, sub_marks = _gather(inc_path, problems, seen + (file,))
+        sub, sub_marks = _gather(inc_path, problems, seen + (file,), reads)
         if sub is None:
             continue
         for key in sub:

@@ -63,7 +63,11 @@ def _find_part(part: str, parts_env: list, ctx):
             file, _ = bsrc.locate((part,))
             path = os.path.normpath(str(Path(file or def_file).parent / definition))
             if path not in ctx.part_files:
-                if not os.path.isfile(path):
+                why = ctx.reads.refusal(path) if ctx.reads is not None else None
+                if why is not None:
+                    ctx.report(bsrc, (part,), f"part file '{definition}' {why}")
+                    ctx.part_files[path] = (None, {})
+                elif not os.path.isfile(path):
                     ctx.report(bsrc, (part,), f"part file '{definition}' does not exist")
                     ctx.part_files[path] = (None, {})
                 else:
