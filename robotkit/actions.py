@@ -308,6 +308,13 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
     return list(pieces) if isinstance(pieces, (list, tuple)) else [pieces], info["fidelity"]
 
 
+def publish_outputs(out_dir: str, robot: str, tasks: list[dict]):
+    """``<robot>:publish`` (dodo.py): the robot's staged folders, published (robotkit.publish)."""
+    from robotkit.publish import publish, staged_files
+
+    publish(out_dir, robot, staged_files(tasks, out_dir))
+
+
 @_user_errors_fail
 def picture_report(robot_dir: str, out_dir: str):
     """report.html and its pictures (robotkit.picture; MuJoCo is imported here, in the task)."""
@@ -315,5 +322,6 @@ def picture_report(robot_dir: str, out_dir: str):
 
     from robotkit.picture import report_build_dir
 
+    shutil.rmtree(out_dir, ignore_errors=True)  # the staged report folder: no picture of an earlier build stays
     name = Path(robot_dir).name
     report_build_dir(Path(robot_dir), Path(out_dir), f"../urdf/{name}.urdf")

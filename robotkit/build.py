@@ -182,6 +182,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     rc = DoitMain(Loader(), config_filenames=()).run(args)
     if recorder.runtime_errors:
         result.errors.append(("doit", "\n".join(recorder.runtime_errors)))
+    published = _publish(out, robots, tasks, result, recorder)
     if result.failed:
         lines = []
         for _, msg in result.failed:
@@ -195,13 +196,34 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         result.errors.append(("doit", f"doit exited with status {rc}"))
     result.warnings = collect_warnings(tasks) + collect_losses(out, result.robots)
     if rc == 0 and not result.errors:
-        outputs = sorted({str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])})
+        outputs = sorted({str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])} | set(published))
         try:
             stamp.write(out, stamp_options, inputs, outputs,
                         {"robots": result.robots, "tasks": len(tasks), "warnings": result.warnings})
         except OSError:
             pass  # no stamp: the next build runs doit's checks
     return result
+
+
+def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder) -> list[str]:
+    """Publish each robot whose tasks all succeeded (robotkit.publish): a failed robot keeps its
+    previous complete output.  Returns the published files."""
+    from robotkit.publish import publish, staged_files
+
+    if recorder.runtime_errors:
+        return []
+    owner = {f"world:{w.name}": robot.name for _, robot in robots for w in robot.worlds}
+    bad = {owner.get(name, name.split(":")[0]) for name, _ in result.failed + result.errors}
+    published = []
+    for _, robot in robots:
+        if robot.name in bad:
+            continue
+        mine = [t for t in tasks if owner.get(t["name"], t["name"].split(":")[0]) == robot.name]
+        try:
+            published += publish(out, robot.name, staged_files(mine, out))
+        except OSError as exc:
+            result.errors.append((f"{robot.name}:publish", f"cannot publish {robot.name}: {exc}"))
+    return published
 
 
 def _input_stats(robots, tasks) -> dict:

@@ -185,8 +185,7 @@ def _build(args) -> int:
         return 2
     start = time.perf_counter()
     extra = {**({"ros": args.ros} if args.ros else {}), **({"no_report": True} if args.no_report else {}),
-             **({"args": dict(args.arg)} if args.arg else {}),
-             **({"roots": os.environ[ROOT_ENV]} if os.environ.get(ROOT_ENV) else {})}
+             **({"args": dict(args.arg)} if args.arg else {})}
     opts = stamp.options(args.recipes, args.out, extra or None)
     done = stamp.up_to_date(args.out, opts)  # nothing changed since the last successful build?
     if done is not None:
