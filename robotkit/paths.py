@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -104,6 +105,23 @@ def recipe_policy(recipe: str | os.PathLike) -> ReadPolicy:
     """The reads a recipe may make: its project, the roots widened on purpose, and robotkit's
     own data (the presets' meshes)."""
     return ReadPolicy.for_file(recipe, extra_roots=(Path(__file__).resolve().parent / "presets",))
+
+
+@contextmanager
+def widened(folders):
+    """Reads also below ``folders`` while inside the ``with`` block (``ROBOTKIT_ROOT``, so
+    worker processes see it too): an importer checking the recipe it wrote, whose meshes sit
+    in the package paths the user declared."""
+    old = os.environ.get(ROOT_ENV)
+    extra = [os.path.abspath(os.fspath(f)) for f in folders]
+    os.environ[ROOT_ENV] = os.pathsep.join(dict.fromkeys(extra + [p for p in (old or "").split(os.pathsep) if p]))
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop(ROOT_ENV, None)
+        else:
+            os.environ[ROOT_ENV] = old
 
 
 def out_join(out_dir: str | os.PathLike, *parts: str, key: str | None = None) -> Path:

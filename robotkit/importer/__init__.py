@@ -119,8 +119,17 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text(text_out, encoding="utf-8")
+    from robotkit.paths import recipe_policy, widened
+
+    read = [] if copy_meshes else [m.source for m in conv.meshes.values()]  # what a build of the recipe reads
+    outside = sorted({os.path.dirname(p) for p in read if not recipe_policy(out).allows(p)})
+    if outside:
+        common = os.path.commonpath(outside)
+        warnings.append(f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: "
+                        f"build it with --root {display_path(common)}")
     try:
-        _check_resolves(tmp, out, conv.invalid_inertias)
+        with widened(outside):  # the package paths the user declared
+            _check_resolves(tmp, out, conv.invalid_inertias)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise

@@ -15,6 +15,7 @@ import hashlib
 import math
 import os
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -29,6 +30,15 @@ from robotkit.recipe.schema import UNITS, Collision
 
 def _h(text: str, n: int = 8) -> str:
     return hashlib.sha1(text.encode()).hexdigest()[:n]
+
+
+def _ident(path: str, base_dir: str) -> str:
+    """A mesh file's identity in task keys: its path relative to the recipe's folder (robotkit's
+    own preset meshes by name), so keys never depend on where the recipe or robotkit sit."""
+    presets = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "presets")
+    if os.path.commonpath([os.path.abspath(path), presets]) == presets:
+        return "robotkit:" + Path(os.path.relpath(path, presets)).as_posix()
+    return Path(os.path.relpath(path, base_dir)).as_posix()
 
 
 def _t(v) -> tuple[float, ...]:
@@ -123,7 +133,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
             mirrored = scale[0] * scale[1] * scale[2] < 0
             if mirrored and dec is None:
                 dec = ("none", 0)
-            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((g.mesh, scale, policy, dec)))}"
+            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((_ident(g.mesh, base_dir), scale, policy, dec)))}"
             file_name = sources[g.mesh] if dec is None else (
                 os.path.splitext(sources[g.mesh])[0] + ("_mirrored" if mirrored else "") + ".stl")
             shape = Shape("mesh", mesh=MeshRef(g.mesh, scale, file_name, key, policy, decimate=dec,
@@ -155,12 +165,12 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                 for i, g in _indexed(link.collision.source):
                     geom = make_geom(g, lp + ("collision", "source") + i, name, "error", "collision")
                     if geom is not None:
-                        made_from.append(_display_only(geom))
-            collisions = _proxies(made_from, strategy, r.meshes.repair)
+                        made_from.append(_display_only(geom, base_dir))
+            collisions = _proxies(made_from, strategy, r.meshes.repair, base_dir)
             for fmt in ("urdf", "sdf", "mjcf"):
                 if getattr(strategy, fmt) is not None:
                     format_collisions.append((fmt, tuple(_proxies(made_from, getattr(strategy, fmt),
-                                                                  r.meshes.repair))))
+                                                                  r.meshes.repair, base_dir))))
         elif link.collision == "visual":
             collisions = [replace(v, material=None) for v in visuals]
         elif link.collision != "none":
@@ -184,8 +194,9 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
         # meshes no inertial is computed from may be open: they are only drawn and collided
         computed = spec.mode in ("density", "mass")
         old = [g.shape.mesh for g in visuals]
-        visuals = [g if computed and spec.source == "visual" else _display_only(g) for g in visuals]
-        collisions = [g if computed and spec.source == "collision" else _display_only(g) for g in collisions]
+        visuals = [g if computed and spec.source == "visual" else _display_only(g, base_dir) for g in visuals]
+        collisions = [g if computed and spec.source == "collision" else _display_only(g, base_dir)
+                      for g in collisions]
         # proxies read their visual mesh's facts (recentering): follow its new key
         renamed = {m.key: g.shape.mesh for m, g in zip(old, visuals) if m is not None}
 
@@ -327,7 +338,7 @@ def _sensors(r, marks, problems, make_geom, sources, base_dir):
                 if kind == "frame":
                     links.append(Link(lname))
                     continue
-                key = f"d435-{_h(mesh)}"
+                key = f"d435-{_h(_ident(mesh, base_dir))}"
                 sources.setdefault(mesh, "d435.dae")
                 visual = Geom(Shape("mesh", mesh=MeshRef(mesh, (1.0, 1.0, 1.0), "d435.dae", key, "visual-only")),
                               Pose(vxyz, vrpy))
@@ -380,7 +391,7 @@ def _strategy(model, repair: bool) -> Strategy:
     return Strategy(model.strategy, model.max_vertices, dec, tuple(sorted(model.coacd.model_dump().items())), repair)
 
 
-def _proxies(visuals: list[Geom], model, repair: bool) -> list[Geom]:
+def _proxies(visuals: list[Geom], model, repair: bool, base_dir: str) -> list[Geom]:
     """Collision geometry made from the visual geometry by a strategy (mesh parts become proxies
     that the collision tasks turn into pieces; primitives stay as they are)."""
     if model.strategy == "none":
@@ -392,7 +403,7 @@ def _proxies(visuals: list[Geom], model, repair: bool) -> list[Geom]:
         if m is None:
             out.append(replace(g, material=None))
             continue
-        key = f"proxy-{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((m.source, m.scale, strategy)))}"
+        key = f"proxy-{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((_ident(m.source, base_dir), m.scale, strategy)))}"
         out.append(replace(g, material=None, shape=Shape("proxy", mesh=m, strategy=strategy, proxy_key=key)))
     return out
 
@@ -418,11 +429,11 @@ def _share_mesh_tasks(links: list[Link]) -> list[Link]:
             for link in links]
 
 
-def _display_only(geom: Geom) -> Geom:
+def _display_only(geom: Geom, base_dir: str) -> Geom:
     m = geom.shape.mesh
     if m is None or m.open_mesh == "visual-only" or geom.shape.kind == "proxy":
         return geom
-    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((m.source, m.scale, 'visual-only', m.decimate)))}"
+    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((_ident(m.source, base_dir), m.scale, 'visual-only', m.decimate)))}"
     return replace(geom, shape=replace(geom.shape, mesh=replace(m, open_mesh="visual-only", key=key)))
 
 
