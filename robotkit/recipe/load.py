@@ -444,7 +444,7 @@ def schema_problems(exc, marks: Marks, model) -> list[Problem]:
     out: list[Problem] = []
     seen = set()
     for err in exc.errors(include_url=False):
-        loc = tuple(p for p in err["loc"] if p not in _TAGS)
+        loc = tuple(p for p in err["loc"] if p not in _TAGS and p != "[key]")
         msg = _message(err)
         if err["type"] == "extra_forbidden" and len(loc) == 1 and loc[0] in RENAMED:
             msg = f"renamed to '{RENAMED[loc[0]]}' (same values)"

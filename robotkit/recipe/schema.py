@@ -161,6 +161,10 @@ def _xml_element(text: str) -> str:
 XmlElement = Annotated[str, AfterValidator(_xml_element)]
 
 
+Name = Annotated[str, AfterValidator(check_name)]
+"""A name of the recipe that becomes a file or element name (checked where it is written)."""
+
+
 class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", use_attribute_docstrings=True, allow_inf_nan=False)
 
@@ -735,11 +739,11 @@ class Recipe(Strict):
     urdf_extras: list[XmlElement] = []
     """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
     metadata: Metadata = Metadata()
-    materials: dict[str, Material] = {}
+    materials: dict[Name, Material] = {}
     defaults: Defaults = Defaults()
-    links: dict[str, Link]
-    joints: dict[str, Joint] = {}
-    sensors: dict[str, Sensor] = {}
+    links: dict[Name, Link]
+    joints: dict[Name, Joint] = {}
+    sensors: dict[Name, Sensor] = {}
     """Sensors by name; each adds its frame link(s) and appears in every format."""
     actuators: dict[str, Actuator] = {}
     """Actuators by joint name: transmissions / ros2_control in the URDF, actuators in the MJCF, controllers YAML."""
@@ -749,7 +753,7 @@ class Recipe(Strict):
     """Which ROS the package is for, and so everything that depends on it: ``ros2`` (ament_cmake package, ``<ros2_control>`` tags, launch/*.launch.py, ros_gz) or ``ros1`` (catkin package, ``<transmission>`` + gazebo_ros_control, roslaunch XML, gazebo_ros). ``robotkit build --ros`` overrides it."""
     gazebo: Literal["sim", "classic"] | None = None
     """Which Gazebo the URDF's sensor and control plugins and launch/gazebo target: ``sim`` (Gazebo Sim, gz-sim systems; ROS 2 only) or ``classic`` (gazebo_ros plugins). Default: ``sim`` for ROS 2, ``classic`` for ROS 1."""
-    worlds: dict[str, World] = {}
+    worlds: dict[Name, World] = {}
     """Worlds made from occupancy maps, by name (``robotkit world`` does the same from the command line)."""
     args: dict[str, Arg | Scalar] = {}
     """Arguments with their defaults, set with ``--arg NAME:=VALUE`` (``robotkit build``, ``check``, ``expand``; ``doit args='NAME:=VALUE ...'``) or by ``variants``; used as ``${NAME}``."""
@@ -767,9 +771,4 @@ class Recipe(Strict):
     def _robot_name(cls, v):
         return check_name(v)
 
-    @field_validator("materials", "links", "joints", "worlds", "sensors")
-    @classmethod
-    def _names(cls, v):
-        for name in v:
-            check_name(name)
-        return v
+
