@@ -85,7 +85,8 @@ class ReadPolicy:
         """Why ``path`` may not be read (to follow the path's own name), or None when it may."""
         if self.allows(path):
             return None
-        return (f"is outside the project {display_path(self.roots[0])}: robotkit reads only the project and "
+        root = display_path(self.roots[0]).rstrip("/")
+        return (f"is outside the project {root}/: robotkit reads only the project and "
                 f"declared package paths (widen on purpose with --root DIR or {ROOT_ENV})")
 
     def problem(self, path: str | os.PathLike, *, file=None, line=None, key=None) -> Problem | None:

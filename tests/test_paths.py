@@ -34,7 +34,7 @@ def test_reads_outside_the_project_are_refused_with_key(tmp_path, monkeypatch):
     assert not policy.allows("/etc/passwd")
     p = policy.problem("/etc/passwd", file=str(recipe), line=3, key="links.a.visual.mesh")
     assert str(p).endswith("links.a.visual.mesh: /etc/passwd is outside the project "
-                           f"{tmp_path / 'repo'}: robotkit reads only the project and declared package "
+                           f"{tmp_path / 'repo'}/: robotkit reads only the project and declared package "
                            "paths (widen on purpose with --root DIR or ROBOTKIT_ROOT)")
     assert ReadPolicy.for_file(recipe, extra_roots=[tmp_path]).allows(tmp_path / "secret")
     monkeypatch.setenv("ROBOTKIT_ROOT", str(tmp_path))
