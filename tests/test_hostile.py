@@ -379,3 +379,44 @@ def test_fuzz_example_recipes(tmp_path, capsys, monkeypatch):
         runs += 1
     assert files_below(tmp_path) - before <= {f"recipes/{p}" for p in files_below(folder)}
     print(f"fuzz: {runs} mutations, {builds} builds, seed {seed}")
+
+
+# ---------------------------------------------------------------- open meshes
+
+
+def test_repair_fills_only_holes_small_against_the_mesh():
+    """By area and perimeter, not edge count: a sphere missing half its faces stays open; a
+    small cap of many edges is filled, with the volume a hair under the closed sphere's."""
+    import numpy as np
+    import trimesh
+
+    from robotkit.mesh.repair import repair
+
+    sphere = trimesh.creation.icosphere(subdivisions=4, radius=1.0)
+    centres = sphere.triangles_center
+    half = trimesh.Trimesh(sphere.vertices, sphere.faces[centres[:, 2] > 0], process=False)
+    fixed, report = repair(half)
+    assert (report["holes_found"], report["holes_filled"], report["is_volume"]) == (1, 0, False)
+    cap = centres[:, 2] < 0.97  # a cap of 2.5 % of the surface, its rim has more than 16 edges
+    capped = trimesh.Trimesh(sphere.vertices, sphere.faces[cap], process=False)
+    fixed, report = repair(capped)
+    assert report["holes_filled"] == 1 and report["is_volume"] and report["faces_added"] > 16
+    assert sphere.volume * 0.995 < fixed.volume < sphere.volume
+    assert report["hole_area"] == pytest.approx(np.pi * (1 - 0.97 ** 2), rel=0.1)  # the flat disc under the cap
+    slit = (np.abs(centres[:, 2]) < 0.03) & (centres[:, 0] > -0.7)  # along 3/4 of the equator: long, narrow
+    _, report = repair(trimesh.Trimesh(sphere.vertices, sphere.faces[~slit], process=False))
+    assert (report["holes_found"], report["holes_filled"]) == (1, 0)
+
+
+def test_a_filled_hole_that_may_change_the_volume_is_warned_about(project, capsys, monkeypatch):
+    import trimesh
+
+    box = trimesh.creation.box([0.1, 0.1, 0.1])
+    trimesh.Trimesh(box.vertices, box.faces[1:], process=False).export(project / "open.stl")  # half a side
+    (project / "robot.yaml").write_text("robot: arm\nlinks:\n  base: {visual: {mesh: open.stl}}\n")
+    rc, out, err = run(["build", "robot.yaml", "--out", "out", "-j", "1", "--no-report"], project, capsys,
+                       monkeypatch)
+    assert rc == 0, err
+    assert "warning: robot.yaml:3: links.base.visual.mesh: mesh 'open.stl': filled 1 holes (0.005 m^2, 8.3% of " \
+           "its surface) with flat patches; if the missing surface was not flat, the volume and the mass " \
+           "properties may be off by up to 13%" in err.splitlines()

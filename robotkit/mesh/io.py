@@ -128,6 +128,10 @@ def _stl_problem(path: str) -> str | None:
     return None
 
 
+NOTICEABLE = 0.01
+"""A hole filling that may change a mesh's volume by more than this fraction is warned about."""
+
+
 def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):
     """Return (mesh, repairs, used, warnings) where ``mesh`` is a closed volume.
 
@@ -148,6 +152,12 @@ def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):
                           ("holes_filled", "filled {} holes")):
             if report.get(key):
                 repairs.append(text.format(report[key]))
+        if mesh.is_volume and report["hole_volume_bound"] > NOTICEABLE * abs(mesh.volume):
+            warnings.append(
+                f"mesh '{name}': filled {report['holes_filled']} holes ({report['hole_area']:.3g} m^2, "
+                f"{100 * report['hole_area'] / mesh.area:.2g}% of its surface) with flat patches; if the missing "
+                f"surface was not flat, the volume and the mass properties may be off by up to "
+                f"{100 * report['hole_volume_bound'] / abs(mesh.volume):.2g}%")
     if mesh.is_volume:
         return mesh, repairs, "mesh", warnings
     reason = _why_not_volume(mesh)
