@@ -40,10 +40,10 @@ def _real(path: str | os.PathLike) -> str:
 
 def inside(path: str | os.PathLike, root: str | os.PathLike) -> bool:
     """Whether ``path`` is ``root`` or below it once both are resolved (``..`` and symlinks)."""
-    p, r = _real(path), _real(root)
     try:
+        p, r = _real(path), _real(root)
         return os.path.commonpath([p, r]) == r
-    except ValueError:  # different drives
+    except ValueError:  # different drives, a NUL character
         return False
 
 
@@ -83,6 +83,8 @@ class ReadPolicy:
 
     def refusal(self, path: str | os.PathLike) -> str | None:
         """Why ``path`` may not be read (to follow the path's own name), or None when it may."""
+        if "\0" in os.fspath(path):
+            return "is not a valid file name (it holds a NUL character)"
         if self.allows(path):
             return None
         root = display_path(self.roots[0]).rstrip("/")

@@ -136,6 +136,13 @@ CASES = {
         "robot: arm\nlinks: {base: {}}\nvalues: {x: " + "[" * 5000 + "]" * 5000 + "}\n",
         ["robot.yaml:3: nested deeper than 64 levels"],
     ),
+    "nul_and_overlong_file_names": (
+        'robot: arm\ninclude: ["a\\0b", "' + "x" * 300 + '.yaml"]\nlinks:\n  base: {visual: {mesh: "x\\0.stl"}}\n',
+        ["robot.yaml:2: include[0]: included file 'a\\x00b' is not a valid file name (it holds a NUL character)",
+         "robot.yaml:2: include[1]: included file '" + "x" * 300 + ".yaml' does not exist",
+         "robot.yaml:4: links.base.visual.mesh: mesh file '{root}/x\\x00.stl' is not a valid file name "
+         "(it holds a NUL character)"],
+    ),
     "reads_outside_the_project": (
         """
         robot: arm
@@ -358,8 +365,17 @@ def test_fuzz_example_recipes(tmp_path, capsys, monkeypatch):
     while time.monotonic() < end or runs < 5:
         name = rng.choice(sorted(sources))
         data, what = _mutate(sources[name], rng)
+        for _ in range(rng.choice([0, 0, 0, 1, 2])):  # sometimes several at once
+            data, more = _mutate(data, rng)
+            what += f"; {more}"
+        text = yaml.safe_dump(data, sort_keys=False)
+        if rng.random() < 0.1:  # and sometimes the text itself: a line dropped, the file cut short
+            lines = text.splitlines(keepends=True)
+            cut = rng.randrange(len(lines))
+            text = "".join(lines[:cut] + lines[cut + 1:]) if rng.random() < 0.5 else text[:rng.randrange(len(text))]
+            what += f"; text edit at line {cut + 1}"
         what = f"seed {seed}, run {runs}: {name}: {what}"
-        (folder / "fuzz.yaml").write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+        (folder / "fuzz.yaml").write_text(text, encoding="utf-8")
         shutil.rmtree(folder / "out", ignore_errors=True)
         try:
             rc, out, err = load(folder / "fuzz.yaml", folder, monkeypatch)

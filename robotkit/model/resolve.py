@@ -454,6 +454,8 @@ def _geoms(value):
 def _show(path: str) -> str:
     from robotkit.errors import display_path
 
+    if "\0" in path:  # display_path cannot resolve it; show the escape, not the byte
+        return repr(path)[1:-1]
     return display_path(path)
 
 

@@ -212,8 +212,12 @@ def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = (), re
     for i, inc in enumerate(includes):
         if not isinstance(inc, str):
             continue
-        inc_path = (file.parent / inc).resolve()
         where = marks.get(("include", i), (str(file), None))
+        if "\0" in inc:
+            problems.append(Problem(f"included file {inc!r} is not a valid file name (it holds a NUL character)",
+                                    file=where[0], line=where[1], key=f"include[{i}]"))
+            continue
+        inc_path = Path(os.path.realpath(file.parent / inc))  # never raises (long names, loops)
         if inc_path in seen or inc_path == file:
             problems.append(Problem(f"'{inc}' includes itself (include cycle)", file=where[0],
                                     line=where[1], key=f"include[{i}]"))
@@ -221,7 +225,7 @@ def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = (), re
         if (why := reads.refusal(inc_path)) is not None:
             problems.append(Problem(f"included file '{inc}' {why}", file=where[0], line=where[1], key=f"include[{i}]"))
             continue
-        if not inc_path.is_file():
+        if not os.path.isfile(inc_path):
             problems.append(Problem(f"included file '{inc}' does not exist", file=where[0],
                                     line=where[1], key=f"include[{i}]"))
             continue
