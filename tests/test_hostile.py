@@ -436,3 +436,43 @@ def test_a_filled_hole_that_may_change_the_volume_is_warned_about(project, capsy
     assert "warning: robot.yaml:3: links.base.visual.mesh: mesh 'open.stl': filled 1 holes (0.005 m^2, 8.3% of " \
            "its surface) with flat patches; if the missing surface was not flat, the volume and the mass " \
            "properties may be off by up to 13%" in err.splitlines()
+
+
+# ---------------------------------------------------------------- imported and checked files
+
+CYCLIC_URDF = """<?xml version="1.0"?>
+<robot name="cyc">
+  <link name="a"/>
+  <link name="b"/>
+  <link name="c"/>
+  <joint name="j1" type="fixed"><parent link="a"/><child link="b"/></joint>
+  <joint name="j2" type="fixed"><parent link="c"/><child link="b"/></joint>
+  <joint name="j3" type="fixed"><parent link="b"/><child link="c"/></joint>
+  <joint name="j4" type="fixed"><parent link="b"/><child link="nowhere"/></joint>
+</robot>
+"""
+
+
+def test_import_errors_name_the_imported_file_and_line(tmp_path, capsys, monkeypatch):
+    (tmp_path / "cyc.urdf").write_text(CYCLIC_URDF.replace(
+        '  <joint name="j4" type="fixed"><parent link="b"/><child link="nowhere"/></joint>\n', ""))
+    rc, out, err = run(["import", "cyc.urdf", "-o", "recipe/cyc.yaml"], tmp_path, capsys, monkeypatch)
+    assert (rc, out) == (2, "")
+    assert err.splitlines() == [
+        "cyc.urdf:7: joints.j2.child: link 'b' already has a parent (joint 'j1'); a link has at most one",
+        "cyc.urdf:7: joints.j2: joints 'j2', 'j3' form a cycle"]
+    assert not (tmp_path / "recipe").exists() or files_below(tmp_path / "recipe") == set()
+
+
+def test_check_of_a_broken_urdf_tree_is_located_and_ends(tmp_path, capsys, monkeypatch):
+    """check_urdf prints a cyclic tree forever and simulators crash on it: the tree is checked
+    first, each finding with its file and line (JSON too)."""
+    import json
+
+    (tmp_path / "cyc.urdf").write_text(CYCLIC_URDF.replace('<parent link="c"/><child link="b"/>',
+                                                           '<parent link="c"/><child link="a"/>'))
+    rc, out, err = run(["check", "cyc.urdf", "--format", "json"], tmp_path, capsys, monkeypatch)
+    assert (rc, err) == (1, "")
+    found = [(f["subject"], f["message"], f["file"], f["line"]) for f in json.loads(out)["findings"]]
+    assert found == [("joint 'j4'", "its child link 'nowhere' is not a link of the robot", "cyc.urdf", 9),
+                     ("link 'a'", "its joints form a cycle: a <- c <- b <- a", "cyc.urdf", 3)]

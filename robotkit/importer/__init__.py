@@ -129,7 +129,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
                         f"build it with --root {display_path(common)}")
     try:
         with widened(outside):  # the package paths the user declared
-            _check_resolves(tmp, out, conv.invalid_inertias)
+            _check_resolves(tmp, source, _element_lines(text) if text is raw else {}, conv.invalid_inertias)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
@@ -164,10 +164,11 @@ def _validate(recipe: dict, source: Path) -> None:
         raise RobotkitError(problems) from None
 
 
-def _check_resolves(recipe_file: Path, final: Path, invalid_inertias: set[str]) -> None:
+def _check_resolves(recipe_file: Path, source: Path, lines: dict, invalid_inertias: set[str]) -> None:
     """Load and resolve the written recipe as the build will.  Given inertias that the
     build rejects were reported as warnings already: the recipe is still written, so that
-    the user can correct them in it."""
+    the user can correct them in it.  Problems name the imported file and, for a URDF, the
+    line of the link or joint (the recipe is not written when there are any)."""
     from dataclasses import replace
 
     from robotkit.tasks import load_robots
@@ -176,10 +177,29 @@ def _check_resolves(recipe_file: Path, final: Path, invalid_inertias: set[str]) 
         load_robots([recipe_file])
     except RobotkitError as exc:
         keys = {f"links.{name}.inertial.inertia" for name in invalid_inertias}
-        rest = [replace(p, file=str(final) if p.file == str(recipe_file) else p.file)
-                for p in exc.problems if p.key not in keys]
+        rest = []
+        for p in exc.problems:
+            if p.key in keys:
+                continue
+            if p.file == str(recipe_file):
+                parts = (p.key or "").split(".")
+                p = replace(p, file=str(source), line=lines.get(tuple(parts[:2])))
+            rest.append(p)
         if rest:
             raise RobotkitError(rest) from None
+
+
+def _element_lines(urdf_text: str) -> dict[tuple[str, str], int]:
+    """(``links`` or ``joints``, name) -> line of that element in a URDF's text."""
+    from lxml import etree
+
+    try:
+        root = etree.fromstring(urdf_text.encode("utf-8"), etree.XMLParser(resolve_entities=False, no_network=True,
+                                                                           huge_tree=False))
+    except etree.XMLSyntaxError:
+        return {}
+    return {(tag + "s", e.get("name")): e.sourceline for tag in ("link", "joint") for e in root.iter(tag)
+            if e.get("name")}
 
 
 # ---------------------------------------------------------------- meshes that are not closed
