@@ -419,6 +419,10 @@ def test_repair_fills_only_holes_small_against_the_mesh():
     assert report["holes_filled"] == 1 and report["is_volume"] and report["faces_added"] > 16
     assert sphere.volume * 0.995 < fixed.volume < sphere.volume
     assert report["hole_area"] == pytest.approx(np.pi * (1 - 0.97 ** 2), rel=0.1)  # the flat disc under the cap
+    three = (np.abs(centres[:, 2]) < 0.97) & (centres[:, 0] < 0.97)  # three caps, each filled with its own fan
+    fixed, report = repair(trimesh.Trimesh(sphere.vertices, sphere.faces[three], process=False))
+    assert (report["holes_filled"], report["vertices_added"], report["is_volume"]) == (3, 3, True)
+    assert sphere.volume * 0.99 < fixed.volume < sphere.volume
     slit = (np.abs(centres[:, 2]) < 0.03) & (centres[:, 0] > -0.7)  # along 3/4 of the equator: long, narrow
     _, report = repair(trimesh.Trimesh(sphere.vertices, sphere.faces[~slit], process=False))
     assert (report["holes_found"], report["holes_filled"]) == (1, 0)

@@ -186,8 +186,10 @@ def _fill_holes(m, max_edges: int) -> dict:
             centre = V[loop].mean(axis=0)
             c = nv + len(new_vertices)
             patch = [[loop[i], loop[(i + 1) % k], c] for i in range(k)]
-        P = np.vstack([V, centre[None]]) if k > 4 else V
-        tri = P[np.array(patch)]
+        if k > 4:  # the fan's triangles around the new centre vertex
+            tri = np.stack([V[loop], V[np.roll(loop, -1)], np.broadcast_to(centre, (k, 3))], axis=1)
+        else:
+            tri = V[np.array(patch)]
         area = float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum() / 2)
         perimeter = float(np.linalg.norm(V[loop] - V[np.roll(loop, -1)], axis=1).sum())
         if area > max_area or perimeter > max_perimeter:  # not small against the mesh: left open
