@@ -480,3 +480,30 @@ def test_check_of_a_broken_urdf_tree_is_located_and_ends(tmp_path, capsys, monke
     found = [(f["subject"], f["message"], f["file"], f["line"]) for f in json.loads(out)["findings"]]
     assert found == [("joint 'j4'", "its child link 'nowhere' is not a link of the robot", "cyc.urdf", 9),
                      ("link 'a'", "its joints form a cycle: a <- c <- b <- a", "cyc.urdf", 3)]
+
+
+def test_meshes_are_bounded_before_and_after_they_are_decoded(project, capsys, monkeypatch):
+    import numpy as np
+    import trimesh
+
+    from robotkit.mesh import io
+
+    (project / "far.obj").write_text("v 0 0 0\nv 1e30 0 0\nv 0 1e30 0\nv 0 0 1e30\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n")
+    (project / "robot.yaml").write_text("robot: arm\nlinks:\n  base: {visual: {mesh: far.obj}}\n"
+                                        "  b: {visual: {mesh: base.stl, scale: 1000000}}\n"
+                                        "joints:\n  j: {type: fixed, parent: base, child: b}\n")
+    rc, _, err = run(["build", "robot.yaml", "--out", "out", "-j", "1", "--no-report"], project, capsys,
+                     monkeypatch)
+    reach = float(np.abs(trimesh.load(project / "base.stl").vertices).max()) * 1e6
+    assert (rc, written(project / "out")) == (2, [])
+    assert sorted(err.splitlines()) == [  # in the order the mesh tasks ran
+        "robot.yaml:3: links.base.visual.mesh: mesh file 'far.obj' reaches 1e+30 m from its origin once scaled; "
+        "robotkit takes meshes within 10000 m (check its units or scale)",
+        f"robot.yaml:4: links.b.visual.mesh: mesh file 'base.stl' reaches {reach:.3g} m from its origin once "
+        "scaled; robotkit takes meshes within 10000 m (check its units or scale)"]
+    monkeypatch.setattr(io, "MAX_MESH_BYTES", 100)
+    with pytest.raises(io.MeshError) as exc:
+        io.load_mesh(str(project / "base.stl"))
+    size = (project / "base.stl").stat().st_size
+    assert str(exc.value.problems[0]) == f"mesh file 'base.stl' is {size:,} bytes; robotkit reads meshes of at " \
+                                         "most 100 bytes"

@@ -15,6 +15,10 @@ import numpy as np
 from robotkit.errors import MeshError, Problem
 
 SUPPORTED = (".stl", ".obj", ".dae")
+MAX_MESH_BYTES = 256 * 2**20
+"""Largest mesh file decoded (checked before it is read)."""
+MAX_EXTENT = 1e4
+"""Farthest a mesh vertex may lie from the mesh's origin, in metres once scaled (10 km)."""
 
 
 def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
@@ -34,6 +38,9 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
         raise fail(f"mesh file '{name}' has an unsupported format (use STL, OBJ or DAE)")
     if not os.path.isfile(path):
         raise fail(f"mesh file '{name}' does not exist")
+    size = os.path.getsize(path)
+    if size > MAX_MESH_BYTES:
+        raise fail(f"mesh file '{name}' is {size:,} bytes; robotkit reads meshes of at most {MAX_MESH_BYTES:,} bytes")
     if ext == ".stl":
         problem = _stl_problem(path)
         if problem:
@@ -51,7 +58,12 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
     if not np.isfinite(vertices).all():
         raise fail(f"mesh file '{name}' has vertices that are not finite numbers (NaN or inf)")
     scale = np.asarray(scale, dtype=np.float64)
-    mesh = trimesh.Trimesh(vertices * scale, np.asarray(loaded.faces), process=True)
+    vertices = vertices * scale
+    reach = float(np.abs(vertices).max())
+    if not reach <= MAX_EXTENT:
+        raise fail(f"mesh file '{name}' reaches {reach:.3g} m from its origin once scaled; robotkit takes meshes "
+                   f"within {MAX_EXTENT:g} m (check its units or scale)")
+    mesh = trimesh.Trimesh(vertices, np.asarray(loaded.faces), process=True)
     if np.prod(scale) < 0:  # a mirroring scale turns the winding inside out
         mesh.invert()
     return mesh
