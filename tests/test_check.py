@@ -172,12 +172,14 @@ def test_exit_codes_and_formats(tmp_path):
     bad.write_text(arm_urdf(arm=link_xml("arm", inertia=(0.01, 0.01, 0.05))))
     proc = run_cli("check", bad)
     assert proc.returncode == 1
+    line = next(i for i, text in enumerate(bad.read_text().splitlines(), 1) if '<link name="arm"' in text)
     assert proc.stdout.splitlines()[:2] == [
-        "link 'arm'",
+        f"link 'arm' ({bad}:{line})",
         "  error: principal moments 0.01, 0.01, 0.05 violate the triangle inequality (I1 + I2 >= I3): "
         "no real body has them [triangle-inequality]"]
     data = json.loads(run_cli("check", bad, "--format", "json").stdout)
     assert data["errors"] == 1 and data["findings"][0]["subject"] == "link 'arm'"
+    assert (data["findings"][0]["file"], data["findings"][0]["line"]) == (str(bad), line)  # located in the URDF
     junit = ET.fromstring(run_cli("check", bad, "--format", "junit").stdout)
     case = junit.find("testsuite/testcase[@classname='robotkit.triangle-inequality']")
     assert case.get("name") == "link 'arm'" and case.find("failure") is not None
