@@ -147,6 +147,18 @@ def name_problem(name: str) -> str | None:
     if not _SAFE.match(name):
         return ("may contain only ASCII letters, digits, '_', '.' and '-' and must start with a letter, "
                 "a digit or '_' (it becomes a file name)")
+    return reserved_problem(name)
+
+
+_RESERVED = re.compile(r"(CON|PRN|AUX|NUL|COM[0-9]|LPT[0-9])(\..*)?\Z", re.IGNORECASE)
+
+
+def reserved_problem(name: str) -> str | None:
+    """Why ``name`` cannot be a file name on Windows (a device name, a trailing dot), or None."""
+    if _RESERVED.match(name):
+        return f"'{name}' is a device name on Windows and cannot name a file there"
+    if name.endswith("."):
+        return "must not end with '.' (Windows drops it from file names)"
     return None
 
 

@@ -67,3 +67,12 @@ def test_names_that_become_file_names():
     assert file_stem("arm/link1").startswith("arm_link1-") and file_stem("arm/link1") != file_stem("arm_link1")
     assert len(file_stem("y" * 300)) == MAX_NAME
     assert file_stem("y" * 300) != file_stem("y" * 301)
+
+
+def test_names_unsafe_on_windows_are_refused():
+    from robotkit.paths import name_problem
+
+    assert name_problem("con") == "'con' is a device name on Windows and cannot name a file there"
+    assert name_problem("LPT1.txt") == "'LPT1.txt' is a device name on Windows and cannot name a file there"
+    assert name_problem("arm.") == "must not end with '.' (Windows drops it from file names)"
+    assert name_problem("console") is None and name_problem("com_link") is None

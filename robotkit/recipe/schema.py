@@ -135,13 +135,15 @@ def _scale_form(value) -> str | None:
 def check_name(value: str) -> str:
     """A name of the recipe (link, joint, sensor, world...): names become file names, so the
     character set is safe on every filesystem and the length is bounded (robotkit.paths)."""
-    from robotkit.paths import MAX_NAME
+    from robotkit.paths import MAX_NAME, reserved_problem
 
     if not NAME_RE.match(value):
         raise ValueError(f"invalid name {value[:40]!r}{'...' if len(value) > 40 else ''}: {NAME_HINT}")
     if len(value) > MAX_NAME:
         raise ValueError(f"name is {len(value)} characters long; names that become file names are at most "
                          f"{MAX_NAME}")
+    if (why := reserved_problem(value)) is not None:
+        raise ValueError(f"name {why}")
     return value
 
 
