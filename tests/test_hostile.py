@@ -287,6 +287,7 @@ HOSTILE = [float("nan"), float("inf"), -float("inf"), 1e308, -1e308, 1e-308, 0, 
            {}, True, "<?xml version='1.0'?><a/>", "a b", ".hidden", 3.5, "90 deg", "-0"]
 LINE = re.compile(r"^(?P<file>[^:\s][^:]*?)(:(?P<line>\d+))?: (?P<rest>.+)$")
 CHEAP = ("turret_bot.yaml", "lidar_mast.yaml", "quadruped.yaml")  # full builds of these take seconds
+USED_BY = {"parts/leg.yaml": "quadruped.yaml", "include/turtlebot3_burger.gazebo.yaml": "turtlebot3_burger.yaml"}
 
 
 def _paths(node, prefix=()):
@@ -304,7 +305,10 @@ def _mutate(data, rng: random.Random) -> tuple[object, str]:
     import copy
 
     data = copy.deepcopy(data)
-    path = rng.choice([p for p in _paths(data) if p])
+    paths = [p for p in _paths(data) if p]
+    if not paths:
+        return data, "nothing left to mutate"
+    path = rng.choice(paths)
     parent = data
     for k in path[:-1]:
         parent = parent[k]
@@ -358,7 +362,8 @@ def test_fuzz_example_recipes(tmp_path, capsys, monkeypatch):
     rng = random.Random(seed)
     folder = tmp_path / "recipes"
     shutil.copytree(RECIPES, folder)
-    sources = {p.name: yaml.safe_load(p.read_text()) for p in sorted(RECIPES.glob("*.yaml"))}
+    sources = {str(p.relative_to(RECIPES)): yaml.safe_load(p.read_text()) for p in sorted(RECIPES.glob("*.yaml"))}
+    sources.update({name: yaml.safe_load((RECIPES / name).read_text()) for name in USED_BY})  # part, included file
     before = files_below(tmp_path)
     end = time.monotonic() + seconds
     runs = builds = 0
@@ -375,17 +380,20 @@ def test_fuzz_example_recipes(tmp_path, capsys, monkeypatch):
             text = "".join(lines[:cut] + lines[cut + 1:]) if rng.random() < 0.5 else text[:rng.randrange(len(text))]
             what += f"; text edit at line {cut + 1}"
         what = f"seed {seed}, run {runs}: {name}: {what}"
-        (folder / "fuzz.yaml").write_text(text, encoding="utf-8")
+        recipe = USED_BY.get(name, "fuzz.yaml")
+        for other in USED_BY:  # the part and included files as they were, but the one mutated
+            shutil.copyfile(RECIPES / other, folder / other)
+        (folder / (name if name in USED_BY else "fuzz.yaml")).write_text(text, encoding="utf-8")
         shutil.rmtree(folder / "out", ignore_errors=True)
         try:
-            rc, out, err = load(folder / "fuzz.yaml", folder, monkeypatch)
+            rc, out, err = load(folder / recipe, folder, monkeypatch)
         except Exception as exc:  # a traceback: report the mutation that caused it
             raise AssertionError(f"{what}: {type(exc).__name__}: {exc}") from exc
         _check_answer(rc, out, err, what, folder)
-        if rc == 0 and name in CHEAP:
+        if rc == 0 and (name in CHEAP or USED_BY.get(name) in CHEAP):
             builds += 1
             try:
-                rc, out, err = run(["build", "fuzz.yaml", "--out", "out", "-j", "1", "--no-report"], folder, capsys,
+                rc, out, err = run(["build", recipe, "--out", "out", "-j", "1", "--no-report"], folder, capsys,
                                    monkeypatch)
             except Exception as exc:
                 raise AssertionError(f"{what}: {type(exc).__name__}: {exc}") from exc
