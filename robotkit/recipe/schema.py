@@ -164,7 +164,7 @@ XmlElement = Annotated[str, AfterValidator(_xml_element)]
 
 
 Name = Annotated[str, AfterValidator(check_name)]
-"""A name of the recipe that becomes a file or element name (checked where it is written)."""
+"""A name of the recipe: it becomes a file or element name (check_name: safe on every filesystem)."""
 
 
 class Strict(BaseModel):
