@@ -44,6 +44,7 @@ class _Recorder:
         self.started: dict[str, float] = {}
         self.failures = []
         self.runtime_errors: list[str] = []
+        self.not_written: set[str] = set()  # refused by a consumer (exit 1), or not run for a failed dependency
 
     def initialize(self, tasks, selected_tasks):
         pass
@@ -67,10 +68,13 @@ class _Recorder:
         from doit.exceptions import TaskFailed, UnmetDependency
 
         if isinstance(fail, UnmetDependency):
+            self.not_written.add(task.name)
             return
         if isinstance(fail, TaskFailed):
             self.result.failed.append((task.name, fail.message))
             self.result.exit_status = max(self.result.exit_status, getattr(fail, "exit_status", 2))
+            if getattr(fail, "exit_status", 2) == 1:
+                self.not_written.add(task.name)
         else:
             self.result.errors.append((task.name, fail.get_msg()))
 
@@ -207,20 +211,24 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
 
 def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder) -> list[str]:
     """Publish each robot whose tasks all succeeded (robotkit.publish): a failed robot keeps its
-    previous complete output.  Returns the published files."""
+    previous complete output.  A file a consumer would refuse (exit 1: the MJCF of a chain too
+    deep for MuJoCo) is left out of an otherwise complete output, as the build says.
+    Returns the published files."""
     from robotkit.publish import publish, staged_files
 
     if recorder.runtime_errors:
         return []
     owner = {f"world:{w.name}": robot.name for _, robot in robots for w in robot.worlds}
-    bad = {owner.get(name, name.split(":")[0]) for name, _ in result.failed + result.errors}
+    bad = {owner.get(name, name.split(":")[0]) for name, _ in result.failed + result.errors
+           if name not in recorder.not_written}
     published = []
     for _, robot in robots:
         if robot.name in bad:
             continue
         mine = [t for t in tasks if owner.get(t["name"], t["name"].split(":")[0]) == robot.name]
         try:
-            published += publish(out, robot.name, staged_files(mine, out))
+            written = [t for t in mine if t["name"] not in recorder.not_written]
+            published += publish(out, robot.name, staged_files(written, out))
         except OSError as exc:
             result.errors.append((f"{robot.name}:publish", f"cannot publish {robot.name}: {exc}"))
     return published
