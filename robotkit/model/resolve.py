@@ -403,7 +403,8 @@ def _proxies(visuals: list[Geom], model, repair: bool, base_dir: str) -> list[Ge
         if m is None:
             out.append(replace(g, material=None))
             continue
-        key = f"proxy-{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((_ident(m.source, base_dir), m.scale, strategy)))}"
+        ident = _h(repr((_ident(m.source, base_dir), m.scale, strategy)))
+        key = f"proxy-{os.path.splitext(os.path.basename(m.source))[0]}-{ident}"
         out.append(replace(g, material=None, shape=Shape("proxy", mesh=m, strategy=strategy, proxy_key=key)))
     return out
 
@@ -433,7 +434,8 @@ def _display_only(geom: Geom, base_dir: str) -> Geom:
     m = geom.shape.mesh
     if m is None or m.open_mesh == "visual-only" or geom.shape.kind == "proxy":
         return geom
-    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((_ident(m.source, base_dir), m.scale, 'visual-only', m.decimate)))}"
+    ident = _h(repr((_ident(m.source, base_dir), m.scale, "visual-only", m.decimate)))
+    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{ident}"
     return replace(geom, shape=replace(geom.shape, mesh=replace(m, open_mesh="visual-only", key=key)))
 
 
