@@ -16,7 +16,7 @@ import shutil
 from robotkit.errors import Problem, RobotkitError
 from robotkit.ioutil import write_if_changed
 
-FACTS_VERSION = 2
+FACTS_VERSION = 3  # 3: sources relative to the recipe (no absolute or working-folder paths)
 
 
 def _user_errors_fail(fn):
@@ -58,7 +58,7 @@ def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
         raise RobotkitError(Problem(f"mesh '{name}' encloses no volume", **where))
     facts = {
         "version": FACTS_VERSION,
-        "source": name,
+        "source": _label(source, where),
         "scale": list(scale),
         "faces": faces_in,
         "vertices": int(len(mesh.vertices)),
@@ -79,6 +79,15 @@ def _display(path: str) -> str:
     from robotkit.errors import display_path
 
     return display_path(path)
+
+
+def _label(source: str, where: dict) -> str:
+    """A mesh file as recorded in the build's JSON (and report.json): relative to the recipe
+    file that names it, so records never depend on where the recipe sits or robotkit runs."""
+    from pathlib import Path
+
+    base = os.path.dirname(where["file"]) if where.get("file") else os.path.dirname(source)
+    return Path(os.path.relpath(source, base)).as_posix()
 
 
 def _where_text(where: dict) -> str:
@@ -192,7 +201,7 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
 
     loc = Problem("", **where)
     mesh = load_mesh(source, scale, loc)
-    info: dict = {"source": _display(source)}
+    info: dict = {"source": _label(source, where)}
     if repair:
         mesh, info["repair"] = run_repair(mesh)
     kind, value = decimate
@@ -238,7 +247,7 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
 
     loc = Problem("", **where)
     mesh = load_mesh(source, scale, loc)
-    info: dict = {"source": _display(source), "strategy": strategy}
+    info: dict = {"source": _label(source, where), "strategy": strategy}
     if strategy["repair"]:
         mesh, info["repair"] = run_repair(mesh)
     kind = strategy["kind"]
@@ -309,6 +318,13 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
     return list(pieces) if isinstance(pieces, (list, tuple)) else [pieces], info["fidelity"]
 
 
+def publish_outputs(out_dir: str, robot: str, tasks: list[dict]):
+    """``<robot>:publish`` (dodo.py): the robot's staged folders, published (robotkit.publish)."""
+    from robotkit.publish import publish, staged_files
+
+    publish(out_dir, robot, staged_files(tasks, out_dir))
+
+
 @_user_errors_fail
 def picture_report(robot_dir: str, out_dir: str):
     """report.html and its pictures (robotkit.picture; MuJoCo is imported here, in the task)."""
@@ -316,5 +332,6 @@ def picture_report(robot_dir: str, out_dir: str):
 
     from robotkit.picture import report_build_dir
 
+    shutil.rmtree(out_dir, ignore_errors=True)  # the staged report folder: no picture of an earlier build stays
     name = Path(robot_dir).name
     report_build_dir(Path(robot_dir), Path(out_dir), f"../urdf/{name}.urdf")

@@ -49,6 +49,7 @@ class _Recorder:
             self.progress = Progress(None if echo else progress, slow=SLOW)
         self.failures = []
         self.runtime_errors: list[str] = []
+        self.not_written: set[str] = set()  # refused by a consumer (exit 1), or not run for a failed dependency
 
     def initialize(self, tasks, selected_tasks):
         self.progress.total = len(tasks)
@@ -68,10 +69,13 @@ class _Recorder:
 
         self.progress.finished(task.name, ran=False)
         if isinstance(fail, UnmetDependency):
+            self.not_written.add(task.name)
             return
         if isinstance(fail, TaskFailed):
             self.result.failed.append((task.name, fail.message))
             self.result.exit_status = max(self.result.exit_status, getattr(fail, "exit_status", 2))
+            if getattr(fail, "exit_status", 2) == 1:
+                self.not_written.add(task.name)
         else:
             self.result.errors.append((task.name, fail.get_msg()))
 
@@ -183,6 +187,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         recorder.progress.clear()  # no progress line left behind, whatever happened
     if recorder.runtime_errors:
         result.errors.append(("doit", "\n".join(recorder.runtime_errors)))
+    published = _publish(out, robots, tasks, result, recorder)
     if result.failed and not keep_going:
         lines = []
         for _, msg in result.failed:
@@ -197,13 +202,38 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     warnings = build_warnings(robots, out)  # (text, file:line: key: warning: text) pairs
     result.warnings, result.warning_lines = [t for t, _ in warnings], [line for _, line in warnings]
     if rc == 0 and not result.errors and not result.failed:
-        outputs = sorted({str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])})
+        outputs = sorted({str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])} | set(published))
         try:
             stamp.write(out, stamp_options, inputs, outputs,
                         {"robots": result.robots, "tasks": len(tasks), "warnings": result.warning_lines})
         except OSError:
             pass  # no stamp: the next build runs doit's checks
     return result
+
+
+def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder) -> list[str]:
+    """Publish each robot whose tasks all succeeded (robotkit.publish): a failed robot keeps its
+    previous complete output.  A file a consumer would refuse (exit 1: the MJCF of a chain too
+    deep for MuJoCo) is left out of an otherwise complete output, as the build says.
+    Returns the published files."""
+    from robotkit.publish import publish, staged_files
+
+    if recorder.runtime_errors:
+        return []
+    owner = {f"world:{w.name}": robot.name for _, robot in robots for w in robot.worlds}
+    bad = {owner.get(name, name.split(":")[0]) for name, _ in result.failed + result.errors
+           if name not in recorder.not_written}
+    published = []
+    for _, robot in robots:
+        if robot.name in bad:
+            continue
+        mine = [t for t in tasks if owner.get(t["name"], t["name"].split(":")[0]) == robot.name]
+        try:
+            written = [t for t in mine if t["name"] not in recorder.not_written]
+            published += publish(out, robot.name, staged_files(written, out))
+        except OSError as exc:
+            result.errors.append((f"{robot.name}:publish", f"cannot publish {robot.name}: {exc}"))
+    return published
 
 
 def _input_stats(robots, tasks) -> dict:

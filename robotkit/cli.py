@@ -36,6 +36,7 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--name", help="world name (default: the YAML file's stem)")
     w.add_argument("--height", type=float, default=2.0, metavar="H", help="wall height in metres (default: 2.0)")
     w.add_argument("--unknown-as-wall", action="store_true", help="treat unknown cells as walls")
+    _add_root_option(w)
 
     k = sub.add_parser("catalogue", help="turn a folder of object meshes into simulation-ready objects",
                        description="Build every STL/OBJ/DAE mesh below DIR (or listed in a text file, one path "
@@ -78,6 +79,7 @@ def _parser() -> argparse.ArgumentParser:
     out.add_argument("--temp-out", action="store_true",
                      help="build recipes in a temporary folder, removed afterwards (pre-commit: never the user's tree)")
     _add_arg_option(c)
+    _add_root_option(c)
 
     e = sub.add_parser("expand", help="print the flat recipe that a recipe's arguments, expressions, units, "
                                       "parts, conditions and variants expand to",
@@ -85,6 +87,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("recipe", metavar="RECIPE", help="recipe YAML file")
     e.add_argument("--variant", metavar="NAME", help="print only this variant")
     _add_arg_option(e)
+    _add_root_option(e)
 
     from robotkit.importer.cli import add_parser as add_import
 
@@ -98,6 +101,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", metavar="DIR",
                    help="folder for report.html and its pictures (default: <build folder>/report)")
     r.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    _add_root_option(r)
     r.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
                    help="folder of ROS package PKG: package://PKG/ meshes of a URDF, $(find PKG) in a xacro "
                         "file (repeatable)")
@@ -109,6 +113,7 @@ def _parser() -> argparse.ArgumentParser:
     v.add_argument("--port", type=int, default=8080, metavar="N", help="port to serve on (default: 8080)")
     v.add_argument("--no-browser", action="store_true", help="do not open a web browser")
     v.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    _add_root_option(v)
 
     n = sub.add_parser("new", help="write a starter recipe (a link, a joint and a mesh) that builds as written",
                        description="Write NAME.yaml, meshes/NAME/arm.stl and recipe.schema.json (for the editor "
@@ -134,6 +139,22 @@ def _add_arg_option(p: argparse.ArgumentParser) -> None:
                    help="set a recipe argument (repeatable; see the recipe's args:)")
 
 
+ROOT_ENV = "ROBOTKIT_ROOT"  # robotkit.paths.ROOT_ENV, not imported: the no-op build stays light
+
+
+def _add_root_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--root", action="append", default=[], metavar="DIR",
+                   help="also read files below DIR (repeatable; default: only the recipe's repository and "
+                        "ROBOTKIT_ROOT)")
+
+
+def _widen_roots(roots: list[str]) -> None:
+    """``--root DIR``: widen the reads on purpose (robotkit.paths), also for worker processes."""
+    if roots:
+        old = [p for p in os.environ.get(ROOT_ENV, "").split(os.pathsep) if p]
+        os.environ[ROOT_ENV] = os.pathsep.join(dict.fromkeys([os.path.abspath(r) for r in roots] + old))
+
+
 def _add_build(sub) -> None:
     b = sub.add_parser("build", help="build recipes into URDF, Gazebo model folders and meshes",
                        description="Build each RECIPE into OUT/<robot>/ (incremental: only what changed reruns).")
@@ -151,6 +172,7 @@ def _add_build(sub) -> None:
     b.add_argument("--no-report", action="store_true",
                    help="do not write the picture report (<robot>/report/report.html)")
     _add_arg_option(b)
+    _add_root_option(b)
 
 
 def _cores() -> int:
@@ -179,6 +201,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         _parser().print_help()
         return 2
+    _widen_roots(getattr(args, "root", []))
     try:
         return {"build": _build, "world": _world, "schema": _schema, "check": _check,
                 "import": _import, "report": _report, "catalogue": _catalogue, "view": _view, "expand": _expand,

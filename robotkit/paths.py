@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -39,10 +40,10 @@ def _real(path: str | os.PathLike) -> str:
 
 def inside(path: str | os.PathLike, root: str | os.PathLike) -> bool:
     """Whether ``path`` is ``root`` or below it once both are resolved (``..`` and symlinks)."""
-    p, r = _real(path), _real(root)
     try:
+        p, r = _real(path), _real(root)
         return os.path.commonpath([p, r]) == r
-    except ValueError:  # different drives
+    except ValueError:  # different drives, a NUL character
         return False
 
 
@@ -80,14 +81,20 @@ class ReadPolicy:
     def allows(self, path: str | os.PathLike) -> bool:
         return any(inside(path, r) for r in (*self.roots, *self.packages.values()))
 
-    def problem(self, path: str | os.PathLike, *, file=None, line=None, key=None) -> Problem | None:
-        """A :class:`Problem` naming ``key`` when ``path`` is outside every allowed root, else None."""
+    def refusal(self, path: str | os.PathLike) -> str | None:
+        """Why ``path`` may not be read (to follow the path's own name), or None when it may."""
+        if "\0" in os.fspath(path):
+            return "is not a valid file name (it holds a NUL character)"
         if self.allows(path):
             return None
-        return Problem(
-            f"{os.fspath(path)!s} is outside the project {display_path(self.roots[0])}: robotkit reads only "
-            f"the project and declared package paths (widen on purpose with --root DIR or {ROOT_ENV})",
-            file, line, key)
+        root = display_path(self.roots[0]).rstrip("/")
+        return (f"is outside the project {root}/: robotkit reads only the project and "
+                f"declared package paths (widen on purpose with --root DIR or {ROOT_ENV})")
+
+    def problem(self, path: str | os.PathLike, *, file=None, line=None, key=None) -> Problem | None:
+        """A :class:`Problem` naming ``key`` when ``path`` is outside every allowed root, else None."""
+        why = self.refusal(path)
+        return None if why is None else Problem(f"{os.fspath(path)!s} {why}", file, line, key)
 
     def check(self, path: str | os.PathLike, *, file=None, line=None, key=None) -> str:
         """``path`` itself when allowed; raises :class:`RobotkitError` otherwise."""
@@ -95,6 +102,29 @@ class ReadPolicy:
         if p is not None:
             raise RobotkitError(p)
         return os.fspath(path)
+
+
+def recipe_policy(recipe: str | os.PathLike) -> ReadPolicy:
+    """The reads a recipe may make: its project, the roots widened on purpose, and robotkit's
+    own data (the presets' meshes)."""
+    return ReadPolicy.for_file(recipe, extra_roots=(Path(__file__).resolve().parent / "presets",))
+
+
+@contextmanager
+def widened(folders):
+    """Reads also below ``folders`` while inside the ``with`` block (``ROBOTKIT_ROOT``, so
+    worker processes see it too): an importer checking the recipe it wrote, whose meshes sit
+    in the package paths the user declared."""
+    old = os.environ.get(ROOT_ENV)
+    extra = [os.path.abspath(os.fspath(f)) for f in folders]
+    os.environ[ROOT_ENV] = os.pathsep.join(dict.fromkeys(extra + [p for p in (old or "").split(os.pathsep) if p]))
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop(ROOT_ENV, None)
+        else:
+            os.environ[ROOT_ENV] = old
 
 
 def out_join(out_dir: str | os.PathLike, *parts: str, key: str | None = None) -> Path:
@@ -117,6 +147,18 @@ def name_problem(name: str) -> str | None:
     if not _SAFE.match(name):
         return ("may contain only ASCII letters, digits, '_', '.' and '-' and must start with a letter, "
                 "a digit or '_' (it becomes a file name)")
+    return reserved_problem(name)
+
+
+_RESERVED = re.compile(r"(CON|PRN|AUX|NUL|COM[0-9]|LPT[0-9])(\..*)?\Z", re.IGNORECASE)
+
+
+def reserved_problem(name: str) -> str | None:
+    """Why ``name`` cannot be a file name on Windows (a device name, a trailing dot), or None."""
+    if _RESERVED.match(name):
+        return f"'{name}' is a device name on Windows and cannot name a file there"
+    if name.endswith("."):
+        return "must not end with '.' (Windows drops it from file names)"
     return None
 
 

@@ -36,9 +36,11 @@ def _key(options: dict) -> str:
 
 
 def options(recipes, out_dir, extra: dict | None = None) -> dict:
-    """What, besides file contents, decides a build's outputs."""
+    """What, besides file contents, decides a build's outputs (the read roots widened on
+    purpose, ROBOTKIT_ROOT, decide whether it succeeds)."""
+    roots = os.environ.get("ROBOTKIT_ROOT")  # robotkit.paths.ROOT_ENV, not imported: this path stays light
     return {"recipes": [os.path.abspath(os.fspath(r)) for r in recipes], "out": os.path.abspath(os.fspath(out_dir)),
-            **(extra or {})}
+            **({"roots": roots} if roots else {}), **(extra or {})}
 
 
 def path(out_dir, opts: dict) -> str:

@@ -24,9 +24,10 @@ from robotkit import actions
 from robotkit.emit import TEMPLATES, ros
 from robotkit.emit.env import template_dirs
 from robotkit.model.robot import Robot
-from robotkit.paths import file_stem
+from robotkit.paths import file_stem, out_join
+from robotkit.publish import STATE, stage_dir  # STATE: below the output folder, doit's database and JSON
 
-STATE = ".robotkit"  # below the output folder: doit's database and intermediate JSON
+
 
 # emitter -> path below the robot folder
 OUTPUTS = {
@@ -73,7 +74,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     """
     where = where or {}
     out_dir = Path(out_dir).absolute()
-    root = out_dir / robot.name
+    root = out_join(stage_dir(out_dir), robot.name, key="robot")  # published by robotkit.publish
     state = out_dir / STATE / robot.name
     where = where or {}
     tasks: list[dict] = []
@@ -284,10 +285,10 @@ def report_task(robot: Robot, root: Path, tasks: list[dict]) -> dict:
 
 def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
     """One task per world of the recipe: OUT/<world>/ with its five files."""
-    out_dir = Path(out_dir).absolute()
+    out_dir = stage_dir(out_dir)  # published by robotkit.publish with the robot
     tasks = []
     for w in robot.worlds:
-        root = out_dir / w.name
+        root = out_join(out_dir, w.name, key=f"worlds.{w.name}")
         targets = [root / "model.config", root / "model.sdf", root / "meshes" / f"{w.name}.stl",
                    root / f"{w.name}.world", root / "scene.xml"]
         spawn = None
@@ -325,10 +326,17 @@ def _map_image(map_yaml: str) -> list[str]:
     """The image a map YAML names (cheap: the YAML only), when it exists; the task reports the rest."""
     import yaml
 
+    from robotkit.recipe.load import MAX_YAML_BYTES, yaml_limits
+
     try:
+        if os.path.getsize(map_yaml) > MAX_YAML_BYTES:
+            return []
         with open(map_yaml, encoding="utf-8") as f:
-            image = (yaml.safe_load(f) or {}).get("image")
-    except (OSError, yaml.YAMLError, AttributeError):
+            text = f.read()
+        if yaml_limits(text) is not None:  # the world task reports it
+            return []
+        image = (yaml.safe_load(text) or {}).get("image")
+    except (OSError, UnicodeDecodeError, yaml.YAMLError, AttributeError):
         return []
     path = Path(map_yaml).parent / str(image)
     return [str(path)] if image and path.is_file() else []
@@ -420,7 +428,23 @@ def load_robots(recipe_files, ros: str | None = None, args: dict[str, str] | Non
 
 def all_tasks(recipe_files, out_dir, args: dict[str, str] | None = None, ignore_unknown_args: bool = False,
               report: bool = True) -> list[dict]:
+    """Every recipe's tasks, each robot's followed by ``<robot>:publish`` (dodo.py; ``robotkit
+    build`` publishes after doit ran, robotkit.build)."""
     tasks = []
     for loaded, robot in load_robots(recipe_files, None, args, ignore_unknown_args):
-        tasks.extend(robot_tasks(robot, out_dir, mesh_locations(loaded, robot), report=report))
+        mine = robot_tasks(robot, out_dir, mesh_locations(loaded, robot), report=report)
+        tasks.extend(mine)
+        tasks.append(publish_task(robot.name, out_dir, mine))
     return tasks
+
+
+def publish_task(name: str, out_dir, tasks: list[dict]) -> dict:
+    """Publish the robot's folders once all its tasks succeeded (doit skips it otherwise)."""
+    plain = [{"name": t["name"], "targets": list(t.get("targets", []))} for t in tasks]
+    return {
+        "name": f"{name}:publish",
+        "doc": f"publish {name}",
+        "actions": [(actions.publish_outputs, [str(Path(out_dir).absolute()), name, plain])],
+        "task_dep": [t["name"] for t in tasks],
+        "uptodate": [False],  # cheap when nothing changed: the published files are the staged ones
+    }

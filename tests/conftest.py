@@ -37,6 +37,24 @@ def mesh_cache(tmp_path_factory):
         os.environ["ROBOTKIT_CACHE"] = old
 
 
+@pytest.fixture(scope="session", autouse=True)
+def read_roots(tmp_path_factory):
+    """Test recipes written to temporary folders read the example meshes, the shared assets and
+    the packages other tests lay out beside them: widened on purpose, as a user would with
+    ``--root`` (tests of the read rules unset it)."""
+    import os
+
+    from robotkit.paths import ROOT_ENV
+
+    old = os.environ.get(ROOT_ENV)
+    os.environ[ROOT_ENV] = os.pathsep.join([str(REPO), str(ASSETS), str(tmp_path_factory.getbasetemp())])
+    yield
+    if old is None:
+        os.environ.pop(ROOT_ENV, None)
+    else:
+        os.environ[ROOT_ENV] = old
+
+
 @pytest.fixture
 def assets() -> Path:
     if not ASSETS.is_dir():

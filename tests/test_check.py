@@ -179,6 +179,7 @@ def test_exit_codes_and_formats(tmp_path):
         "no real body has them [triangle-inequality]"]
     data = json.loads(run_cli("check", bad, "--format", "json").stdout)
     assert data["errors"] == 1 and data["findings"][0]["subject"] == "link 'arm'"
+    assert (data["findings"][0]["file"], data["findings"][0]["line"]) == (str(bad), line)  # located in the URDF
     junit = ET.fromstring(run_cli("check", bad, "--format", "junit").stdout)
     case = junit.find("testsuite/testcase[@classname='robotkit.triangle-inequality']")
     assert case.get("name") == "link 'arm'" and case.find("failure") is not None

@@ -34,7 +34,7 @@ def test_reads_outside_the_project_are_refused_with_key(tmp_path, monkeypatch):
     assert not policy.allows("/etc/passwd")
     p = policy.problem("/etc/passwd", file=str(recipe), line=3, key="links.a.visual.mesh")
     assert str(p).endswith("links.a.visual.mesh: /etc/passwd is outside the project "
-                           f"{tmp_path / 'repo'}: robotkit reads only the project and declared package "
+                           f"{tmp_path / 'repo'}/: robotkit reads only the project and declared package "
                            "paths (widen on purpose with --root DIR or ROBOTKIT_ROOT)")
     assert ReadPolicy.for_file(recipe, extra_roots=[tmp_path]).allows(tmp_path / "secret")
     monkeypatch.setenv("ROBOTKIT_ROOT", str(tmp_path))
@@ -67,3 +67,12 @@ def test_names_that_become_file_names():
     assert file_stem("arm/link1").startswith("arm_link1-") and file_stem("arm/link1") != file_stem("arm_link1")
     assert len(file_stem("y" * 300)) == MAX_NAME
     assert file_stem("y" * 300) != file_stem("y" * 301)
+
+
+def test_names_unsafe_on_windows_are_refused():
+    from robotkit.paths import name_problem
+
+    assert name_problem("con") == "'con' is a device name on Windows and cannot name a file there"
+    assert name_problem("LPT1.txt") == "'LPT1.txt' is a device name on Windows and cannot name a file there"
+    assert name_problem("arm.") == "must not end with '.' (Windows drops it from file names)"
+    assert name_problem("console") is None and name_problem("com_link") is None

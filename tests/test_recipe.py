@@ -284,7 +284,7 @@ def test_urdf_extras_must_be_well_formed(tmp_path):
         """)
     with pytest.raises(RobotkitError) as err:
         build([recipe], tmp_path / "out")
-    assert err.value.lines() == [f"{recipe}:3: urdf_extras: urdf_extras[0] is not well-formed XML: "
+    assert err.value.lines() == [f"{recipe}:3: urdf_extras[0]: not well-formed XML: "
                                  "mismatched tag: line 1, column 18"]
 
 

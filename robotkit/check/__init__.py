@@ -30,14 +30,24 @@ def _stage(name: str, subject: str, run) -> list[Finding]:
 
 
 def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
+    """Findings on a URDF, each located at its link's or joint's line.  A broken tree (a
+    cycle, a second parent, a missing link) is found here first: the validators and
+    consumers are not given it (check_urdf prints a cycle forever, simulators crash)."""
     from robotkit.check.consumers import Build, consumer_findings
     from robotkit.check.lints import lint, read_urdf_facts
 
-    links, joints, notes = read_urdf_facts(path, package_paths)
-    findings = validate_urdf(path) + notes + lint(links, joints)
-    build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths)
-    findings += _stage("consumers", f"robot '{path.stem}'", lambda: consumer_findings(build, URDF_CONSUMERS)[0])
-    return locate(findings, path)
+    try:
+        links, joints, notes = read_urdf_facts(path, package_paths)
+    except (ValueError, TypeError) as exc:  # numbers that are not numbers
+        raise RobotkitError(Problem(f"not a valid URDF: {exc}", file=str(path))) from None
+    lines, tree = urdf_tree(path)
+    findings = notes + lint(links, joints) + tree
+    if not tree:
+        findings = validate_urdf(path) + findings
+        build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths)
+        findings += _stage("consumers", f"robot '{path.stem}'", lambda: consumer_findings(build, URDF_CONSUMERS)[0])
+    return locate([f if f.file or f.subject not in lines else replace(f, file=str(path), line=lines[f.subject])
+                   for f in findings], path)
 
 
 def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, str]) -> list[Finding]:
@@ -70,6 +80,48 @@ def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, 
                      file=None if f.file == str(urdf) else f.file, line=None if f.file == str(urdf) else f.line)
              for f in findings]
     return locate(moved, path)
+
+
+def urdf_tree(path: Path) -> tuple[dict[str, int], list[Finding]]:
+    """(subject -> line of each ``<link>`` and ``<joint>``, findings on the kinematic tree)."""
+    from lxml import etree
+
+    try:
+        root = etree.parse(str(path), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+    except (etree.XMLSyntaxError, OSError) as exc:
+        raise RobotkitError(Problem(f"not well-formed XML: {exc}", file=str(path))) from None
+    lines = {f"{e.tag} '{e.get('name')}'": e.sourceline for e in root if e.tag in ("link", "joint")}
+    links = {e.get("name") for e in root.iter("link") if e.getparent() is root}
+    found: list[Finding] = []
+
+    def bad(joint, message):
+        found.append(Finding("error", "tree", f"joint '{joint.get('name')}'", message, file=str(path),
+                             line=joint.sourceline))
+
+    parent_of: dict[str, str] = {}
+    for j in (e for e in root if e.tag == "joint"):
+        ends = {}
+        for end in ("parent", "child"):
+            el = j.find(end)
+            ends[end] = el.get("link") if el is not None else None
+            if ends[end] not in links:
+                bad(j, f"its {end} link {ends[end]!r} is not a link of the robot")
+        child = ends["child"]
+        if child in parent_of:
+            bad(j, f"link '{child}' already has a parent ('{parent_of[child]}'); a link has at most one")
+        elif child in links and ends["parent"] in links:
+            parent_of[child] = ends["parent"]
+    cycles = set()
+    for start in sorted(parent_of):
+        seen, node = [], start
+        while node in parent_of and node not in seen:
+            seen.append(node)
+            node = parent_of[node]
+        if node == start and frozenset(seen) not in cycles:
+            cycles.add(frozenset(seen))
+            found.append(Finding("error", "tree", f"link '{start}'", "its joints form a cycle: "
+                                 + " <- ".join(seen + [start]), file=str(path), line=lines.get(f"link '{start}'")))
+    return lines, found
 
 
 def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list[Finding]:

@@ -9,11 +9,34 @@ from pathlib import Path
 from robotkit.check.findings import Finding
 
 
+MAX_OUTPUT = 4 * 2**20
+"""Most bytes of output kept from a validator (check_urdf prints a cyclic tree forever)."""
+TIMEOUT = 300
+"""Seconds a validator may run."""
+
+
+def _limit_output():  # in the child: writing past MAX_OUTPUT to its output file ends it (SIGXFSZ)
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_FSIZE, (MAX_OUTPUT, MAX_OUTPUT))
+
+
 def _run(cmd: list[str]) -> tuple[int, str]:
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    out = "\n".join(line for line in (proc.stdout + proc.stderr).splitlines()
-                    if "libignition-tools-backward" not in line)
-    return proc.returncode, out.strip()
+    """Run a validator with bounded output and time: (exit status, its output without noise)."""
+    import tempfile
+
+    with tempfile.TemporaryFile() as f:
+        try:
+            proc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, timeout=TIMEOUT, preexec_fn=_limit_output)
+            rc = proc.returncode
+        except subprocess.TimeoutExpired:
+            rc = -1
+        f.seek(0)
+        text = f.read(MAX_OUTPUT).decode("utf-8", "replace")
+    if rc == -1:
+        text += f"\nError: {cmd[0]} did not finish in {TIMEOUT} s"
+    out = "\n".join(line for line in text.splitlines() if "libignition-tools-backward" not in line)
+    return rc, out.strip()
 
 
 def validate_urdf(path: Path) -> list[Finding]:

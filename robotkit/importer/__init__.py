@@ -126,6 +126,13 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     name_mesh_folders(recipe)
     _validate(recipe, source)
 
+    from robotkit.paths import inside
+
+    outside = [Problem(f"mesh '{display_path(src)}' would be copied to {display_path(dest)}, outside the "
+                       f"recipe's folder {display_path(out.parent)}", file=str(source))
+               for dest, src in sorted(conv.copies.items()) if not inside(dest, out.parent)]
+    if outside:  # a package:// path climbing out with ../: nothing is written
+        raise RobotkitError(outside)
     copied = []
     for dest, src in sorted(conv.copies.items()):
         if not (os.path.isfile(dest) and _same_bytes(src, dest)):
@@ -145,8 +152,17 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text(text_out, encoding="utf-8")
+    from robotkit.paths import recipe_policy, widened
+
+    read = [] if copy_meshes else [m.source for m in conv.meshes.values()]  # what a build of the recipe reads
+    outside = sorted({os.path.dirname(p) for p in read if not recipe_policy(out).allows(p)})
+    if outside:
+        common = os.path.commonpath(outside)
+        warnings.append(f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: "
+                        f"build it with --root {display_path(common)}")
     try:
-        _check_resolves(tmp, out)
+        with widened(outside):  # the package paths the user declared
+            _check_resolves(tmp, source, _element_lines(text) if text is raw else {})
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
@@ -184,9 +200,11 @@ def _validate(recipe: dict, source: Path) -> None:
         raise RobotkitError(problems) from None
 
 
-def _check_resolves(recipe_file: Path, final: Path) -> None:
+def _check_resolves(recipe_file: Path, source: Path, lines: dict) -> None:
     """Load and resolve the written recipe as the build will (given inertias that no real body
-    has were repaired by the import, each stated in the recipe)."""
+    has were repaired by the import, each stated in the recipe).  Problems name the imported
+    file and, for a URDF, the line of the link or joint (the recipe is not written when there
+    are any)."""
     from dataclasses import replace
 
     from robotkit.tasks import load_robots
@@ -194,5 +212,23 @@ def _check_resolves(recipe_file: Path, final: Path) -> None:
     try:
         load_robots([recipe_file])
     except RobotkitError as exc:
-        raise RobotkitError([replace(p, file=str(final) if p.file == str(recipe_file) else p.file)
-                             for p in exc.problems]) from None
+        rest = []
+        for p in exc.problems:
+            if p.file == str(recipe_file):
+                parts = (p.key or "").split(".")
+                p = replace(p, file=str(source), line=lines.get(tuple(parts[:2])))
+            rest.append(p)
+        raise RobotkitError(rest) from None
+
+
+def _element_lines(urdf_text: str) -> dict[tuple[str, str], int]:
+    """(``links`` or ``joints``, name) -> line of that element in a URDF's text."""
+    from lxml import etree
+
+    try:
+        root = etree.fromstring(urdf_text.encode("utf-8"), etree.XMLParser(resolve_entities=False, no_network=True,
+                                                                           huge_tree=False))
+    except etree.XMLSyntaxError:
+        return {}
+    return {(tag + "s", e.get("name")): e.sourceline for tag in ("link", "joint") for e in root.iter(tag)
+            if e.get("name")}

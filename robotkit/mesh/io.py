@@ -15,6 +15,10 @@ import numpy as np
 from robotkit.errors import MeshError, Problem
 
 SUPPORTED = (".stl", ".obj", ".dae")
+MAX_MESH_BYTES = 256 * 2**20
+"""Largest mesh file decoded (checked before it is read)."""
+MAX_EXTENT = 1e4
+"""Farthest a mesh vertex may lie from the mesh's origin, in metres once scaled (10 km)."""
 
 
 def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
@@ -34,6 +38,9 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
         raise fail(f"mesh file '{name}' has an unsupported format (use STL, OBJ or DAE)")
     if not os.path.isfile(path):
         raise fail(f"mesh file '{name}' does not exist")
+    size = os.path.getsize(path)
+    if size > MAX_MESH_BYTES:
+        raise fail(f"mesh file '{name}' is {size:,} bytes; robotkit reads meshes of at most {MAX_MESH_BYTES:,} bytes")
     if ext == ".stl":
         problem = _stl_problem(path)
         if problem:
@@ -51,7 +58,12 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
     if not np.isfinite(vertices).all():
         raise fail(f"mesh file '{name}' has vertices that are not finite numbers (NaN or inf)")
     scale = np.asarray(scale, dtype=np.float64)
-    mesh = trimesh.Trimesh(vertices * scale, np.asarray(loaded.faces), process=True)
+    vertices = vertices * scale
+    reach = float(np.abs(vertices).max())
+    if not reach <= MAX_EXTENT:
+        raise fail(f"mesh file '{name}' reaches {reach:.3g} m from its origin once scaled; robotkit takes meshes "
+                   f"within {MAX_EXTENT:g} m (check its units or scale)")
+    mesh = trimesh.Trimesh(vertices, np.asarray(loaded.faces), process=True)
     if np.prod(scale) < 0:  # a mirroring scale turns the winding inside out
         mesh.invert()
     return mesh
@@ -128,6 +140,10 @@ def _stl_problem(path: str) -> str | None:
     return None
 
 
+NOTICEABLE = 0.01
+"""A hole filling that may change a mesh's volume by more than this fraction is warned about."""
+
+
 def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):
     """Return (mesh, repairs, used, warnings) where ``mesh`` is a closed volume.
 
@@ -148,6 +164,12 @@ def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):
                           ("holes_filled", "filled {} holes")):
             if report.get(key):
                 repairs.append(text.format(report[key]))
+        if mesh.is_volume and report["hole_volume_bound"] > NOTICEABLE * abs(mesh.volume):
+            warnings.append(
+                f"mesh '{name}': filled {report['holes_filled']} holes ({report['hole_area']:.3g} m^2, "
+                f"{100 * report['hole_area'] / mesh.area:.2g}% of its surface) with flat patches; if the missing "
+                f"surface was not flat, the volume and the mass properties may be off by up to "
+                f"{100 * report['hole_volume_bound'] / abs(mesh.volume):.2g}%")
     if mesh.is_volume:
         return mesh, repairs, "mesh", warnings
     reason = _why_not_volume(mesh)

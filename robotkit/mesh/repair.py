@@ -17,9 +17,14 @@ Library parts and hand-written parts:
   boundary cycle it finds (triangles and quads only unless ``use_fan``, and
   fans from a vertex, wrong for non-convex holes).  Here boundary loops are
   traced with their orientation, loops through a vertex shared by several
-  loops are left alone, and only loops of at most ``max_hole_edges`` edges are
-  closed: a triangle, a quad split along its shorter diagonal, larger loops by
-  a fan from a new vertex at the loop centroid;
+  loops are left alone, and only holes *small against the mesh* are closed: the
+  patch's area at most :data:`MAX_HOLE_AREA` of the mesh's surface and the loop's
+  perimeter at most twice the circumference of a circle of that area (a slit is
+  not small), whatever their edge count; a triangle as it is, a quad split along
+  its shorter diagonal, larger loops by a fan from a new vertex at the loop
+  centroid.  ``hole_area`` and ``hole_volume_bound`` report how much was
+  invented: the bound is the volume of a hemispherical dome over each patch of
+  its area, what the missing surface could have enclosed;
 - orientation is hand-written: ``trimesh.repair.fix_inversion(multibody=True)``
   makes every closed body's volume positive, which turns the inner shell of a
   hollow part (a cavity, correctly inward) outward and adds the cavity's volume
@@ -33,11 +38,13 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-DEFAULT_MAX_HOLE_EDGES = 16
+DEFAULT_MAX_HOLE_EDGES = None  # no limit: holes are judged by area and perimeter
+MAX_HOLE_AREA = 0.1
+"""Largest hole filled, as a fraction of the mesh's surface area."""
 
 
 def repair(mesh, fill_holes: bool = True, *,
-           max_hole_edges: int = DEFAULT_MAX_HOLE_EDGES) -> tuple[trimesh.Trimesh, dict]:
+           max_hole_edges: int | None = DEFAULT_MAX_HOLE_EDGES) -> tuple[trimesh.Trimesh, dict]:
     """Return ``(repaired copy, report)``.
 
     Report keys (counts are ints): ``vertices_in``, ``faces_in``,
@@ -49,7 +56,9 @@ def repair(mesh, fill_holes: bool = True, *,
     most of their input faces had),
     ``nested_bodies`` (closed bodies inside another: cavities or embedded parts),
     ``holes_found``, ``holes_filled``, ``faces_added``, ``vertices_added``,
-    ``holes_left`` (open loops too large or ambiguous to fill),
+    ``holes_left`` (open loops too large against the mesh or ambiguous to fill),
+    ``hole_area`` (m^2 of patches added), ``hole_volume_bound`` (m^3: how far the
+    volume may be off if the missing surface was not flat),
     ``open_edges``, ``nonmanifold_edges``, ``vertices_out``, ``faces_out``,
     ``watertight``, ``winding_consistent``, ``is_volume`` (closed, consistently
     wound, positive volume: the mass properties can be trusted),
@@ -84,7 +93,7 @@ def repair(mesh, fill_holes: bool = True, *,
     if len(m.faces) and not m.is_winding_consistent:
         trimesh.repair.fix_winding(m)
 
-    holes = _fill_holes(m, max_hole_edges if fill_holes else 0)
+    holes = _fill_holes(m, (max_hole_edges or len(m.faces) * 3) if fill_holes else 0)
     report.update(holes)
 
     inverted, nested = _orient_bodies(m, before)
@@ -121,7 +130,8 @@ def _edge_counts(m) -> tuple[int, int]:
 
 def _fill_holes(m, max_edges: int) -> dict:
     """Close boundary loops of at most ``max_edges`` edges, in place; return counts."""
-    out = {"holes_found": 0, "holes_filled": 0, "faces_added": 0, "vertices_added": 0, "holes_left": 0}
+    out = {"holes_found": 0, "holes_filled": 0, "faces_added": 0, "vertices_added": 0, "holes_left": 0,
+           "hole_area": 0.0, "hole_volume_bound": 0.0}
     if len(m.faces) == 0:
         return out
     edges = np.asarray(m.edges)  # directed, 3 per face, in face order
@@ -158,22 +168,37 @@ def _fill_holes(m, max_edges: int) -> dict:
     V = np.asarray(m.vertices)
     new_faces, new_vertices = [], []
     nv = len(V)
+    max_area = MAX_HOLE_AREA * float(m.area)
+    max_perimeter = 2 * 2 * np.sqrt(np.pi * max_area)  # twice a circle's of the largest area
     for loop in loops:
         k = len(loop)
         if k > max_edges:
             continue
         if k == 3:
-            new_faces.append(loop)
+            patch = [loop]
         elif k == 4:
             a, b, c, d = loop
             if np.linalg.norm(V[a] - V[c]) <= np.linalg.norm(V[b] - V[d]):
-                new_faces += [[a, b, c], [a, c, d]]
+                patch = [[a, b, c], [a, c, d]]
             else:
-                new_faces += [[a, b, d], [b, c, d]]
+                patch = [[a, b, d], [b, c, d]]
         else:
-            new_vertices.append(V[loop].mean(axis=0))
-            c = nv + len(new_vertices) - 1
-            new_faces += [[loop[i], loop[(i + 1) % k], c] for i in range(k)]
+            centre = V[loop].mean(axis=0)
+            c = nv + len(new_vertices)
+            patch = [[loop[i], loop[(i + 1) % k], c] for i in range(k)]
+        if k > 4:  # the fan's triangles around the new centre vertex
+            tri = np.stack([V[loop], V[np.roll(loop, -1)], np.broadcast_to(centre, (k, 3))], axis=1)
+        else:
+            tri = V[np.array(patch)]
+        area = float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum() / 2)
+        perimeter = float(np.linalg.norm(V[loop] - V[np.roll(loop, -1)], axis=1).sum())
+        if area > max_area or perimeter > max_perimeter:  # not small against the mesh: left open
+            continue
+        if k > 4:
+            new_vertices.append(centre)
+        new_faces += patch
+        out["hole_area"] += area
+        out["hole_volume_bound"] += 2 / 3 * area * np.sqrt(area / np.pi)  # a hemisphere of the patch's area
         out["holes_filled"] += 1
     out["holes_left"] = out["holes_found"] - out["holes_filled"]
     if new_faces:

@@ -15,6 +15,7 @@ import hashlib
 import math
 import os
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -30,6 +31,15 @@ from robotkit.recipe.schema import UNITS, Collision
 
 def _h(text: str, n: int = 8) -> str:
     return hashlib.sha1(text.encode()).hexdigest()[:n]
+
+
+def _ident(path: str, base_dir: str) -> str:
+    """A mesh file's identity in task keys: its path relative to the recipe's folder (robotkit's
+    own preset meshes by name), so keys never depend on where the recipe or robotkit sit."""
+    presets = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "presets")
+    if os.path.commonpath([os.path.abspath(path), presets]) == presets:
+        return "robotkit:" + Path(os.path.relpath(path, presets)).as_posix()
+    return Path(os.path.relpath(path, base_dir)).as_posix()
 
 
 def _t(v) -> tuple[float, ...]:
@@ -69,15 +79,25 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
             for geom in _geoms(getattr(link, kind)):
                 if geom.mesh:
                     sources.setdefault(geom.mesh, "")
+    from robotkit.paths import file_stem
+
+    def safe_name(src: str) -> str:  # a mesh file's own name, safe as an output file name
+        stem, ext = os.path.splitext(os.path.basename(src))
+        return file_stem(stem) + (ext if file_stem(ext[1:]) == ext[1:] else "")
+
     taken: dict[str, int] = {}
     for src in sources:
-        taken[os.path.basename(src)] = taken.get(os.path.basename(src), 0) + 1
+        taken[safe_name(src)] = taken.get(safe_name(src), 0) + 1
     for src in sources:
-        name = os.path.basename(src)
+        name = safe_name(src)
         if taken[name] > 1:
             stem, ext = os.path.splitext(name)
             name = f"{stem}-{_h(os.path.relpath(src, base_dir))}{ext}"
         sources[src] = name
+
+    from robotkit.paths import recipe_policy
+
+    reads = recipe_policy(loaded.file)
 
     def make_geom(g, path, link_name, policy, role="visual") -> Geom | None:
         if g.material is not None and g.material not in material_names:
@@ -90,6 +110,9 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
         elif g.sphere is not None:
             shape = Shape("sphere", radius=float(g.sphere.radius))
         else:
+            if (why := reads.refusal(g.mesh)) is not None:
+                problems.append(marks.problem(path + ("mesh",), f"mesh file '{_show(g.mesh)}' {why}"))
+                return None
             if not os.path.isfile(g.mesh):
                 problems.append(marks.problem(path + ("mesh",), f"mesh file '{_show(g.mesh)}' does not exist"))
                 return None
@@ -97,7 +120,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                 problems.append(marks.problem(path + ("mesh",),
                                               f"mesh file '{_show(g.mesh)}' has an unsupported format (use STL, OBJ or DAE)"))
                 return None
-            sources.setdefault(g.mesh, os.path.basename(g.mesh))
+            sources.setdefault(g.mesh, safe_name(g.mesh))
             if g.scale is not None:
                 s = g.scale if isinstance(g.scale, list) else [g.scale] * 3
                 scale = _t(s)
@@ -111,7 +134,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
             mirrored = scale[0] * scale[1] * scale[2] < 0
             if mirrored and dec is None:
                 dec = ("none", 0)
-            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((g.mesh, scale, policy, dec)))}"
+            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((_ident(g.mesh, base_dir), scale, policy, dec)))}"
             file_name = sources[g.mesh] if dec is None else (
                 os.path.splitext(sources[g.mesh])[0] + ("_mirrored" if mirrored else "") + ".stl")
             shape = Shape("mesh", mesh=MeshRef(g.mesh, scale, file_name, key, policy, decimate=dec,
@@ -146,12 +169,12 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                 for i, g in _indexed(link.collision.source):
                     geom = make_geom(g, lp + ("collision", "source") + i, name, "error", "collision")
                     if geom is not None:
-                        made_from.append(_display_only(geom))
-            collisions = _proxies(made_from, strategy, r.meshes.repair)
+                        made_from.append(_display_only(geom, base_dir))
+            collisions = _proxies(made_from, strategy, r.meshes.repair, base_dir)
             for fmt in ("urdf", "sdf", "mjcf"):
                 if getattr(strategy, fmt) is not None:
                     format_collisions.append((fmt, tuple(_proxies(made_from, getattr(strategy, fmt),
-                                                                  r.meshes.repair))))
+                                                                  r.meshes.repair, base_dir))))
         elif link.collision == "visual":
             collisions = [replace(v, material=None) for v in visuals]
         elif link.collision != "none":
@@ -182,8 +205,9 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
         # meshes no inertial is computed from may be open: they are only drawn and collided
         computed = spec.mode in ("density", "mass")
         old = [g.shape.mesh for g in visuals]
-        visuals = [g if computed and spec.source == "visual" else _display_only(g) for g in visuals]
-        collisions = [g if computed and spec.source == "collision" else _display_only(g) for g in collisions]
+        visuals = [g if computed and spec.source == "visual" else _display_only(g, base_dir) for g in visuals]
+        collisions = [g if computed and spec.source == "collision" else _display_only(g, base_dir)
+                      for g in collisions]
         # proxies read their visual mesh's facts (recentering): follow its new key
         renamed = {m.key: g.shape.mesh for m, g in zip(old, visuals) if m is not None}
 
@@ -269,7 +293,9 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
             actuators.append(Actuator(name, a.interface, float(a.p), float(a.i), float(a.d)))
     worlds = []
     for name, w in r.worlds.items():
-        if not os.path.isfile(w.map):
+        if (why := reads.refusal(w.map)) is not None:
+            problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' {why}"))
+        elif not os.path.isfile(w.map):
             problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' does not exist"))
         spawn = Pose(_t(w.spawn.xyz), _t(w.spawn.rpy)) if w.spawn is not None else None
         worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall, spawn))
@@ -323,7 +349,7 @@ def _sensors(r, marks, problems, make_geom, sources, base_dir):
                 if kind == "frame":
                     links.append(Link(lname))
                     continue
-                key = f"d435-{_h(mesh)}"
+                key = f"d435-{_h(_ident(mesh, base_dir))}"
                 sources.setdefault(mesh, "d435.dae")
                 visual = Geom(Shape("mesh", mesh=MeshRef(mesh, (1.0, 1.0, 1.0), "d435.dae", key, "visual-only")),
                               Pose(vxyz, vrpy))
@@ -376,7 +402,7 @@ def _strategy(model, repair: bool) -> Strategy:
     return Strategy(model.strategy, model.max_vertices, dec, tuple(sorted(model.coacd.model_dump().items())), repair)
 
 
-def _proxies(visuals: list[Geom], model, repair: bool) -> list[Geom]:
+def _proxies(visuals: list[Geom], model, repair: bool, base_dir: str) -> list[Geom]:
     """Collision geometry made from the visual geometry by a strategy (mesh parts become proxies
     that the collision tasks turn into pieces; primitives stay as they are)."""
     if model.strategy == "none":
@@ -388,7 +414,8 @@ def _proxies(visuals: list[Geom], model, repair: bool) -> list[Geom]:
         if m is None:
             out.append(replace(g, material=None))
             continue
-        key = f"proxy-{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((m.source, m.scale, strategy)))}"
+        ident = _h(repr((_ident(m.source, base_dir), m.scale, strategy)))
+        key = f"proxy-{os.path.splitext(os.path.basename(m.source))[0]}-{ident}"
         out.append(replace(g, material=None, shape=Shape("proxy", mesh=m, strategy=strategy, proxy_key=key)))
     return out
 
@@ -414,11 +441,12 @@ def _share_mesh_tasks(links: list[Link]) -> list[Link]:
             for link in links]
 
 
-def _display_only(geom: Geom) -> Geom:
+def _display_only(geom: Geom, base_dir: str) -> Geom:
     m = geom.shape.mesh
     if m is None or m.open_mesh == "visual-only" or geom.shape.kind == "proxy":
         return geom
-    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{_h(repr((m.source, m.scale, 'visual-only', m.decimate)))}"
+    ident = _h(repr((_ident(m.source, base_dir), m.scale, "visual-only", m.decimate)))
+    key = f"{os.path.splitext(os.path.basename(m.source))[0]}-{ident}"
     return replace(geom, shape=replace(geom.shape, mesh=replace(m, open_mesh="visual-only", key=key)))
 
 
@@ -439,6 +467,8 @@ def _geoms(value):
 def _show(path: str) -> str:
     from robotkit.errors import display_path
 
+    if "\0" in path:  # display_path cannot resolve it; show the escape, not the byte
+        return repr(path)[1:-1]
     return display_path(path)
 
 

@@ -71,15 +71,76 @@ class _PyLoader(yaml.SafeLoader):  # for syntax errors: the pure-Python parser's
     pass
 
 
+MAX_YAML_BYTES = 16 * 2**20
+"""Largest recipe, part or included file read."""
+MAX_DEPTH = 64
+"""Deepest nesting of mappings and lists (libyaml's composer recurses in C: deep nesting crashes it)."""
+MAX_NODES = 1_000_000
+"""Most values a file may hold once its aliases are expanded (an alias bomb stops here)."""
+
+
+def yaml_limits(text: str) -> tuple[str, int] | None:
+    """(problem, line) when ``text`` nests too deep, has a recursive alias or expands past
+    :data:`MAX_NODES` values; None otherwise (syntax errors are left to the composer).
+
+    One pass over libyaml's events, stopping at the first excess, so nothing is built first:
+    each anchor's expanded size is known when its node closes; an alias adds that size."""
+    open_nodes: list[list] = [[0, None]]  # [expanded size, anchor] per open collection
+    sizes: dict[str, int] = {}
+    opened = set()
+    try:
+        for event in yaml.parse(text, Loader=_Loader):
+            kind = type(event)
+            if kind in (yaml.MappingStartEvent, yaml.SequenceStartEvent):
+                if len(open_nodes) > MAX_DEPTH:
+                    return f"nested deeper than {MAX_DEPTH} levels", event.start_mark.line + 1
+                open_nodes.append([1, event.anchor])
+                if event.anchor:
+                    opened.add(event.anchor)
+                continue
+            if kind in (yaml.MappingEndEvent, yaml.SequenceEndEvent):
+                n, anchor = open_nodes.pop()
+                if anchor:
+                    sizes[anchor] = n
+                    opened.discard(anchor)
+            elif kind is yaml.ScalarEvent:
+                n = 1
+                if event.anchor:
+                    sizes[event.anchor] = 1
+            elif kind is yaml.AliasEvent:
+                if event.anchor in opened:
+                    return f"alias '*{event.anchor}' refers to a node that contains it (recursive alias)", \
+                        event.start_mark.line + 1
+                n = sizes.get(event.anchor, 1)  # undefined: the composer says so
+            else:
+                continue
+            open_nodes[-1][0] += n
+            if open_nodes[-1][0] > MAX_NODES or sum(f[0] for f in open_nodes) > MAX_NODES:
+                return (f"aliases expand to more than {MAX_NODES:,} values (an alias bomb?)",
+                        event.start_mark.line + 1)
+    except yaml.YAMLError:
+        return None
+    return None
+
+
 def _read_yaml(file: Path, problems: list[Problem]):
     """Parse ``file``; return (data, marks) with one mark per key path."""
     try:
+        size = file.stat().st_size
+        if size > MAX_YAML_BYTES:
+            problems.append(Problem(f"file is {size:,} bytes; robotkit reads YAML files of at most "
+                                    f"{MAX_YAML_BYTES:,} bytes", file=str(file)))
+            return None, {}
         text = file.read_text(encoding="utf-8")
     except FileNotFoundError:
         problems.append(Problem("file not found", file=str(file)))
         return None, {}
     except (OSError, UnicodeDecodeError) as exc:
         problems.append(Problem(f"cannot read file: {exc}", file=str(file)))
+        return None, {}
+    limit = yaml_limits(text)
+    if limit is not None:
+        problems.append(Problem(limit[0], file=str(file), line=limit[1]))
         return None, {}
     try:
         try:
@@ -129,8 +190,13 @@ def _construct(node, path, file, marks, problems, constructor):
 MERGED_SECTIONS = ("materials", "links", "joints")
 
 
-def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = ()):
-    """Read ``file`` and, recursively, the files it includes; merge their sections."""
+def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = (), reads=None):
+    """Read ``file`` and, recursively, the files it includes (inside ``reads``, a
+    :class:`robotkit.paths.ReadPolicy`); merge their sections."""
+    if reads is None:
+        from robotkit.paths import recipe_policy
+
+        reads = recipe_policy(file)
     data, marks = _read_yaml(file, problems)
     if data is None:
         return None, marks
@@ -143,17 +209,24 @@ def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = ()):
     for i, inc in enumerate(includes):
         if not isinstance(inc, str):
             continue
-        inc_path = (file.parent / inc).resolve()
         where = marks.get(("include", i), (str(file), None))
+        if "\0" in inc:
+            problems.append(Problem(f"included file {inc!r} is not a valid file name (it holds a NUL character)",
+                                    file=where[0], line=where[1], key=f"include[{i}]"))
+            continue
+        inc_path = Path(os.path.realpath(file.parent / inc))  # never raises (long names, loops)
         if inc_path in seen or inc_path == file:
             problems.append(Problem(f"'{inc}' includes itself (include cycle)", file=where[0],
                                     line=where[1], key=f"include[{i}]"))
             continue
-        if not inc_path.is_file():
+        if (why := reads.refusal(inc_path)) is not None:
+            problems.append(Problem(f"included file '{inc}' {why}", file=where[0], line=where[1], key=f"include[{i}]"))
+            continue
+        if not os.path.isfile(inc_path):
             problems.append(Problem(f"included file '{inc}' does not exist", file=where[0],
                                     line=where[1], key=f"include[{i}]"))
             continue
-        sub, sub_marks = _gather(inc_path, problems, seen + (file,))
+        sub, sub_marks = _gather(inc_path, problems, seen + (file,), reads)
         if sub is None:
             continue
         for key in sub:
@@ -318,7 +391,9 @@ def _unwrap(tp):
 
 
 def _num(x) -> str:
-    return f"{x:g}" if isinstance(x, float) else str(x)
+    from robotkit.recipe.schema import _g
+
+    return _g(x) if isinstance(x, float) else str(x)
 
 
 def _message(err: dict) -> str:
@@ -338,7 +413,9 @@ def _message(err: dict) -> str:
         return f"must be < {ctx['lt']}"
     if kind == "less_than_equal":
         return f"must be <= {ctx['le']}"
-    if kind in ("float_parsing", "float_type", "int_parsing", "int_type", "finite_number"):
+    if kind == "finite_number":
+        return f"must be a finite number (got {got!r})"
+    if kind in ("float_parsing", "float_type", "int_parsing", "int_type"):
         return f"must be a number (got {got!r})"
     if kind == "string_type":
         return f"must be a string (got {got!r})"
@@ -368,7 +445,7 @@ def schema_problems(exc, marks: Marks, model) -> list[Problem]:
     out: list[Problem] = []
     seen = set()
     for err in exc.errors(include_url=False):
-        loc = tuple(p for p in err["loc"] if p not in _TAGS)
+        loc = tuple(p for p in err["loc"] if p not in _TAGS and p != "[key]")
         msg = _message(err)
         if err["type"] == "extra_forbidden" and len(loc) == 1 and loc[0] in RENAMED:
             msg = f"renamed to '{RENAMED[loc[0]]}' (same values)"

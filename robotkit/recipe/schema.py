@@ -27,14 +27,56 @@ from __future__ import annotations
 import re
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator, model_validator
+from pydantic import (AfterValidator, BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator,
+                      model_validator)
 
 NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*$")
 NAME_HINT = "a name starts with a letter or '_' and holds only letters, digits, '_', '-' and '.'"
 FRAME_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*(/[A-Za-z0-9_.\-]+)*$")
 FRAME_NAME_HINT = NAME_HINT + ", with '/' between parts (a ROS frame name such as arm/link_1)"
 
-Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+# Physical ranges: every number in a recipe is finite (the model config refuses NaN and
+# infinity) and within these bounds, so nothing downstream overflows or divides by zero.
+MAX_LENGTH = 1e4
+"""Largest length or coordinate in metres (10 km)."""
+MIN_LENGTH = 1e-6
+"""Smallest positive length in metres (a micrometre)."""
+MAX_MASS = 1e6
+"""Largest mass in kg."""
+MIN_MASS = 1e-9
+"""Smallest positive mass in kg."""
+MAX_DENSITY = 1e5
+"""Largest density in kg/m^3 (osmium: 22,590)."""
+MIN_DENSITY = 1e-3
+"""Smallest density in kg/m^3."""
+MAX_ANGLE = 1e3
+"""Largest angle in radians (angles and joint positions)."""
+MAX_VALUE = 1e12
+"""Largest gain, stiffness, effort, rate or other physical coefficient."""
+MAX_SCALE = 1e6
+"""Largest mesh scale factor (and axis component)."""
+MAX_COUNT = 10**8
+"""Largest count (faces, samples, pixels, iterations)."""
+
+
+def _at_least(low: float, unit: str):
+    def check(v):
+        if 0 < abs(v) < low:
+            raise ValueError(f"must be at least {_g(low)} {unit} (got {_g(v)})")
+        return v
+    return AfterValidator(check)
+
+
+def _g(x: float) -> str:
+    """A short number for messages: 1e-06 -> 1e-6, 10000.0 -> 10000."""
+    return f"{x:g}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
+
+
+def _bounded(low: float, high: float):
+    return Field(ge=low, le=high)
+
+
+Vec3 = Annotated[list[Annotated[float, _bounded(-MAX_SCALE, MAX_SCALE)]], Field(min_length=3, max_length=3)]
 
 
 class Dim:
@@ -55,12 +97,20 @@ class Dim:
 
 
 LENGTH, ANGLE, MASS, POSITION = Dim("length"), Dim("angle"), Dim("mass"), Dim("position")
-LengthVec3 = Annotated[list[Annotated[float, LENGTH]], Field(min_length=3, max_length=3)]
-AngleVec3 = Annotated[list[Annotated[float, ANGLE]], Field(min_length=3, max_length=3)]
-PositiveLength = Annotated[float, Field(gt=0), LENGTH]
+Length = Annotated[float, _bounded(-MAX_LENGTH, MAX_LENGTH), LENGTH]
+Angle = Annotated[float, _bounded(-MAX_ANGLE, MAX_ANGLE), ANGLE]
+Position = Annotated[float, _bounded(-MAX_LENGTH, MAX_LENGTH), POSITION]
+LengthVec3 = Annotated[list[Length], Field(min_length=3, max_length=3)]
+AngleVec3 = Annotated[list[Angle], Field(min_length=3, max_length=3)]
+PositiveLength = Annotated[float, Field(gt=0, le=MAX_LENGTH), _at_least(MIN_LENGTH, "m"), LENGTH]
 Rgba = Annotated[list[Annotated[float, Field(ge=0, le=1)]], Field(min_length=4, max_length=4)]
-Positive = Annotated[float, Field(gt=0)]
-NonNegative = Annotated[float, Field(ge=0)]
+Positive = Annotated[float, Field(gt=0, le=MAX_VALUE)]
+NonNegative = Annotated[float, Field(ge=0, le=MAX_VALUE)]
+PositiveMass = Annotated[float, Field(gt=0, le=MAX_MASS), _at_least(MIN_MASS, "kg"), MASS]
+Density = Annotated[float, Field(gt=0, le=MAX_DENSITY), _at_least(MIN_DENSITY, "kg/m^3")]
+Count = Annotated[int, Field(gt=0, le=MAX_COUNT)]
+InertiaValue = Annotated[float, _bounded(-MAX_VALUE, MAX_VALUE)]
+ScaleFactor = Annotated[float, _bounded(-MAX_SCALE, MAX_SCALE)]
 
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}
 Units = Literal["m", "cm", "mm", "in"]
@@ -85,21 +135,57 @@ def _scale_form(value) -> str | None:
 
 
 def check_name(value: str) -> str:
+    """A name of the recipe (link, joint, sensor, world...): names become file names, so the
+    character set is safe on every filesystem and the length is bounded (robotkit.paths)."""
+    from robotkit.paths import MAX_NAME, reserved_problem
+
     if not NAME_RE.match(value):
-        raise ValueError(f"invalid name {value!r}: {NAME_HINT}")
+        raise ValueError(f"invalid name {value[:40]!r}{'...' if len(value) > 40 else ''}: {NAME_HINT}")
+    if len(value) > MAX_NAME:
+        raise ValueError(f"name is {len(value)} characters long; names that become file names are at most "
+                         f"{MAX_NAME}")
+    if (why := reserved_problem(value)) is not None:
+        raise ValueError(f"name {why}")
     return value
 
 
 def check_frame_name(value: str) -> str:
     """Link and joint names: as :func:`check_name`, and '/' between parts (ROS accepts them;
     files named after them go through :func:`robotkit.paths.file_stem`)."""
+    from robotkit.paths import MAX_NAME
+
     if not FRAME_NAME_RE.match(value):
-        raise ValueError(f"invalid name {value!r}: {FRAME_NAME_HINT}")
+        raise ValueError(f"invalid name {value[:40]!r}{'...' if len(value) > 40 else ''}: {FRAME_NAME_HINT}")
+    if len(value) > MAX_NAME:
+        raise ValueError(f"name is {len(value)} characters long; names that become file names are at most "
+                         f"{MAX_NAME}")
     return value
 
 
+def _xml_element(text: str) -> str:
+    """One well-formed XML element, without a declaration (it is pasted inside the URDF)."""
+    import xml.etree.ElementTree as ET
+
+    if text.lstrip().startswith("<?"):
+        raise ValueError("starts with an XML declaration or processing instruction: give the element alone")
+    try:
+        ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ValueError(f"not well-formed XML: {exc}") from None
+    return text
+
+
+XmlElement = Annotated[str, AfterValidator(_xml_element)]
+
+
+Name = Annotated[str, AfterValidator(check_name)]
+"""A name of the recipe: it becomes a file or element name (check_name: safe on every filesystem)."""
+FrameName = Annotated[str, AfterValidator(check_frame_name)]
+"""A link or joint name: a :data:`Name`, or ROS frame parts joined by '/'."""
+
+
 class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", use_attribute_docstrings=True, allow_inf_nan=False)
 
 
 class Origin(Strict):
@@ -131,7 +217,7 @@ class Sphere(Strict):
 class Decimate(Strict):
     """Quadric decimation to a face count or a fraction of the faces (exactly one)."""
 
-    faces: Annotated[int, Field(gt=3)] | None = None
+    faces: Annotated[int, Field(gt=3, le=MAX_COUNT)] | None = None
     """Target number of triangles."""
     ratio: Annotated[float, Field(gt=0, le=1)] | None = None
     """Fraction of the triangles to keep."""
@@ -148,17 +234,17 @@ class Coacd(Strict):
 
     threshold: Annotated[float, Field(ge=0.01, le=1)] = 0.05
     """Concavity threshold: smaller gives more, finer pieces."""
-    max_hulls: int = -1
+    max_hulls: Annotated[int, Field(ge=-1, le=MAX_COUNT)] = -1
     """Upper bound on the number of pieces (-1: none)."""
-    resolution: Annotated[int, Field(gt=0)] = 2000
+    resolution: Count = 2000
     """Surface sampling resolution."""
     preprocess: Literal["auto", "on", "off"] = "auto"
     """``auto``: a closed mesh goes to CoACD as the union of its bodies (exact, no remeshing; above 20,000 faces decimated to 20,000 first), any other mesh is remeshed into a manifold when it is not one; ``on``: always remesh; ``off``: the mesh as it is."""
-    preprocess_resolution: Annotated[int, Field(gt=0)] = 50
+    preprocess_resolution: Annotated[int, Field(gt=0, le=1000)] = 50
     """Voxel resolution of that remeshing."""
-    seed: int = 0
+    seed: Annotated[int, Field(ge=0, le=2**32 - 1)] = 0
     """Random seed (the same seed gives the same pieces)."""
-    mcts_iterations: Annotated[int, Field(gt=0)] = 150
+    mcts_iterations: Count = 150
     """Cutting-plane search iterations (fewer: faster and coarser)."""
 
 
@@ -167,7 +253,7 @@ class Proxy(Strict):
 
     strategy: Literal["mesh", "hull", "decompose", "box", "cylinder", "sphere", "capsule", "none"]
     """``mesh``: the visual mesh (optionally decimated); ``hull``: one convex hull; ``decompose``: convex pieces by CoACD; ``box`` (oriented bounding box), ``cylinder``, ``sphere``, ``capsule``: a fitted primitive; ``none``: no collision."""
-    max_vertices: Annotated[int, Field(ge=4)] | None = None
+    max_vertices: Annotated[int, Field(ge=4, le=MAX_COUNT)] | None = None
     """Vertex budget of a hull or of each decomposed piece (MuJoCo recommends at most 64)."""
     decimate: Decimate | None = None
     """For ``mesh``: decimate the collision mesh."""
@@ -207,7 +293,7 @@ class Geometry(Strict):
     units: Units | None = None
     """Units of the mesh file's coordinates (m, cm, mm, in). Default: the recipe's ``units``."""
     scale: Annotated[
-        Annotated[float, Tag("number")] | Annotated[Vec3, Tag("vector")], Discriminator(_scale_form)
+        Annotated[ScaleFactor, Tag("number")] | Annotated[Vec3, Tag("vector")], Discriminator(_scale_form)
     ] | None = None
     """Explicit scale applied to the mesh coordinates (instead of ``units``); a number or [sx, sy, sz]."""
     recenter: Literal["none", "bbox", "com"] = "none"
@@ -238,20 +324,23 @@ class Geometry(Strict):
                 raise ValueError("'decimate' applies to mesh geometry only")
         elif self.units is not None and self.scale is not None:
             raise ValueError("give either 'units' or 'scale', not both")
-        if isinstance(self.scale, list) and any(s == 0 for s in self.scale) or self.scale == 0:
+        scales = self.scale if isinstance(self.scale, list) else [self.scale] if self.scale is not None else []
+        if any(s == 0 for s in scales):
             raise ValueError("scale must not be 0")
+        if any(abs(s) < 1e-9 for s in scales):
+            raise ValueError("scale must be at least 1e-9 in size")
         return self
 
 
 class Inertia(Strict):
     """Inertia tensor about the centre of mass, in the link frame, kg m^2."""
 
-    ixx: float
-    iyy: float
-    izz: float
-    ixy: float = 0.0
-    ixz: float = 0.0
-    iyz: float = 0.0
+    ixx: InertiaValue
+    iyy: InertiaValue
+    izz: InertiaValue
+    ixy: InertiaValue = 0.0
+    ixz: InertiaValue = 0.0
+    iyz: InertiaValue = 0.0
 
 
 class Inertial(Strict):
@@ -262,9 +351,9 @@ class Inertial(Strict):
     - ``mass`` + ``com`` + ``inertia``: given explicitly.
     """
 
-    density: Positive | None = None
+    density: Density | None = None
     """Density in kg/m^3. Default: the recipe's ``density``."""
-    mass: Annotated[Positive, MASS] | None = None
+    mass: PositiveMass | None = None
     """Total mass in kg."""
     com: LengthVec3 | None = None
     """Centre of mass in the link frame, metres (explicit inertials only)."""
@@ -339,9 +428,9 @@ class Link(Strict):
 
 
 class Limit(Strict):
-    lower: Annotated[float, POSITION] | None = None
+    lower: Position | None = None
     """Lower position limit (rad or m). Required for revolute and prismatic joints."""
-    upper: Annotated[float, POSITION] | None = None
+    upper: Position | None = None
     """Upper position limit (rad or m). Required for revolute and prismatic joints."""
     effort: NonNegative | None = None
     """Maximum effort (N m or N). Required for revolute and prismatic joints."""
@@ -361,8 +450,8 @@ class Dynamics(Strict):
 class Mimic(Strict):
     joint: str
     """The joint this joint follows: position = multiplier * joint + offset."""
-    multiplier: float = 1.0
-    offset: Annotated[float, POSITION] = 0.0
+    multiplier: ScaleFactor = 1.0
+    offset: Position = 0.0
 
 
 JOINT_TYPES = ("fixed", "revolute", "continuous", "prismatic", "floating", "planar")
@@ -468,9 +557,9 @@ class Defaults(Strict):
 
 
 class CameraParams(Strict):
-    width: Annotated[int, Field(gt=0)] = 640
+    width: Annotated[int, Field(gt=0, le=65536)] = 640
     """Image width in pixels."""
-    height: Annotated[int, Field(gt=0)] = 480
+    height: Annotated[int, Field(gt=0, le=65536)] = 480
     """Image height in pixels."""
     hfov: Annotated[float, Field(gt=0, lt=3.1416), ANGLE] = 1.047
     """Horizontal field of view in radians."""
@@ -483,23 +572,23 @@ class CameraParams(Strict):
 
 
 class LidarParams(Strict):
-    samples: Annotated[int, Field(gt=0)] = 360
+    samples: Annotated[int, Field(gt=0, le=10**6)] = 360
     """Horizontal rays per scan."""
-    min_angle: Annotated[float, ANGLE] = -3.141592653589793
+    min_angle: Angle = -3.141592653589793
     """Start of the horizontal scan, radians."""
-    max_angle: Annotated[float, ANGLE] = 3.141592653589793
+    max_angle: Angle = 3.141592653589793
     """End of the horizontal scan, radians."""
-    vertical_samples: Annotated[int, Field(gt=0)] = 1
+    vertical_samples: Annotated[int, Field(gt=0, le=10**6)] = 1
     """Vertical rays (1: a 2D lidar)."""
-    vertical_min_angle: Annotated[float, ANGLE] = 0.0
-    vertical_max_angle: Annotated[float, ANGLE] = 0.0
+    vertical_min_angle: Angle = 0.0
+    vertical_max_angle: Angle = 0.0
     min_range: PositiveLength = 0.1
     """Minimum range in metres."""
     max_range: PositiveLength = 12.0
     """Maximum range in metres."""
     resolution: PositiveLength = 0.01
     """Range resolution in metres."""
-    noise: Annotated[float, Field(ge=0), LENGTH] = 0.0
+    noise: Annotated[float, Field(ge=0, le=MAX_LENGTH), LENGTH] = 0.0
     """Standard deviation of Gaussian range noise, metres."""
 
 
@@ -522,7 +611,7 @@ class SensorBody(Strict):
 
     visual: Shapes
     """The sensor's shape (also its collision geometry)."""
-    mass: Annotated[Positive, MASS]
+    mass: PositiveMass
     """Mass in kg; the inertia is computed from the shape at uniform density."""
 
 
@@ -537,7 +626,7 @@ class Sensor(Strict):
     """Pose of the sensor frame in the parent link (for ``d435``: of the bottom screw frame)."""
     frame: str | None = None
     """Name of the sensor's frame link. Default: ``<sensor>_link`` (``d435``: frames ``<sensor>_*`` as upstream)."""
-    update_rate: Positive = 30.0
+    update_rate: Annotated[float, Field(gt=0, le=1e6)] = 30.0
     """Updates per second."""
     topic: str | None = None
     """Topic name. Default: the sensor's name."""
@@ -548,6 +637,11 @@ class Sensor(Strict):
     body: SensorBody | None = None
     if_: bool | None = Field(None, alias="if")
     """Keep this entry only when true (usually an expression of arguments: ``${with_camera}``)."""
+
+    @field_validator("frame")
+    @classmethod
+    def _frame_name(cls, v):
+        return v if v is None else check_name(v)
 
     @model_validator(mode="after")
     def _params(self):
@@ -653,7 +747,7 @@ class Recipe(Strict):
     """Other YAML files (relative to this one) whose materials, links and joints are merged into this recipe (and whose urdf_extras are appended)."""
     units: Units = "m"
     """Default units of mesh files (m, cm, mm, in)."""
-    density: Positive = 1000.0
+    density: Density = 1000.0
     """Default density in kg/m^3 for inertials computed from geometry."""
     inertia_policy: Literal["keep", "repair"] = "keep"
     """Explicit inertias: ``keep`` them as given, or ``repair`` those no real body has with the smallest change (per link: ``inertial.policy``)."""
@@ -661,18 +755,18 @@ class Recipe(Strict):
     """Default policy for meshes that are not closed volumes after safe repair."""
     meshes: MeshDefaults = MeshDefaults()
     """Mesh processing defaults: repair, visual decimation, collision strategy."""
-    measured_mass: Annotated[Positive, MASS] | None = None
+    measured_mass: PositiveMass | None = None
     """The robot's total mass as weighed, in kg; `robotkit check` compares it with the sum of the links' masses."""
     self_collide: bool = False
     """Whether the robot's links collide with each other (Gazebo's ``self_collide``; MJCF contact filtering). Links joined by a joint never collide."""
-    urdf_extras: list[str] = []
+    urdf_extras: list[XmlElement] = []
     """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
     metadata: Metadata = Metadata()
-    materials: dict[str, Material] = {}
+    materials: dict[Name, Material] = {}
     defaults: Defaults = Defaults()
-    links: dict[str, Link]
-    joints: dict[str, Joint] = {}
-    sensors: dict[str, Sensor] = {}
+    links: dict[FrameName, Link]
+    joints: dict[FrameName, Joint] = {}
+    sensors: dict[Name, Sensor] = {}
     """Sensors by name; each adds its frame link(s) and appears in every format."""
     actuators: dict[str, Actuator] = {}
     """Actuators by joint name: transmissions / ros2_control in the URDF, actuators in the MJCF, controllers YAML."""
@@ -682,7 +776,7 @@ class Recipe(Strict):
     """Which ROS the package is for, and so everything that depends on it: ``ros2`` (ament_cmake package, ``<ros2_control>`` tags, launch/*.launch.py, ros_gz) or ``ros1`` (catkin package, ``<transmission>`` + gazebo_ros_control, roslaunch XML, gazebo_ros). ``robotkit build --ros`` overrides it."""
     gazebo: Literal["sim", "classic"] | None = None
     """Which Gazebo the URDF's sensor and control plugins and launch/gazebo target: ``sim`` (Gazebo Sim, gz-sim systems; ROS 2 only) or ``classic`` (gazebo_ros plugins). Default: ``sim`` for ROS 2, ``classic`` for ROS 1."""
-    worlds: dict[str, World] = {}
+    worlds: dict[Name, World] = {}
     """Worlds made from occupancy maps, by name (``robotkit world`` does the same from the command line)."""
     args: dict[str, Arg | Scalar] = {}
     """Arguments with their defaults, set with ``--arg NAME:=VALUE`` (``robotkit build``, ``check``, ``expand``; ``doit args='NAME:=VALUE ...'``) or by ``variants``; used as ``${NAME}``."""
@@ -700,28 +794,4 @@ class Recipe(Strict):
     def _robot_name(cls, v):
         return check_name(v)
 
-    @field_validator("urdf_extras")
-    @classmethod
-    def _well_formed(cls, v):
-        import xml.etree.ElementTree as ET
 
-        for i, text in enumerate(v):
-            try:
-                ET.fromstring(text)
-            except ET.ParseError as exc:
-                raise ValueError(f"urdf_extras[{i}] is not well-formed XML: {exc}") from None
-        return v
-
-    @field_validator("materials", "worlds", "sensors")
-    @classmethod
-    def _names(cls, v):
-        for name in v:
-            check_name(name)
-        return v
-
-    @field_validator("links", "joints")
-    @classmethod
-    def _frame_names(cls, v):
-        for name in v:
-            check_frame_name(name)
-        return v

@@ -55,6 +55,10 @@ def check_name(name: str) -> str:
     if not isinstance(name, str) or not _NAME.match(name):
         raise MapError(Problem(f"{name!r} cannot name a Gazebo model and its files "
                                "(use letters, digits, '_', '-' and '.')", key="name"))
+    from robotkit.paths import name_problem
+
+    if (why := name_problem(name)) is not None:
+        raise MapError(Problem(f"name {why}", key="name"))
     return name
 
 

@@ -225,6 +225,11 @@ def load_map(map_yaml: str | os.PathLike) -> OccupancyMap:
             bad("image", f"must be the image file name (PGM or PNG), not {_show(image)}")
         else:
             image_path = Path(image) if os.path.isabs(image) else yaml_path.parent / image
+            from robotkit.paths import ReadPolicy
+
+            if (why := ReadPolicy.for_file(yaml_path).refusal(image_path)) is not None:
+                bad("image", f"image file '{image}' {why}")
+                image_path = None
 
     resolution = None
     if "resolution" in data:

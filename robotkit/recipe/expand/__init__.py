@@ -78,9 +78,10 @@ class Expanded:
 class Context:
     """Problems and the part definitions visible while expanding."""
 
-    def __init__(self, read_yaml, problems: list[Problem]):
+    def __init__(self, read_yaml, problems: list[Problem], reads=None):
         self.read_yaml = read_yaml  # file -> (data, marks) (robotkit.recipe.load._read_yaml)
         self.problems = problems
+        self.reads = reads  # where part files may be read (robotkit.paths.ReadPolicy)
         self.part_files: dict = {}  # resolved path -> (data, marks)
 
     def report(self, src: Source, rel, message: str):
@@ -298,7 +299,9 @@ def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_y
     """The flat recipe(s) of ``data``: one per variant (one when there are none)."""
     from robotkit.recipe.expand.parts import expand_instances
 
-    ctx = Context(read_yaml, problems)
+    from robotkit.paths import recipe_policy
+
+    ctx = Context(read_yaml, problems, recipe_policy(file))
     top = Source(where)
     if not any(k in data for k in CONTROL) and not overrides and not _has_if(data) and not _has_dollar(
             {k: v for k, v in data.items() if k not in VERBATIM}):

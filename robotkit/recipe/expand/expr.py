@@ -102,7 +102,10 @@ class _Eval:
 
     def v_Name(self, node):
         if node.id in self.scope:
-            return self.scope[node.id]
+            value = self.scope[node.id]
+            if not isinstance(value, (bool, int, float, str)):  # a value the schema will reject too
+                raise ExprError(f"'{node.id}' is not a number, true/false or text (got {show(value)})")
+            return value
         if node.id in CONSTANTS:
             return CONSTANTS[node.id]
         if node.id in FUNCTIONS:

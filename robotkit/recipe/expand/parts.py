@@ -63,7 +63,11 @@ def _find_part(part: str, parts_env: list, ctx):
             file, _ = bsrc.locate((part,))
             path = os.path.normpath(str(Path(file or def_file).parent / definition))
             if path not in ctx.part_files:
-                if not os.path.isfile(path):
+                why = ctx.reads.refusal(path) if ctx.reads is not None else None
+                if why is not None:
+                    ctx.report(bsrc, (part,), f"part file '{definition}' {why}")
+                    ctx.part_files[path] = (None, {})
+                elif not os.path.isfile(path):
                     ctx.report(bsrc, (part,), f"part file '{definition}' does not exist")
                     ctx.part_files[path] = (None, {})
                 else:
@@ -107,7 +111,7 @@ def _instance(name, spec, isrc: Source, scope, parts_env, ctx, flat, items, defa
                        else f"must be a name (got {spec[key]!r})")
             bad = True
     mirror = spec.get("mirror")
-    if mirror is not None and mirror not in MIRRORS:
+    if mirror is not None and (not isinstance(mirror, str) or mirror not in MIRRORS):
         ctx.report(isrc, ("mirror",), f"must be one of xz, yz, xy (got {mirror!r})")
         bad = True
     prefix = spec.get("prefix", f"{name}_")
@@ -279,7 +283,9 @@ def _compose(pose, origin):
     if not isinstance(origin, dict):
         origin = {}
     xyz1, rpy1 = origin.get("xyz", [0, 0, 0]), origin.get("rpy", [0, 0, 0])
-    if not all(_is_num(v) for v in list(xyz1) + list(rpy1)) or len(xyz1) != 3 or len(rpy1) != 3:
+    values = [xyz0, rpy0, xyz1, rpy1]
+    if not all(isinstance(v, (list, tuple)) and len(v) == 3 and all(_is_num(x) and math.isfinite(x) for x in v)
+               for v in values):
         return origin  # the schema reports it
     if not any(rpy0):
         return {"xyz": [a + b for a, b in zip(xyz0, xyz1)], "rpy": list(rpy1)}

@@ -135,9 +135,11 @@ def _walk(value, tp, path, joint_type, problem):
     si, dim = q
     want = dims[0].kind if dims else None
     if want == "position":
-        want = {"revolute": "angle", "continuous": "angle", "prismatic": "length"}.get(joint_type)
+        want = {"revolute": "angle", "continuous": "angle", "prismatic": "length"}.get(
+            joint_type if isinstance(joint_type, str) else None)
         if want is None:
-            problem(path, f"takes a plain number for a {joint_type or 'untyped'} joint (got '{value.strip()}')")
+            kind = joint_type if isinstance(joint_type, str) and joint_type else "untyped"
+            problem(path, f"takes a plain number for a {kind} joint (got '{value.strip()}')")
             return value
     if want is None:
         problem(path, f"takes a plain number, not a quantity with units (got '{value.strip()}')")
