@@ -445,7 +445,7 @@ def test_a_filled_hole_that_may_change_the_volume_is_warned_about(project, capsy
     rc, out, err = run(["build", "robot.yaml", "--out", "out", "-j", "1", "--no-report"], project, capsys,
                        monkeypatch)
     assert rc == 0, err
-    assert "warning: robot.yaml:3: links.base.visual.mesh: mesh 'open.stl': filled 1 holes (0.005 m^2, 8.3% of " \
+    assert "robot.yaml:3: links.base.visual.mesh: warning: mesh 'open.stl': filled 1 holes (0.005 m^2, 8.3% of " \
            "its surface) with flat patches; if the missing surface was not flat, the volume and the mass " \
            "properties may be off by up to 13%" in err.splitlines()
 

@@ -113,9 +113,10 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
         if root != "world" and below and not body_mass(root):
             # the mass goes on the first link with geometry welded to the root, else on the root
             welded, todo = [], [root]
-            while todo:
+            while todo:  # breadth first; a cycle (reported by the tree check) is walked once
                 welded += todo
-                todo = [j["child"] for n in todo for j in children.get(n, []) if j["type"] == "fixed"]
+                todo = list(dict.fromkeys(j["child"] for n in todo for j in children.get(n, [])
+                                          if j["type"] == "fixed" and j["child"] not in welded))
             root = next((n for n in welded if links[n].get("visual") or isinstance(links[n].get("collision"),
                                                                                      (dict, list))), root)
             refused.setdefault(root, "no mass in the original (nor on the links welded to it), and it is (or is "
