@@ -355,11 +355,20 @@ def test_catalogue_on_a_cluster_survives_a_killed_worker(tmp_path):
     again = subprocess.run([sys.executable, "-m", "robotkit", "catalogue", str(objs), "--out", str(out),
                             "--density", "800", "-j", "1"], env=env, capture_output=True, text=True)
     assert "; 0 tasks run," in again.stdout, again.stdout
-    (out / by_source["knot.stl"]["urdf"]).unlink()
+    (out / by_source["knot.stl"]["urdf"]).unlink()  # a deleted output comes back from the stage
     third = subprocess.run([sys.executable, "-m", "robotkit", "catalogue", str(objs), "--out", str(out),
                             "--density", "800", "-j", "1"], env=env, capture_output=True, text=True)
-    assert "; 1 tasks run," in third.stdout and (out / by_source["knot.stl"]["urdf"]).is_file()
+    assert "; 0 tasks run," in third.stdout and (out / by_source["knot.stl"]["urdf"]).is_file()
     assert json.loads((out / "catalogue.json").read_text()) == index
+    # a changed mesh: that object is built again, the others are not
+    trimesh.creation.torus(0.1, 0.02, major_sections=18, minor_sections=8).export(objs / "knot.stl")
+    fourth = subprocess.run([sys.executable, "-m", "robotkit", "catalogue", str(objs), "--out", str(out),
+                             "--density", "800", "-j", "1"], env=env, capture_output=True, text=True)
+    assert "; 0 tasks run," not in fourth.stdout, fourth.stdout
+    after = {o["source"]: o for o in json.loads((out / "catalogue.json").read_text())["objects"]}
+    assert after["knot.stl"]["mass"] != by_source["knot.stl"]["mass"]
+    assert {k: v for k, v in after.items() if k != "knot.stl"} == {k: v for k, v in by_source.items()
+                                                                    if k != "knot.stl"}
 
 
 def test_catalogue_bad_input(tmp_path):
