@@ -256,18 +256,11 @@ def catalogue(source: str | os.PathLike, out_dir: str | os.PathLike, *, density:
     if recipes:
         from robotkit.build import build
 
-        roots = os.environ.get(paths.ROOT_ENV, "")
-        os.environ[paths.ROOT_ENV] = os.pathsep.join(r for r in (roots, str(base.resolve())) if r)
         from robotkit.progress import Progress
 
         bar = Progress(progress, slow=float("inf"), eta=True, log_every=10.0, label="catalogue ")
-        try:
+        with paths.widened([base.resolve()]):  # the generated recipes read the meshes where they are
             result = build(recipes, out, jobs=jobs, report=False, keep_going=True, progress=bar)
-        finally:
-            if roots:
-                os.environ[paths.ROOT_ENV] = roots
-            else:
-                os.environ.pop(paths.ROOT_ENV, None)
         failed_by_robot: dict[str, list[str]] = {}
         for task, message in result.failed:
             failed_by_robot.setdefault(task.split(":", 1)[0], []).extend(
