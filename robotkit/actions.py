@@ -16,7 +16,7 @@ import shutil
 from robotkit.errors import Problem, RobotkitError
 from robotkit.ioutil import write_if_changed
 
-FACTS_VERSION = 3  # 3: sources relative to the recipe (no absolute or working-folder paths)
+FACTS_VERSION = 4  # 3: sources relative to the recipe (no absolute or working-folder paths); 4: hull points
 
 
 def _user_errors_fail(fn):
@@ -44,7 +44,7 @@ def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
     """Load a mesh, make it a closed volume, record its unit-density mass properties."""
     import numpy as np
 
-    from robotkit.mesh.inertia import mesh_mass_properties
+    from robotkit.mesh.inertia import hull_points, mesh_mass_properties
     from robotkit.mesh.io import load_mesh, volume_mesh
 
     loc = Problem("", **where)
@@ -64,6 +64,7 @@ def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
         "vertices": int(len(mesh.vertices)),
         "bbox_min": [float(v) for v in bbox_min],
         "bbox_max": [float(v) for v in bbox_max],
+        "hull": [[float(v) for v in p] for p in hull_points(mesh.vertices)],  # bounding primitives
         "volume": props.volume,
         "com": [float(v) for v in props.com],
         "inertia": [[float(v) for v in row] for row in np.asarray(props.inertia)],

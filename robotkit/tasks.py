@@ -188,7 +188,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
 
     inertials: dict[str, str] = {}
     for link in robot.links:
-        if link.inertial_spec.mode not in ("density", "mass"):
+        if link.inertial_spec.mode not in ("density", "mass", "estimate"):
             continue
         keys = sorted({g.shape.mesh.key for g in link.source_geoms() if g.shape.mesh is not None})
         deps = {k: facts[k] for k in keys}

@@ -93,3 +93,76 @@ def combine(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> tuple[float, n
         r = np.asarray(c) - com
         I += Ic + m * (np.dot(r, r) * np.eye(3) - np.outer(r, r))
     return mass, com, I
+
+
+@dataclass(frozen=True)
+class Bounding:
+    """A solid primitive enclosing a set of points: ``kind`` box | cylinder | sphere, its
+    ``size`` (box edges; cylinder radius and length along its z; sphere radius) and its pose
+    ``transform`` (4x4, the primitive's centre and axes in the points' frame)."""
+
+    kind: str
+    size: tuple[float, ...]
+    transform: np.ndarray
+
+    @property
+    def volume(self) -> float:
+        return {"box": lambda s: s[0] * s[1] * s[2], "cylinder": lambda s: np.pi * s[0] ** 2 * s[1],
+                "sphere": lambda s: 4.0 / 3.0 * np.pi * s[0] ** 3}[self.kind](self.size)
+
+    def inertia(self, mass: float) -> tuple[np.ndarray, np.ndarray]:
+        """(centre of mass, inertia about it) of the primitive as a uniform solid of ``mass``,
+        in the points' frame (a flat or thin primitive gives a plate's or a rod's tensor)."""
+        s = self.size
+        if self.kind == "box":
+            x2, y2, z2 = (v * v for v in s)
+            d = np.array([y2 + z2, x2 + z2, x2 + y2]) / 12.0
+        elif self.kind == "cylinder":
+            r2, h2 = s[0] ** 2, s[1] ** 2
+            d = np.array([(3 * r2 + h2) / 12.0, (3 * r2 + h2) / 12.0, r2 / 2.0])
+        else:
+            d = np.full(3, 0.4 * s[0] ** 2)
+        R = self.transform[:3, :3]
+        I = R @ np.diag(mass * d) @ R.T
+        return self.transform[:3, 3].copy(), 0.5 * (I + I.T)
+
+
+def bounding_primitive(points) -> Bounding:
+    """The smallest in volume of four solids enclosing ``points`` (trimesh.bounds): the box
+    along the points' axes, the minimum-volume oriented box, the minimum cylinder and the
+    minimum sphere.  Ties (to 1e-9) go to that order, so a box along the link's axes comes
+    first; points in a plane or on a line get the box along the points' axes."""
+    import trimesh
+
+    P = np.unique(np.asarray(points, dtype=float).reshape(-1, 3), axis=0)
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    aabb = np.eye(4)
+    aabb[:3, 3] = 0.5 * (lo + hi)
+    found = [Bounding("box", tuple(float(v) for v in hi - lo), aabb)]
+    if not _solid(P):
+        return found[0]  # points in a plane or on a line: no hull; a plate's or a rod's box
+    to_origin, extents = trimesh.bounds.oriented_bounds(P)
+    found.append(Bounding("box", tuple(float(v) for v in extents), np.linalg.inv(to_origin)))
+    cyl = trimesh.bounds.minimum_cylinder(P)
+    found.append(Bounding("cylinder", (float(cyl["radius"]), float(cyl["height"])), np.asarray(cyl["transform"])))
+    centre, radius = trimesh.nsphere.minimum_nsphere(P)
+    sphere = np.eye(4)
+    sphere[:3, 3] = centre
+    found.append(Bounding("sphere", (float(radius),), sphere))
+    smallest = min(b.volume for b in found)
+    return next(b for b in found if b.volume <= smallest * (1 + 1e-9))
+
+
+def _solid(P: np.ndarray) -> bool:
+    """Whether points span a volume (qhull can make their hull)."""
+    size = float((P.max(axis=0) - P.min(axis=0)).max()) if len(P) else 0.0
+    return size > 0 and np.linalg.matrix_rank(P - P.mean(axis=0), tol=1e-12 * size) == 3
+
+
+def hull_points(vertices) -> np.ndarray:
+    """The vertices of the convex hull of ``vertices`` (all of them, deduplicated, when they lie
+    in a plane or on a line): what a bounding primitive of the mesh depends on."""
+    import trimesh
+
+    P = np.unique(np.asarray(vertices, dtype=float).reshape(-1, 3), axis=0)
+    return np.asarray(trimesh.convex.hull_points(P)) if _solid(P) else P

@@ -189,6 +189,18 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                     unusable.add("collision")
         spec = InertialSpec("none") if ispec == "none" else _inertial_spec(ispec, r.density)
         source = visuals if spec.source == "visual" else collisions
+        asked = ispec.policy if ispec not in (None, "none") else None
+        use = asked or r.inertia_policy
+        if use in ("recompute", "estimate") and spec.mode in ("explicit", "mass"):
+            if source:
+                spec = InertialSpec("mass" if use == "recompute" else "estimate", mass=spec.mass, source=spec.source)
+            elif asked and spec.source not in unusable:
+                problems.append(marks.problem(lp + ("inertial", "policy"),
+                                              f"'{use}' needs the link's {spec.source} geometry, and the link has "
+                                              "none (give the inertia with 'policy: repair')"))
+                spec = InertialSpec("none")
+            else:
+                use = "repair"  # recipe-wide: the given tensor is all there is
         if spec.mode in ("density", "mass") and not source:
             if ispec is None or spec.source in unusable:
                 spec = InertialSpec("none")
@@ -196,13 +208,14 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
                 problems.append(marks.problem(lp + ("inertial",),
                                               f"computing the inertial needs {spec.source} geometry, and the link has none"))
         if spec.mode == "explicit":
-            if (ispec.policy or r.inertia_policy) == "repair":
+            if use == "repair":
                 fixed = inertia_policy.repair(spec.explicit.mass, spec.explicit.tensor(), spec.explicit.mass)
                 if fixed.changes:
                     spec = replace(spec, explicit=Inertial.from_tensor(fixed.mass, spec.explicit.com, fixed.inertia))
             else:
                 problems.extend(_check_explicit(spec.explicit, marks, lp + ("inertial",)))
-        # meshes no inertial is computed from may be open: they are only drawn and collided
+        # meshes no inertial is computed from may be open: they are only drawn and collided (an
+        # estimate only needs their hull)
         computed = spec.mode in ("density", "mass")
         old = [g.shape.mesh for g in visuals]
         visuals = [g if computed and spec.source == "visual" else _display_only(g, base_dir) for g in visuals]
@@ -588,11 +601,54 @@ def compute_inertial(link: Link, facts: dict) -> Inertial | None:
         return spec.explicit
     if spec.mode == "none":
         return None
+    if spec.mode == "estimate":
+        return _estimate(link, facts)
     parts = [geom_mass_props(g, facts) for g in link.source_geoms()]
     volume = sum(v for v, _, _ in parts)
     density = spec.density if spec.mode == "density" else spec.mass / volume
     mass, com, I = combine([(v * density, c, Ic * density) for v, c, Ic in parts])
     return Inertial.from_tensor(mass, _snap(com, _size(link, facts)), _snap(I, float(np.abs(I).max())))
+
+
+def _estimate(link: Link, facts: dict) -> Inertial:
+    """The link's mass as its bounding primitive (robotkit.mesh.inertia.bounding_primitive) of
+    its source geometry, in the link frame; a link of one primitive is its own.  A flat or thin
+    primitive's tensor (a plate's, a rod's) gets the repair's floor."""
+    from robotkit.mesh.inertia import Bounding, bounding_primitive
+
+    geoms = link.source_geoms()
+    s = geoms[0].shape
+    if len(geoms) == 1 and s.kind in ("box", "cylinder", "sphere"):
+        size = {"box": s.size, "cylinder": (s.radius, s.length), "sphere": (s.radius,)}[s.kind]
+        bounds = Bounding(s.kind, tuple(size), geoms[0].pose.matrix())
+    else:
+        bounds = bounding_primitive(np.vstack([_points(g, facts) for g in geoms]))
+    mass = link.inertial_spec.mass
+    com, I = bounds.inertia(mass)
+    fixed = inertia_policy.repair(mass, I, mass)
+    return Inertial.from_tensor(mass, _snap(com, _size(link, facts)), _snap(fixed.inertia, float(np.abs(I).max())))
+
+
+def _points(geom: Geom, facts: dict) -> np.ndarray:
+    """Points whose hull encloses a geometry, in its link frame: a mesh's hull vertices, a box's
+    corners, a cylinder's and a sphere's circumscribed polyhedra (64 sections; an icosphere of
+    642 vertices), so an enclosure of them encloses the geometry."""
+    import trimesh
+
+    s = geom.shape
+    if s.kind == "box":
+        P = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * 0.5 * np.asarray(s.size)
+    elif s.kind == "cylinder":
+        n = 64
+        P = trimesh.creation.cylinder(radius=s.radius / math.cos(math.pi / n), height=s.length, sections=n).vertices
+    elif s.kind == "sphere":
+        ico = trimesh.creation.icosphere(subdivisions=3)
+        inner = float(np.min(np.abs(np.einsum("ij,ij->i", ico.face_normals, ico.triangles_center))))
+        P = ico.vertices * (s.radius / inner)
+    else:  # a mesh, or a collision proxy made from one
+        P = np.asarray(facts[s.mesh.key]["hull"], dtype=float)
+    T = geom.pose.matrix()
+    return P @ T[:3, :3].T + T[:3, 3]
 
 
 def _snap(values, scale: float, rel: float = 1e-12):

@@ -332,6 +332,9 @@ class Geometry(Strict):
         return self
 
 
+InertiaPolicy = Literal["keep", "repair", "recompute", "estimate"]
+
+
 class Inertia(Strict):
     """Inertia tensor about the centre of mass, in the link frame, kg m^2."""
 
@@ -348,7 +351,8 @@ class Inertial(Strict):
 
     - ``density``: computed from the link's geometry (``source``) at this density.
     - ``mass``: computed from the geometry, the density derived so the total is ``mass``.
-    - ``mass`` + ``com`` + ``inertia``: given explicitly.
+    - ``mass`` + ``com`` + ``inertia``: given explicitly; ``policy`` says what the build does
+      with them.
     """
 
     density: Density | None = None
@@ -363,8 +367,8 @@ class Inertial(Strict):
     """Which of the link's geometries the mass properties are computed from."""
     open_mesh: Literal["error", "hull"] | None = None
     """What to do with a mesh that is not a closed volume after safe repair: ``error``, or use its convex ``hull`` (with a warning). Default: the recipe's ``open_mesh``."""
-    policy: Literal["keep", "repair"] | None = None
-    """For an explicit inertia: ``keep`` it as given (a tensor no real body has stops the build), or ``repair`` it with the smallest change that makes it physical (principal moments raised to a floor, then to the triangle inequality; axes kept). Default: the recipe's ``inertia_policy``."""
+    policy: InertiaPolicy | None = None
+    """What the build does with a link that gives a ``mass``: ``keep`` an explicit ``com`` and ``inertia`` as given (a tensor no real body has stops the build); ``repair`` them with the smallest change that makes them physical (principal moments raised to a floor, then to the triangle inequality; axes kept; a physical tensor is kept as it is); ``recompute`` the centre of mass and tensor from the link's ``source`` geometry keeping the mass (the given ``com`` and ``inertia`` stay in the recipe for the record, unused); ``estimate`` them as the link's bounding primitive (the smallest in volume of the box along the link's axes, the smallest oriented box, cylinder and sphere enclosing the ``source`` geometry), a uniform solid carrying the mass, centred on the primitive. ``keep`` and ``repair`` compute a link without explicit tensor from its geometry as usual; ``recompute`` and ``estimate`` need the ``source`` geometry (an error here without it) and ``estimate`` needs a ``mass``. Default: the recipe's ``inertia_policy``."""
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -376,6 +380,8 @@ class Inertial(Strict):
                 raise ValueError("give 'density' or an explicit 'inertia', not both")
         elif self.mass is not None and self.density is not None:
             raise ValueError("give 'density' or 'mass', not both")
+        if self.policy == "estimate" and self.mass is None:
+            raise ValueError("policy 'estimate' needs the link's 'mass' (a bounding primitive has no density)")
         return self
 
 
@@ -749,8 +755,8 @@ class Recipe(Strict):
     """Default units of mesh files (m, cm, mm, in)."""
     density: Density = 1000.0
     """Default density in kg/m^3 for inertials computed from geometry."""
-    inertia_policy: Literal["keep", "repair"] = "keep"
-    """Explicit inertias: ``keep`` them as given, or ``repair`` those no real body has with the smallest change (per link: ``inertial.policy``)."""
+    inertia_policy: InertiaPolicy = "keep"
+    """What the build does with the links that give a ``mass`` (per link: ``inertial.policy``, which says more): ``keep`` explicit tensors as given, ``repair`` those no real body has with the smallest change, ``recompute`` every one from the link's geometry keeping its mass, or ``estimate`` every one from the link's bounding primitive. Links with a ``density`` are always computed from their geometry. Recipe-wide, a link without the geometry ``recompute`` or ``estimate`` needs has its explicit tensor repaired instead."""
     open_mesh: Literal["error", "hull"] = "error"
     """Default policy for meshes that are not closed volumes after safe repair."""
     meshes: MeshDefaults = MeshDefaults()
