@@ -283,8 +283,9 @@ def lint_link(link: LinkFacts) -> list[Finding]:
     eig = np.linalg.eigvalsh(0.5 * (I + I.T))
     if inertia_policy.defects(link.mass, I):  # the rules the import's repair follows
         fixed = inertia_policy.repair(link.mass, I, link.mass)
-        hint = ("compute it from the geometry instead of typing it; the smallest repair (robotkit import "
-                "writes it): " + "; ".join(fixed.changes))
+        hint = ("inertia policy 'repair' (robotkit import's default) makes the smallest change: "
+                + "; ".join(fixed.changes) + "; 'recompute' or 'estimate' derive it from the link's geometry "
+                "(robotkit import --inertia-policy, or inertial.policy in a recipe)")
         if eig.min() <= 0:
             add("error", "inertia", "inertia is not positive definite (principal moments "
                 + ", ".join(f"{e:.4g}" for e in eig) + ")", hint)

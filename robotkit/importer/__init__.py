@@ -76,13 +76,16 @@ onto the recipe; another format is another entry here."""
 
 def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_paths: dict[str, str] | None = None,
                 args: dict[str, str] | None = None, recompute_inertials: bool = False, copy_meshes: bool = False,
-                density: float | None = None) -> ImportResult:
+                density: float | None = None, inertia_policy: str = "repair") -> ImportResult:
     """Import the URDF or xacro file ``path`` into the recipe ``out_recipe``.
 
     ``package_paths`` maps ROS package names to folders (``$(find PKG)``, ``package://PKG``);
     ``args`` are xacro arguments.  With ``recompute_inertials`` each link's inertial is
     computed from its geometry (collision geometry when it has some), keeping the given
-    mass, or at ``density`` when given; the differences are reported per link.
+    mass, or at ``density`` when given; the differences are reported per link.  Otherwise a
+    physical inertial is kept as given and one that no real body has gets ``inertia_policy``
+    (keep, repair, recompute, estimate; see robotkit.importer.inertials.chosen_inertial), with a
+    comment above its link saying what was wrong.
     ``copy_meshes`` copies the meshes below the recipe's folder (``meshes/``) instead of
     referencing them where they are.
     """
@@ -92,6 +95,10 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     from robotkit.importer.urdf_to_recipe import dump_recipe, urdf_to_recipe
     from robotkit.importer.xacro_expand import check_package_paths
 
+    from robotkit.importer.inertials import POLICIES
+
+    if inertia_policy not in POLICIES:
+        raise RobotkitError(Problem(f"inertia policy '{inertia_policy}' is not one of {', '.join(POLICIES)}"))
     if density is not None and not density > 0:
         raise RobotkitError(Problem(f"density must be > 0 (got {density!r})"))
     source = Path(path).absolute()
@@ -112,7 +119,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     inputs.extend(got.includes)
 
     conv = urdf_to_recipe(text, source, out, packages, copy_meshes=copy_meshes,
-                          recompute_inertials=recompute_inertials, density=density)
+                          recompute_inertials=recompute_inertials, density=density, inertia_policy=inertia_policy)
     warnings.extend(conv.warnings)
     inputs.extend(sorted({m.source for m in conv.meshes.values()}))
     recipe = conv.recipe
@@ -147,7 +154,8 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         header.append("inertials recomputed from the geometry "
                       + ("at the recipe's density" if density is not None else "keeping each link's given mass"))
     else:
-        header.append("inertials as given in the original (explicit)")
+        header.append("inertials as given in the original (explicit); those no real body has: "
+                      f"{inertia_policy} (--inertia-policy)")
     text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")

@@ -29,8 +29,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "import", help="turn an existing URDF or xacro file into a recipe",
         description="Expand FILE (.urdf, or .xacro with $(find PKG) and package://PKG resolved through "
-                    "--package-path) and write a recipe that builds into an equivalent URDF. Inertials "
-                    "are kept as given unless --recompute-inertials; <gazebo>, <transmission> and other "
+                    "--package-path) and write a recipe that builds into an equivalent URDF. Physical "
+                    "inertials are kept as given, the others get --inertia-policy (each stated in a comment "
+                    "above its link) unless --recompute-inertials; <gazebo>, <transmission> and other "
                     "elements the recipe cannot express are carried verbatim in urdf_extras.")
     p.add_argument("file", metavar="FILE", help="URDF or xacro file")
     p.add_argument("-o", "--output", required=True, metavar="RECIPE.yaml", help="recipe file to write")
@@ -38,9 +39,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="folder of ROS package PKG (repeatable)")
     p.add_argument("--arg", action="append", type=_xacro_arg, default=[], metavar="NAME:=VALUE",
                    help="xacro argument (repeatable)")
+    p.add_argument("--inertia-policy", choices=("keep", "repair", "recompute", "estimate"), default="repair",
+                   help="for each link whose given inertia no real body has: keep it (the import stops on it, "
+                        "as the build would), repair it with the smallest change (default), recompute it from "
+                        "the link's geometry or estimate it from its bounding primitive, keeping the mass "
+                        "(a link without geometry is repaired)")
     p.add_argument("--recompute-inertials", action="store_true",
-                   help="compute inertials from the geometry (keeping each link's mass, or at --density) "
-                        "and report the difference per link")
+                   help="compute every link's inertial from its geometry, physical or not (keeping each "
+                        "link's mass, or at --density) and report the difference per link")
     p.add_argument("--density", type=float, metavar="KG_M3",
                    help="with --recompute-inertials: density in kg/m^3 instead of keeping the given masses")
     p.add_argument("--copy-meshes", action="store_true",
@@ -59,7 +65,7 @@ def run(args) -> int:
         packages[name] = folder
     result = import_file(args.file, args.output, packages, dict(args.arg),
                          recompute_inertials=args.recompute_inertials, copy_meshes=args.copy_meshes,
-                         density=args.density)
+                         density=args.density, inertia_policy=args.inertia_policy)
     for w in result.warnings:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {os.path.relpath(result.recipe_path)} (robot {result.robot})")

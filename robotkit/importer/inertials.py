@@ -72,6 +72,38 @@ def _explicit_dict(given: dict) -> dict:
     return out
 
 
+POLICIES = ("keep", "repair", "recompute", "estimate")
+"""``robotkit import --inertia-policy``: what a link whose given tensor no real body has gets."""
+
+
+def chosen_inertial(name: str, given: dict, source: str | None, policy: str, repairs: dict[str, str]) -> dict:
+    """The recipe's inertial for link ``name`` whose original gives a positive mass: as given when
+    it is physical, else by ``policy`` (``source``: the geometry a recompute or an estimate reads,
+    None when the link has none, which gets the repair), with what was wrong and what was done in
+    ``repairs[name]`` (the comment above the link).  ``keep`` writes the tensor as given: the
+    import then stops on it, as the build would."""
+    wrong = inertia_policy.defects(given["mass"], _tensor(given["inertia"]))
+    if not wrong or policy == "keep":
+        return _explicit_dict(given)
+    what = f"the original's {'; '.join(wrong)}"
+    if policy in ("recompute", "estimate") and source is not None:
+        spec = {**_explicit_dict(given), "policy": policy}  # the given values stay, for the record
+        if source != "visual":
+            spec["source"] = source
+        how = ("recomputed from its {} geometry" if policy == "recompute" else
+               "estimated as the bounding primitive of its {} geometry").format(source)
+        repairs[name] = f"{what}: {how}, keeping the mass (policy: {policy}; the given com and inertia are unused)"
+        return spec
+    fixed = inertia_policy.repair(given["mass"], _tensor(given["inertia"]), given["mass"])
+    t = fixed.inertia
+    given = dict(given, inertia={k: float(v) + 0.0 for k, v in {
+        "ixx": t[0, 0], "ixy": t[0, 1], "ixz": t[0, 2], "iyy": t[1, 1], "iyz": t[1, 2], "izz": t[2, 2]}.items()})
+    alone = f"; it has no geometry to {'recompute it from' if policy == 'recompute' else 'estimate it from'}" \
+        if policy != "repair" else ""
+    repairs[name] = f"{what}{alone}: repaired ({'; '.join(fixed.changes)})"
+    return _explicit_dict(given)
+
+
 def _has_mass(link: dict) -> bool:
     spec = link.get("inertial")
     return isinstance(spec, dict) or (spec is None and bool(link.get("visual")))

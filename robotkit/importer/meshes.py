@@ -116,8 +116,9 @@ def _open_meshes(conv, recipe: dict, warnings: list[str], recompute: bool) -> No
     top_level = []
     for link, found in open_by_link.items():
         spec = recipe["links"][link].get("inertial")
-        if spec == "none" or (isinstance(spec, dict) and "inertia" in spec):
-            continue  # no inertial is computed from the link's geometry
+        if spec == "none" or (isinstance(spec, dict) and ("inertia" in spec or spec.get("policy") == "estimate")
+                              and spec.get("policy") != "recompute"):
+            continue  # no inertial is computed from the link's geometry (an estimate reads only its hull)
         source = spec.get("source", "visual") if isinstance(spec, dict) else "visual"
         read = [name for kind, name in found if kind == source]
         if not read:

@@ -30,13 +30,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from robotkit.importer.inertials import (  # noqa: F401  (no_inertial_form: used by the tests)
-    _explicit_dict, _give_moving_links_mass, _inertial, _tensor, no_inertial_form,
+    _give_moving_links_mass, _inertial, chosen_inertial, no_inertial_form,
 )
 from robotkit.importer.meshes import MeshResolver, MeshUse
 from robotkit.importer.names import _material_name, _name_hint, _valid_frame_name, _valid_name
 from robotkit.importer.parsing import _Problems, _float, _floats, _fmt_list, _local, _origin, _origin_dict
 from robotkit.importer.recipe_writer import dump_recipe, fmt  # noqa: F401  (the import's writer)
-from robotkit.model import inertia_policy
 from robotkit.errors import Problem, RobotkitError, display_path
 from robotkit.recipe.schema import FRAME_NAME_RE, NAME_RE, UNITS
 
@@ -89,8 +88,11 @@ class Converted:
 
 def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.PathLike,
                    package_paths: dict[str, str] | None = None, copy_meshes: bool = False,
-                   recompute_inertials: bool = False, density: float | None = None) -> Converted:
+                   recompute_inertials: bool = False, density: float | None = None,
+                   inertia_policy: str = "repair") -> Converted:
     """Map the URDF ``text`` (read from ``source``) to a recipe dict for ``recipe_path``.
+    ``inertia_policy``: what a link whose given tensor no real body has gets
+    (:func:`robotkit.importer.inertials.chosen_inertial`).
 
     Raises RobotkitError with every problem found (one line each, naming links and URIs).
     """
@@ -222,14 +224,9 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
                 if recompute_inertials:
                     warnings.append(f"link '{name}' has no geometry to compute an inertial from; "
                                     "its inertial is kept as given")
-                wrong = inertia_policy.defects(given["mass"], _tensor(given["inertia"]))
-                if wrong:
-                    fixed = inertia_policy.repair(given["mass"], _tensor(given["inertia"]), given["mass"])
-                    t = fixed.inertia
-                    given = dict(given, inertia={k: float(v) + 0.0 for k, v in {"ixx": t[0, 0], "ixy": t[0, 1], "ixz": t[0, 2],
-                                                 "iyy": t[1, 1], "iyz": t[1, 2], "izz": t[2, 2]}.items()})
-                    out.repairs[name] = (f"the original's {'; '.join(wrong)}: repaired ({'; '.join(fixed.changes)})")
-                link["inertial"] = _explicit_dict(given)
+                source = ("collision" if collisions and not (visuals and _same_shapes(visuals, collisions))
+                          else "visual" if visuals else None)
+                link["inertial"] = chosen_inertial(name, given, source, inertia_policy, out.repairs)
         else:
             if given is not None and given["mass"] < 0:
                 problems.add(f"link '{name}': negative mass {given['mass']!r}")
