@@ -143,14 +143,30 @@ def bounding_primitive(points) -> Bounding:
         return found[0]  # points in a plane or on a line: no hull; a plate's or a rod's box
     to_origin, extents = trimesh.bounds.oriented_bounds(P)
     found.append(Bounding("box", tuple(float(v) for v in extents), np.linalg.inv(to_origin)))
-    cyl = trimesh.bounds.minimum_cylinder(P)
-    found.append(Bounding("cylinder", (float(cyl["radius"]), float(cyl["height"])), np.asarray(cyl["transform"])))
+    cyl = trimesh.bounds.minimum_cylinder(P)  # a local search: it can miss the axis of a long part
+    cylinders = [Bounding("cylinder", (float(cyl["radius"]), float(cyl["height"])), np.asarray(cyl["transform"]))]
+    axes = np.vstack([np.eye(3), found[1].transform[:3, :3].T, np.linalg.eigh(np.cov(P.T))[1].T])
+    cylinders += [_cylinder_along(P, axis) for axis in axes]
+    found.append(min(cylinders, key=lambda b: b.volume))
     centre, radius = trimesh.nsphere.minimum_nsphere(P)
     sphere = np.eye(4)
     sphere[:3, 3] = centre
     found.append(Bounding("sphere", (float(radius),), sphere))
     smallest = min(b.volume for b in found)
     return next(b for b in found if b.volume <= smallest * (1 + 1e-9))
+
+
+def _cylinder_along(P: np.ndarray, axis: np.ndarray) -> Bounding:
+    """The smallest cylinder along ``axis`` enclosing ``P`` (the smallest circle of their
+    projection, trimesh.nsphere)."""
+    import trimesh
+
+    T = trimesh.geometry.align_vectors([0.0, 0.0, 1.0], axis)  # the cylinder's axes -> the points' frame
+    local = P @ T[:3, :3]
+    centre, radius = trimesh.nsphere.minimum_nsphere(local[:, :2])
+    lo, hi = local[:, 2].min(), local[:, 2].max()
+    T[:3, 3] = T[:3, :3] @ np.array([centre[0], centre[1], 0.5 * (lo + hi)])
+    return Bounding("cylinder", (float(radius), float(hi - lo)), T)
 
 
 def _solid(P: np.ndarray) -> bool:

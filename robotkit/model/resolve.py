@@ -506,7 +506,7 @@ def _inertial_spec(spec, default_density: float) -> InertialSpec:
     return InertialSpec("density", density=float(spec.density or default_density), source=spec.source)
 
 
-FIXES = "policy: repair, recompute or estimate makes one"
+FIXES = "'policy: repair', 'recompute' or 'estimate' gives the link a physical one"
 """What a build error on an explicit tensor suggests (the recipe's ``inertial.policy``)."""
 
 
@@ -518,13 +518,13 @@ def _check_explicit(inertial: Inertial, marks, path) -> list[Problem]:
         out.append(marks.problem(path + ("inertia",), "inertia must be finite"))
     elif eig.min() <= 0:
         out.append(marks.problem(path + ("inertia",), "inertia is not positive definite (principal moments "
-                                 f"{', '.join(f'{e:.6g}' for e in eig)}; no real body has them: {FIXES})"))
+                                 f"{', '.join(f'{e:.6g}' for e in eig)}; no real body has them; {FIXES})"))
     else:
         a, b, c = eig
         if a + b < c * (1 - 1e-9):
             out.append(marks.problem(path + ("inertia",),
                                      f"principal moments {a:.6g}, {b:.6g}, {c:.6g} violate the triangle inequality "
-                                     f"(no real body has them: {FIXES})"))
+                                     f"(no real body has them; {FIXES})"))
     return out
 
 
