@@ -186,6 +186,80 @@ def test_recompute_at_density_finds_the_turret_bot_base_com(tmp_path):
     assert any(w.startswith("link 'base': recomputed inertial") and "given 16" in w for w in result.warnings)
 
 
+VENDOR = """
+    <?xml version="1.0"?>
+    <robot name="vendor">
+      <link name="base">
+        <visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>
+        <inertial><mass value="1"/><inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial>
+      </link>
+      <link name="arm">
+        <visual><origin xyz="0 0 0.2"/><geometry><box size="0.1 0.2 0.4"/></geometry></visual>
+        <inertial><mass value="2"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/></inertial>
+      </link>
+      <link name="tip">
+        <inertial><mass value="0.1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+      </link>
+      <joint name="j1" type="continuous"><parent link="base"/><child link="arm"/></joint>
+      <joint name="j2" type="continuous"><parent link="arm"/><child link="tip"/><origin xyz="0 0 0.4"/></joint>
+    </robot>
+    """
+TRIANGLE = "the original's principal moments 0.01, 0.01, 0.05 violate the triangle inequality"
+
+
+@pytest.mark.parametrize("policy", ["repair", "recompute", "estimate"])
+def test_import_inertia_policy(tmp_path, policy):
+    """Physical inertials are kept; the arm's tensor breaks the triangle inequality and gets the
+    policy asked for, stated above its link; the tip has no geometry and is repaired."""
+    from tests.conftest import run_cli
+
+    source = _write(tmp_path / "vendor.urdf", VENDOR)
+    recipe = tmp_path / "recipe" / "robot.yaml"
+    proc = run_cli("import", source, "-o", recipe, "--inertia-policy", policy)
+    assert proc.returncode == 0, proc.stderr
+    result = import_file(source, recipe, {}, {}, inertia_policy=policy)
+    arm = {"repair": f"{TRIANGLE}: repaired (principal moments 0.01, 0.01, 0.05 moved to 0.02, 0.02, 0.04 to "
+                     "meet the triangle inequality)",
+           "recompute": f"{TRIANGLE}: recomputed from its visual geometry, keeping the mass (policy: recompute; "
+                        "the given com and inertia are unused)",
+           "estimate": f"{TRIANGLE}: estimated as the bounding primitive of its visual geometry, keeping the mass "
+                       "(policy: estimate; the given com and inertia are unused)"}[policy]
+    alone = {"repair": "", "recompute": "; it has no geometry to recompute it from",
+             "estimate": "; it has no geometry to estimate it from"}[policy]
+    assert result.repairs == {"arm": arm, "tip": f"the original's inertia is zero{alone}: repaired (principal "
+                                                 "moments 0, 0, 0 raised to at least 4e-08 kg m^2)"}
+    text = recipe.read_text(encoding="utf-8")
+    assert f"  # {TRIANGLE}" in text and "  # the original's inertia is zero" in text
+    data = yaml.safe_load(text)
+    assert data["links"]["base"]["inertial"] == {"mass": 1, "inertia": {"ixx": 0.002, "iyy": 0.002, "izz": 0.002}}
+    if policy != "repair":  # the given values stay in the recipe, for the record
+        assert data["links"]["arm"]["inertial"] == {"mass": 2, "inertia": {"ixx": 0.01, "iyy": 0.01, "izz": 0.05},
+                                                    "policy": policy}
+    built = build([recipe], tmp_path / "build")
+    assert not built.errors
+    links = read_urdf(tmp_path / "build" / "vendor" / "urdf" / "vendor.urdf").links
+    box = 2.0 / 12 * np.diag([0.2 ** 2 + 0.4 ** 2, 0.1 ** 2 + 0.4 ** 2, 0.1 ** 2 + 0.2 ** 2])
+    want = np.diag([0.02, 0.02, 0.04]) if policy == "repair" else box  # a box is its own bounding primitive
+    assert np.allclose(links["arm"].inertia, want, rtol=1e-12, atol=1e-15)
+    assert np.allclose(links["arm"].com, [0, 0, 0] if policy == "repair" else [0, 0, 0.2], rtol=0, atol=1e-12)
+    assert links["arm"].mass == 2.0 and links["base"].mass == 1.0
+    assert np.allclose(links["base"].inertia, np.eye(3) * 0.002, rtol=0, atol=0)
+    assert np.allclose(links["tip"].inertia, np.eye(3) * 4e-8, rtol=1e-12, atol=0)
+
+
+def test_import_inertia_policy_keep_stops_on_the_tensor(tmp_path):
+    source = _write(tmp_path / "vendor.urdf", VENDOR)
+    with pytest.raises(RobotkitError) as info:
+        import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {}, inertia_policy="keep")
+    assert info.value.lines() == [
+        f"{source}:7: links.arm.inertial.inertia: principal moments 0.01, 0.01, 0.05 violate the triangle "
+        "inequality (no real body has them; 'policy: repair', 'recompute' or 'estimate' gives the link a physical "
+        "one)",
+        f"{source}:11: links.tip.inertial.inertia: inertia is not positive definite (principal moments 0, 0, 0; "
+        "no real body has them; 'policy: repair', 'recompute' or 'estimate' gives the link a physical one)"]
+    assert not (tmp_path / "recipe" / "robot.yaml").exists()
+
+
 def test_copy_meshes(tmp_path):
     source = ASSETS / "turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro"
     result, urdf = import_and_build(tmp_path, source, copy_meshes=True)
