@@ -247,3 +247,48 @@ def test_check_takes_xacro_and_names_moving_links_without_mass(tmp_path):
     assert proc.returncode == 1, proc.stdout + proc.stderr
     assert "  error: moves (joint 'arm_left_joint_1_s') but has no mass: MuJoCo refuses to load the robot and " \
            "Gazebo drops the link with everything below it [massless-moving]" in proc.stdout.splitlines()
+
+
+@pytest.mark.parametrize("policy", ["recompute", "estimate"])
+def test_pmb2_with_an_inertia_policy_builds_and_loads(tmp_path, policy):
+    """PMB-2's antennas have tensors that are not positive definite; with ``--inertia-policy
+    recompute`` (or ``estimate``) they get their collision cylinder's (r 5 mm, 170 mm long, which
+    is its own bounding primitive) at the given 1 g, stated in the recipe; the rest equals the
+    original, and every consumer loads the build."""
+    import numpy as np
+
+    mujoco()
+    spec = CORPUS["pmb2"]
+    proc = run_cli("import", spec["entry"], "-o", tmp_path / "recipe" / "robot.yaml", "--inertia-policy", policy,
+                   *[x for k, v in spec["packages"].items() for x in ("--package-path", f"{k}={v}")])
+    assert proc.returncode == 0, proc.stderr
+    written = (tmp_path / "recipe" / "robot.yaml").read_text(encoding="utf-8")
+    result = import_file(spec["entry"], tmp_path / "recipe" / "robot.yaml", spec["packages"], spec["args"],
+                         inertia_policy=policy)
+    assert result.recipe_path.read_text(encoding="utf-8") == written  # the command and the API agree
+    assert sorted(result.repairs) == ["base_antenna_left_link", "base_antenna_right_link"]
+    assert result.repairs["base_antenna_left_link"].startswith(
+        "the original's inertia is not positive definite (principal moments -3.53486e-08, 3.50085e-08, "
+        f"9.08701e-08): {'recomputed from' if policy == 'recompute' else 'estimated as the bounding primitive of'} "
+        f"its collision geometry, keeping the mass (policy: {policy};")
+    built = build([result.recipe_path], tmp_path / "build")
+    assert not built.errors, built.errors
+    robot_dir = tmp_path / "build" / result.robot
+    urdf = robot_dir / "urdf" / f"{result.robot}.urdf"
+    check_urdf(urdf)
+    m, r, h = 1e-6, 0.005, 0.17
+    for name in result.repairs:
+        link = read_urdf(urdf).links[name]
+        assert link.mass == m and np.allclose(link.com, [0, 0, 0.085], rtol=0, atol=1e-12)
+        side = m * (3 * r * r + h * h) / 12
+        assert np.allclose(np.linalg.eigvalsh(link.inertia), [m * r * r / 2, side, side], rtol=1e-12, atol=0)
+    stated = tmp_path / "stated.urdf"
+    stated.write_text(_with_stated_repairs(_original("pmb2", tmp_path / "original.urdf"), urdf, result.repairs),
+                      encoding="utf-8")
+    assert compare(read_urdf(stated), read_urdf(urdf), TOL, configs=20) == []
+    mjcf = robot_dir / "mjcf" / f"{result.robot}.xml"
+    base = "free" if "<freejoint" in mjcf.read_text(encoding="utf-8") else "fixed"
+    findings, summary = consumer_findings(Build(result.robot, robot_dir, urdf, robot_dir / "model.sdf", mjcf, base),
+                                          configs=5)
+    assert [str(f) for f in findings if f.severity == "error"] == []
+    assert all(s["loaded"] for s in summary.values()), summary
