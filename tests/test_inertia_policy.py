@@ -244,3 +244,22 @@ def test_the_bounding_primitive_is_the_smallest_enclosure():
     b = bounding_primitive([[0, 0, 0], [1, 0, 0], [0, 2, 0], [1, 2, 0]])
     assert (b.kind, b.size) == ("box", (1.0, 2.0, 0.0))
     assert ip.defects(1.0, b.inertia(1.0)[1]) == []
+
+
+def test_check_names_the_defect_and_the_policies_on_the_original(tmp_path):
+    from robotkit.check import check_urdf_file
+
+    urdf = tmp_path / "vendor.urdf"
+    urdf.write_text("""<robot name="vendor">
+  <link name="base"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
+  <link name="arm"><visual><geometry><box size="0.1 0.1 0.4"/></geometry></visual>
+    <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/></inertial></link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/></joint>
+</robot>""", encoding="utf-8")
+    found = [f for f in check_urdf_file(urdf, {}) if f.check == "triangle-inequality"]
+    assert [(f.subject, f.message, f.hint) for f in found] == [(
+        "link 'arm'", "principal moments 0.01, 0.01, 0.05 violate the triangle inequality (I1 + I2 >= I3): no real "
+        "body has them", "inertia policy 'repair' (robotkit import's default) makes the smallest change: principal "
+        "moments 0.01, 0.01, 0.05 moved to 0.02, 0.02, 0.04 to meet the triangle inequality; 'recompute' or "
+        "'estimate' derive it from the link's geometry (robotkit import --inertia-policy, or inertial.policy in a "
+        "recipe)")]

@@ -1,8 +1,9 @@
 """What is wrong with a link's mass properties, and the smallest change that makes them physical.
 
 One rule set, used where an inertial is read: ``robotkit import`` (writes each repair into
-the recipe with a comment), the build (a recipe's ``inertia_policy: repair``, whole recipe or
-per link) and ``robotkit check``'s lints (which name each defect on the original).
+the recipe with a comment), the build (a recipe's ``inertia_policy``, whole recipe or per
+link) and ``robotkit check``'s lints (which name each defect on the original and the policies
+that fix it).
 
 The policies:
 
@@ -14,7 +15,13 @@ The policies:
   the largest moment down and the other two up by a third of the excess each (the least
   change in the Frobenius norm).  The principal axes are kept.
 - ``recompute``: from the link's geometry, keeping the given mass (a recipe's
-  ``inertial: {mass: M}``; ``robotkit import --recompute-inertials``).
+  ``inertial: {mass: M}`` does the same; ``robotkit import --recompute-inertials`` for every link).
+- ``estimate``: the link's bounding primitive (robotkit.mesh.inertia.bounding_primitive) as a
+  uniform solid of the given mass.
+
+The build applies them in robotkit.model.resolve (recipe-wide ``inertia_policy``, per link
+``inertial.policy``); ``robotkit import --inertia-policy`` chooses one for each link whose given
+tensor has :func:`defects` (robotkit.importer.inertials.chosen_inertial).
 
 A link without mass that moves (or a massless root body with moving joints below it) gets one
 on import: from its geometry at the recipe's density, or, without geometry, a point mass of a
