@@ -263,3 +263,23 @@ def test_check_names_the_defect_and_the_policies_on_the_original(tmp_path):
         "moments 0.01, 0.01, 0.05 moved to 0.02, 0.02, 0.04 to meet the triangle inequality; 'recompute' or "
         "'estimate' derive it from the link's geometry (robotkit import --inertia-policy, or inertial.policy in a "
         "recipe)")]
+
+
+def test_estimate_encloses_all_of_a_links_shapes(tmp_path):
+    """Two 0.1 m cubes at x = +-0.2: the bounding primitive is the 0.5 x 0.1 x 0.1 box along the
+    link's axes (smaller than the cylinder around them), centred between them."""
+    from robotkit.model.resolve import compute_inertial
+
+    recipe = write_recipe(tmp_path, """
+        robot: pair
+        links:
+          base:
+            visual:
+              - {box: {size: [0.1, 0.1, 0.1]}, origin: {xyz: [-0.2, 0, 0.3]}}
+              - {box: {size: [0.1, 0.1, 0.1]}, origin: {xyz: [0.2, 0, 0.3]}}
+            inertial: {mass: 4, policy: estimate}
+        """)
+    (_, robot), = load_robots([recipe])
+    got = compute_inertial(robot.link("base"), {})
+    assert got.mass == 4.0 and got.com == (0.0, 0.0, 0.3)
+    assert np.allclose(got.tensor(), 4.0 / 12 * np.diag([0.02, 0.26, 0.26]), rtol=1e-12, atol=0)
