@@ -247,3 +247,20 @@ def test_check_takes_xacro_and_names_moving_links_without_mass(tmp_path):
     assert proc.returncode == 1, proc.stdout + proc.stderr
     assert "  error: moves (joint 'arm_left_joint_1_s') but has no mass: MuJoCo refuses to load the robot and " \
            "Gazebo drops the link with everything below it [massless-moving]" in proc.stdout.splitlines()
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_defaults_change_no_value(corpus, name, tmp_path, monkeypatch):
+    """The values moved to the recipe's ``defaults`` (and the exceptions written per joint or
+    link) give, once merged, the recipe written without them: field for field."""
+    import robotkit.importer.defaults
+    from robotkit.recipe.load import load_recipes
+
+    result = corpus[name][0]
+    spec = CORPUS[name]
+    monkeypatch.setattr(robotkit.importer.defaults, "factor_defaults", lambda recipe: {})
+    plain = import_file(spec["entry"], result.recipe_path.parent / "plain.yaml", spec["packages"], spec["args"])
+    assert "\ndefaults:" not in plain.recipe_path.read_text(encoding="utf-8")
+    (factored,), (unfactored,) = load_recipes(result.recipe_path), load_recipes(plain.recipe_path)
+    assert factored.problems == [] and unfactored.problems == []
+    assert factored.recipe.model_dump(exclude={"defaults"}) == unfactored.recipe.model_dump(exclude={"defaults"})

@@ -803,3 +803,66 @@ def test_metadata_comes_from_the_package_xml(tmp_path):
     build([tmp_path / "box.yaml"], tmp_path / "out")
     assert '<maintainer email="support@kinova.ca">Kinova Support</maintainer>' in (
         tmp_path / "out" / "box" / "package.xml").read_text()
+
+
+# ---------------------------------------------------------------- the recipe written for people: defaults
+
+
+SHARED_VALUES = """
+    <robot name="d">
+      <link name="l0"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="l4"/><link name="l5"/>
+      <joint name="j1" type="revolute"><parent link="l0"/><child link="l1"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="10" velocity="2"/><dynamics damping="0.5"/></joint>
+      <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/>
+        <limit lower="-2" upper="2" effort="10" velocity="2"/><dynamics damping="0.5"/></joint>
+      <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" effort="10" velocity="2"/><dynamics damping="0.5" friction="1"/></joint>
+      <joint name="j4" type="continuous"><parent link="l3"/><child link="l4"/>
+        <dynamics damping="0.5"/></joint>
+      <joint name="tool" type="fixed"><parent link="l4"/><child link="l5"/></joint>
+    </robot>
+"""
+
+
+def test_shared_joint_values_go_to_defaults(tmp_path):
+    """Values more than half of the joints hold (and at least three) are written once in
+    ``defaults``; a joint with another value keeps its own, one with none says so (the schema's
+    default, or null); a default limit or axis does not go to a fixed joint.  The recipe builds
+    the same robot as the URDF."""
+    urdf = _write(tmp_path / "d.urdf", SHARED_VALUES)
+    for i in range(6):
+        urdf.write_text(urdf.read_text().replace(f'<link name="l{i}"/>', f'<link name="l{i}"><inertial><mass value="1"/>'
+                        '<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>'))
+    result = import_file(urdf, tmp_path / "d.yaml", {}, {})
+    text = result.recipe_path.read_text(encoding="utf-8")
+    assert text.split("\njoints:\n")[1] == "  " + textwrap.dedent("""\
+          j1:
+            parent: l0
+            child: l1
+            limit: {lower: -1, upper: 1}
+          j2:
+            parent: l1
+            child: l2
+            limit: {lower: -2, upper: 2}
+          j3:
+            parent: l2
+            child: l3
+            limit: {lower: -3, upper: 3}
+            dynamics: {friction: 1}
+          j4:
+            type: continuous
+            parent: l3
+            child: l4
+            axis: [1, 0, 0]
+            limit: null
+          tool:
+            type: fixed
+            parent: l4
+            child: l5
+            dynamics: null
+        """).replace("\n", "\n  ").rstrip(" ")
+    assert "\ndefaults:\n  joint: {type: revolute, axis: [0, 0, 1], limit: {effort: 10, velocity: 2}, " \
+           "dynamics: {damping: 0.5}}\n" in text
+    built = build([result.recipe_path], tmp_path / "build")
+    assert not built.errors, built.errors
+    assert compare(read_urdf(urdf), read_urdf(tmp_path / "build/d/urdf/d.urdf"), TOL) == []

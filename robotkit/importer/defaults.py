@@ -39,17 +39,21 @@ def factor_defaults(recipe: dict) -> dict:
             continue
         kind = KIND[section]
         base: dict = {}
+        groups: dict[str, list[tuple]] = {}
         for path in paths:
-            value = _shared(items, path, kind, base)
-            if value is _NONE:
-                continue
-            trial_base = copy.deepcopy(base)
-            _set(trial_base, path, value)
-            trial = {name: _without(item, path, value, kind, trial_base) for name, item in items.items()}
-            before = len(section_text(section, items)) + (len(section_text(kind, base)) if base else 0)
-            after = len(section_text(section, trial)) + len(section_text(kind, trial_base))
-            if after < before:
-                base, items = trial_base, trial
+            groups.setdefault(path[0], []).append(path)
+        for group in groups.values():  # a mapping's values together (limit: effort and velocity), else one by one
+            for tried in [group] + ([[p] for p in group] if len(group) > 1 else []):
+                trial_base, trial = copy.deepcopy(base), items
+                for path in tried:
+                    value = _shared(trial, path, kind, trial_base)
+                    if value is not _NONE:
+                        _set(trial_base, path, value)
+                        trial = {name: _without(item, path, value, kind, trial_base) for name, item in trial.items()}
+                before = len(section_text(section, items)) + (len(section_text(kind, base)) if base else 0)
+                after = len(section_text(section, trial)) + len(section_text(kind, trial_base))
+                if trial is not items and after < before:
+                    base, items = trial_base, trial
         if base:
             recipe[section] = items
             written[kind] = base
