@@ -152,7 +152,7 @@ def test_the_repairs_are_the_expected_ones(corpus, name):
 def edited_kuka(folder: Path) -> Path:
     """A copy of the corpus' KUKA iiwa (BSD-2, see LICENSES/) with the traits real files show and the
     corpus lacks: a '/' in a link name, a revolute joint with lower == upper and effort 0 (meant
-    free), principal moments that break the triangle inequality, an ASCII STL as visual and
+    free), a prismatic one with lower == upper != 0 (it can only be there), principal moments that break the triangle inequality, an ASCII STL as visual and
     collision, a joint named like a link, a moving link without <inertial>, a mimic chain with a
     multiplier and offset, and a mimic whose leader is a fixed joint."""
     import shutil
@@ -165,6 +165,9 @@ def edited_kuka(folder: Path) -> Path:
     t = t.replace('"lbr_iiwa_link_3"', '"lbr/iiwa_link_3"')
     t = re.sub(r'(<joint name="lbr_iiwa_joint_4"[\s\S]*?)<limit[^>]*/>',
                r'\1<limit effort="0" lower="0" upper="0" velocity="0"/>', t)
+    t = re.sub(r'<joint name="lbr_iiwa_joint_6" type="revolute">([\s\S]*?)<limit[^>]*/>',
+               r'<joint name="lbr_iiwa_joint_6" type="prismatic">\1<limit effort="0" lower="0.02" upper="0.02" '
+               r'velocity="0"/>', t)
     t = re.sub(r'(<link name="lbr_iiwa_link_5">[\s\S]*?)<inertia [^>]*/>',
                r'\1<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/>', t)
     t = re.sub(r'(<link name="lbr_iiwa_link_7">\s*)<inertial>[\s\S]*?</inertial>', r'\1', t)
@@ -185,11 +188,24 @@ def edited_kuka(folder: Path) -> Path:
 
 
 def _with_stated_joint_changes(text: str, notes: dict[str, str]) -> str:
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
     root = ET.fromstring(text)
     for el in root.iter("joint"):
         note = notes.get(el.get("name"), "")
         if note.startswith("mimicked fixed joint"):
             el.remove(el.find("mimic"))
+        elif "so it is fixed there" in note:  # a prismatic joint at its only position
+            at = float(el.find("limit").get("lower"))
+            origin = el.find("origin")
+            xyz = np.array([float(v) for v in origin.get("xyz").split()])
+            rotation = Rotation.from_euler("xyz", [float(v) for v in origin.get("rpy").split()])
+            axis = np.array([float(v) for v in el.find("axis").get("xyz").split()])
+            origin.set("xyz", " ".join(repr(float(v)) for v in xyz + rotation.apply(axis / np.linalg.norm(axis)) * at))
+            el.set("type", "fixed")
+            for tag in ("limit", "axis"):
+                el.remove(el.find(tag))
         elif "lower == upper" in note:
             el.set("type", "continuous")
             for key in ("lower", "upper"):
@@ -211,6 +227,9 @@ def test_an_edited_copy_imports_builds_and_loads(tmp_path):
     assert result.joint_notes == {
         "lbr_iiwa_joint_4": "limit lower == upper (0.0) in the original: read as no position limit (lower and "
                             "upper default to 0 in URDF), the joint is continuous",
+        "lbr_iiwa_joint_6": "limit lower == upper (0.02) in the original: the joint can only be at that position, "
+                            "so it is fixed there, its origin moved 0.02 along the axis; MuJoCo would ignore the "
+                            "equal limits and let it slide freely",
         "lbr_iiwa_joint_7": "mimicked fixed joint 'tool_joint' in the original: a fixed joint has no position to "
                             "follow, so the mimic is dropped and the joint moves on its own",
         "lbr_iiwa_link_5": "named like a link in the original: SDF, where links and joints share names, calls it "
@@ -223,6 +242,8 @@ def test_an_edited_copy_imports_builds_and_loads(tmp_path):
                                                         "'lbr_iiwa_joint_7')")
     recipe = result.recipe_path.read_text(encoding="utf-8")
     assert "  # limit lower == upper (0.0) in the original" in recipe and "  lbr/iiwa_link_3:" in recipe
+    unwrapped = re.sub(r"\n  # ", " ", recipe)  # the comments above the joints, each on one line
+    assert f" {result.joint_notes['lbr_iiwa_joint_6']}\n  lbr_iiwa_joint_6:\n    type: fixed\n" in unwrapped
     # equal to the original except what the recipe states
     stated = _with_stated_repairs(source, urdf, result.repairs)
     (tmp_path / "stated.urdf").write_text(_with_stated_joint_changes(stated, result.joint_notes), encoding="utf-8")

@@ -866,3 +866,25 @@ def test_shared_joint_values_go_to_defaults(tmp_path):
     built = build([result.recipe_path], tmp_path / "build")
     assert not built.errors, built.errors
     assert compare(read_urdf(urdf), read_urdf(tmp_path / "build/d/urdf/d.urdf"), TOL) == []
+
+
+def test_prismatic_joint_with_equal_limits_is_fixed_where_it_can_be(tmp_path):
+    """lower == upper: the joint can only be there (Gazebo, Drake, Pinocchio hold it; MuJoCo would
+    let it slide), so the recipe fixes it there and says so; a mimic it had goes with it."""
+    inertia = '<inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>'
+    urdf = _write(tmp_path / "p.urdf", f"""
+        <robot name="p">
+          <link name="a">{inertia}</link><link name="b">{inertia}</link><link name="c">{inertia}</link>
+          <joint name="lead" type="prismatic"><parent link="a"/><child link="b"/>
+            <limit lower="0" upper="0.1" effort="1" velocity="1"/></joint>
+          <joint name="slide" type="prismatic"><parent link="b"/><child link="c"/><origin xyz="0.5 0 0"/>
+            <limit lower="0" upper="0" effort="0" velocity="0"/><mimic joint="lead"/></joint>
+        </robot>
+    """)
+    result = import_file(urdf, tmp_path / "p.yaml", {}, {})
+    assert result.joint_notes == {"slide": "limit lower == upper (0.0) in the original: the joint can only be at "
+                                           "that position, so it is fixed there; MuJoCo would ignore the equal limits "
+                                           "and let it slide freely; its mimic is dropped"}
+    assert "joint 'slide': a fixed joint follows no other joint: its <mimic> is dropped" in result.warnings
+    data = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
+    assert data["joints"]["slide"] == {"type": "fixed", "parent": "b", "child": "c", "origin": {"xyz": [0.5, 0, 0]}}
