@@ -888,3 +888,35 @@ def test_prismatic_joint_with_equal_limits_is_fixed_where_it_can_be(tmp_path):
     assert "joint 'slide': a fixed joint follows no other joint: its <mimic> is dropped" in result.warnings
     data = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
     assert data["joints"]["slide"] == {"type": "fixed", "parent": "b", "child": "c", "origin": {"xyz": [0.5, 0, 0]}}
+
+
+def test_a_build_imports_back_into_the_same_robot(examples, tmp_path):
+    """build -> import -> build: the URDF of every example imports (its massless frame links,
+    written as 1e-300 kg with no inertia, come back massless) and builds into the same robot:
+    masses, tensors, frames and limits at 1e-9."""
+    urdfs = sorted(examples.glob("*/urdf/*.urdf"))
+    assert len(urdfs) == 7 and sum('<mass value="1e-300"/>' in u.read_text(encoding="utf-8") for u in urdfs) >= 5
+    for urdf in urdfs:
+        name = urdf.stem
+        result = import_file(urdf, tmp_path / name / "robot.yaml", {name: str(examples / name)}, {})
+        assert not any("massless" in w for w in result.warnings), result.warnings
+        built = build([result.recipe_path], tmp_path / name / "build")
+        assert not built.errors, (name, built.errors)
+        again = tmp_path / name / "build" / result.robot / "urdf" / f"{result.robot}.urdf"
+        assert compare(read_urdf(urdf), read_urdf(again), TOL, configs=20) == [], name
+
+
+def test_a_tiny_mass_without_inertia_is_a_massless_link(tmp_path):
+    urdf = _write(tmp_path / "t.urdf", """
+        <robot name="t">
+          <link name="base"><inertial><mass value="1"/>
+            <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+          <joint name="j" type="fixed"><parent link="base"/><child link="tip"/></joint>
+          <link name="tip"><inertial><mass value="1e-12"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/>
+            </inertial></link>
+        </robot>
+    """)
+    result = import_file(urdf, tmp_path / "t.yaml", {}, {})
+    assert "link 'tip': mass 1e-12 kg with no inertia, below the smallest mass a recipe takes (1e-9 kg): read " \
+           "as a massless link" in result.warnings
+    assert yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))["links"]["tip"] == {}

@@ -38,7 +38,8 @@ from robotkit.importer.parsing import _Problems, _float, _floats, _fmt_list, _lo
 from robotkit.importer.recipe_writer import dump_recipe, fmt  # noqa: F401  (the import's writer)
 from robotkit.model import inertia_policy
 from robotkit.errors import Problem, RobotkitError, display_path
-from robotkit.recipe.schema import FRAME_NAME_RE, NAME_RE, UNITS
+from robotkit.emit.urdf import MASSLESS
+from robotkit.recipe.schema import FRAME_NAME_RE, MIN_MASS, NAME_RE, UNITS, _g
 
 GREY = [0.5, 0.5, 0.5, 1.0]
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
@@ -207,6 +208,12 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
 
         inertial_el = el.find("inertial")
         given = _inertial(inertial_el, name, problems) if inertial_el is not None else None
+        if given is not None and 0 < given["mass"] < MIN_MASS and not any(given["inertia"].values()):
+            # robotkit's own URDF writes a massless link as 1e-300 kg with no inertia: read back as massless
+            if given["mass"] != MASSLESS:
+                warnings.append(f"link '{name}': mass {given['mass']!r} kg with no inertia, below the smallest mass "
+                                f"a recipe takes ({_g(MIN_MASS)} kg): read as a massless link")
+            given = dict(given, mass=0.0)
         if given is not None and given["mass"] > 0:
             out.explicit[name] = given
             geometry = visuals or collisions
