@@ -19,6 +19,9 @@ def _load(build, path) -> View:
     import logging
 
     logging.getLogger("drake").setLevel(logging.ERROR)  # its warnings (joint friction, sensors) are not failures
+    if _unnamed(path):
+        raise Refused('the robot has no name (<robot name="">): Drake stops the whole program on it '
+                      "(model_instance.cc: condition '!name.empty()' failed)")
     plant, _ = AddMultibodyPlantSceneGraph(DiagramBuilder(), 0.0)
     parser = Parser(plant)
     parser.package_map().Add(build.name, str(build.dir))
@@ -49,6 +52,18 @@ def _load(build, path) -> View:
         return {f.name(): f.CalcPoseInWorld(context).GetAsMatrix4() for f in frames}
 
     return View(masses, poses)
+
+
+def _unnamed(path) -> bool:
+    """A URDF whose robot name is empty (checked before Drake, which aborts the process on it)."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        for _, el in ET.iterparse(str(path), events=("start",)):
+            return el.tag == "robot" and not el.get("name")
+    except ET.ParseError:
+        return False  # Drake's parser names the problem
+    return False
 
 
 def from_urdf(build) -> View:
