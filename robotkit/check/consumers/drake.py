@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View
+from robotkit.check.consumers import Missing, Refused, Unreadable, View
 
 
 def _load(build, path) -> View:
@@ -24,15 +24,17 @@ def _load(build, path) -> View:
                       "(model_instance.cc: condition '!name.empty()' failed)")
     plant, _ = AddMultibodyPlantSceneGraph(DiagramBuilder(), 0.0)
     parser = Parser(plant)
-    parser.package_map().Add(build.name, str(build.dir))
-    for pkg, d in build.package_paths.items():
+    for pkg, d in build.package_paths.items():  # the folders given first: a foreign URDF's own package
         if not parser.package_map().Contains(pkg):
             parser.package_map().Add(pkg, d)
+    if not parser.package_map().Contains(build.name):  # a build folder is its robot's package
+        parser.package_map().Add(build.name, str(build.dir))
     try:
         (model,) = parser.AddModels(str(path))
         plant.Finalize()
     except Exception as exc:  # Drake raises RuntimeError with its parser's message
-        raise Refused(" ".join(str(exc).split())[:400]) from None
+        message = " ".join(str(exc).split())[:400]
+        raise (Unreadable if "unsupported extension" in message else Refused)(message) from None
     bodies = [plant.get_body(i) for i in plant.GetBodyIndices(model)]
     masses = {b.name(): float(b.default_mass()) for b in bodies}
     frames = [plant.get_frame(i) for i in plant.GetFrameIndices(model)]
