@@ -55,6 +55,17 @@ def read_roots(tmp_path_factory):
         os.environ[ROOT_ENV] = old
 
 
+@pytest.fixture(scope="session")
+def examples(tmp_path_factory) -> Path:
+    """Every example recipe of recipes/ built once per session (tests that change a build copy it first)."""
+    from robotkit.build import build
+
+    out = tmp_path_factory.mktemp("examples")
+    result = build(sorted(RECIPES.glob("*.yaml")), out)
+    assert not result.errors, result.errors
+    return out
+
+
 @pytest.fixture
 def assets() -> Path:
     if not ASSETS.is_dir():

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import RECIPES, example_robots, run_cli, write_recipe
+from conftest import example_robots, run_cli, write_recipe
 from robotkit.build import build
 from robotkit.check.consumers import CONSUMERS, Build, consumer_findings, read
 from robotkit.check.simulation import smoke_test
@@ -40,13 +40,6 @@ def consumers_installed():
 def build_of(out: Path, name: str, base: str = "fixed") -> Build:
     d = out / name
     return Build(name, d, d / "urdf" / f"{name}.urdf", d / "model.sdf", d / "mjcf" / f"{name}.xml", base)
-
-
-@pytest.fixture(scope="module")
-def examples(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("examples")
-    assert not build(sorted(RECIPES.glob("*.yaml")), out).errors
-    return out
 
 
 @pytest.mark.parametrize("name", EXAMPLES)

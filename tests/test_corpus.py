@@ -152,7 +152,7 @@ def test_the_repairs_are_the_expected_ones(corpus, name):
 def edited_kuka(folder: Path) -> Path:
     """A copy of the corpus' KUKA iiwa (BSD-2, see LICENSES/) with the traits real files show and the
     corpus lacks: a '/' in a link name, a revolute joint with lower == upper and effort 0 (meant
-    free), principal moments that break the triangle inequality, an ASCII STL as visual and
+    free), a prismatic one with lower == upper != 0 (it can only be there), principal moments that break the triangle inequality, an ASCII STL as visual and
     collision, a joint named like a link, a moving link without <inertial>, a mimic chain with a
     multiplier and offset, and a mimic whose leader is a fixed joint."""
     import shutil
@@ -165,6 +165,9 @@ def edited_kuka(folder: Path) -> Path:
     t = t.replace('"lbr_iiwa_link_3"', '"lbr/iiwa_link_3"')
     t = re.sub(r'(<joint name="lbr_iiwa_joint_4"[\s\S]*?)<limit[^>]*/>',
                r'\1<limit effort="0" lower="0" upper="0" velocity="0"/>', t)
+    t = re.sub(r'<joint name="lbr_iiwa_joint_6" type="revolute">([\s\S]*?)<limit[^>]*/>',
+               r'<joint name="lbr_iiwa_joint_6" type="prismatic">\1<limit effort="0" lower="0.02" upper="0.02" '
+               r'velocity="0"/>', t)
     t = re.sub(r'(<link name="lbr_iiwa_link_5">[\s\S]*?)<inertia [^>]*/>',
                r'\1<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/>', t)
     t = re.sub(r'(<link name="lbr_iiwa_link_7">\s*)<inertial>[\s\S]*?</inertial>', r'\1', t)
@@ -185,11 +188,24 @@ def edited_kuka(folder: Path) -> Path:
 
 
 def _with_stated_joint_changes(text: str, notes: dict[str, str]) -> str:
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
     root = ET.fromstring(text)
     for el in root.iter("joint"):
         note = notes.get(el.get("name"), "")
         if note.startswith("mimicked fixed joint"):
             el.remove(el.find("mimic"))
+        elif "so it is fixed there" in note:  # a prismatic joint at its only position
+            at = float(el.find("limit").get("lower"))
+            origin = el.find("origin")
+            xyz = np.array([float(v) for v in origin.get("xyz").split()])
+            rotation = Rotation.from_euler("xyz", [float(v) for v in origin.get("rpy").split()])
+            axis = np.array([float(v) for v in el.find("axis").get("xyz").split()])
+            origin.set("xyz", " ".join(repr(float(v)) for v in xyz + rotation.apply(axis / np.linalg.norm(axis)) * at))
+            el.set("type", "fixed")
+            for tag in ("limit", "axis"):
+                el.remove(el.find(tag))
         elif "lower == upper" in note:
             el.set("type", "continuous")
             for key in ("lower", "upper"):
@@ -211,6 +227,9 @@ def test_an_edited_copy_imports_builds_and_loads(tmp_path):
     assert result.joint_notes == {
         "lbr_iiwa_joint_4": "limit lower == upper (0.0) in the original: read as no position limit (lower and "
                             "upper default to 0 in URDF), the joint is continuous",
+        "lbr_iiwa_joint_6": "limit lower == upper (0.02) in the original: the joint can only be at that position, "
+                            "so it is fixed there, its origin moved 0.02 along the axis; MuJoCo would ignore the "
+                            "equal limits and let it slide freely",
         "lbr_iiwa_joint_7": "mimicked fixed joint 'tool_joint' in the original: a fixed joint has no position to "
                             "follow, so the mimic is dropped and the joint moves on its own",
         "lbr_iiwa_link_5": "named like a link in the original: SDF, where links and joints share names, calls it "
@@ -223,6 +242,8 @@ def test_an_edited_copy_imports_builds_and_loads(tmp_path):
                                                         "'lbr_iiwa_joint_7')")
     recipe = result.recipe_path.read_text(encoding="utf-8")
     assert "  # limit lower == upper (0.0) in the original" in recipe and "  lbr/iiwa_link_3:" in recipe
+    unwrapped = re.sub(r"\n  # ", " ", recipe)  # the comments above the joints, each on one line
+    assert f" {result.joint_notes['lbr_iiwa_joint_6']}\n  lbr_iiwa_joint_6:\n    type: fixed\n" in unwrapped
     # equal to the original except what the recipe states
     stated = _with_stated_repairs(source, urdf, result.repairs)
     (tmp_path / "stated.urdf").write_text(_with_stated_joint_changes(stated, result.joint_notes), encoding="utf-8")
@@ -292,3 +313,114 @@ def test_pmb2_with_an_inertia_policy_builds_and_loads(tmp_path, policy):
                                           configs=5)
     assert [str(f) for f in findings if f.severity == "error"] == []
     assert all(s["loaded"] for s in summary.values()), summary
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_defaults_change_no_value(corpus, name, tmp_path, monkeypatch):
+    """The values moved to the recipe's ``defaults`` (and the exceptions written per joint or
+    link) give, once merged, the recipe written without them: field for field."""
+    import robotkit.importer.defaults
+    from robotkit.recipe.load import load_recipes
+
+    result = corpus[name][0]
+    spec = CORPUS[name]
+    monkeypatch.setattr(robotkit.importer.defaults, "factor_defaults", lambda recipe: {})
+    plain = import_file(spec["entry"], result.recipe_path.parent / "plain.yaml", spec["packages"], spec["args"])
+    assert "\ndefaults:" not in plain.recipe_path.read_text(encoding="utf-8")
+    (factored,), (unfactored,) = load_recipes(result.recipe_path), load_recipes(plain.recipe_path)
+    assert factored.problems == [] and unfactored.problems == []
+    assert factored.recipe.model_dump(exclude={"defaults"}) == unfactored.recipe.model_dump(exclude={"defaults"})
+
+
+# ---------------------------------------------------------------- check on the originals
+
+DEFECTS = {  # every error `robotkit check` names on each original; why each is real is said beside it
+    # inertia-box: tensors that do not fit the parts (the fingers' is a 3 cm rod along y; the wrist
+    # links' moments are a twelfth of their geometry's); PyBullet gives its links without <inertial> 1 kg
+    "kinova_j2n6s300": {
+        "inertia-box": ["j2n6s300_link_4", "j2n6s300_link_5", "j2n6s300_link_6", "j2n6s300_link_finger_1",
+                        "j2n6s300_link_finger_tip_1", "j2n6s300_link_finger_2", "j2n6s300_link_finger_tip_2",
+                        "j2n6s300_link_finger_3", "j2n6s300_link_finger_tip_3"],
+        "consumer": ["PyBullet (URDF): total mass 6.784574 kg, the description's is 4.784574 kg",
+                     "PyBullet (URDF): link 'j2n6s300_end_effector' weighs 1 kg (its default for a link without "
+                     "<inertial>), the description says 0 kg",
+                     "PyBullet (URDF): link 'root' weighs 1 kg (its default for a link without <inertial>), the "
+                     "description says 0 kg"]},
+    # the calf rotors' transverse moments exceed their axial one: a disc's are half of it
+    "aliengo": {
+        "inertia-box": ["FR_calf_rotor", "FL_calf_rotor", "RR_calf_rotor", "RL_calf_rotor"],
+        "consumer": ["PyBullet (URDF): total mass 25.937 kg, the description's is 24.937 kg",
+                     "PyBullet (URDF): link 'base' weighs 1 kg (its default for a link without <inertial>), the "
+                     "description says 0 kg"]},
+    # no <inertial> anywhere and effort 0 on every joint (ROS-Industrial's kinematics-only files)
+    "motoman_sda10f": {
+        "joint-limits": [f"arm_{side}_joint_{j}" for side in ("left", "right")
+                         for j in ("1_s", "2_l", "3_e", "4_u", "5_r", "6_b", "7_t")],
+        "massless-moving": ["torso_link_b1", "torso_link_b2"] + [f"arm_{side}_link_{j}" for side in ("left", "right")
+                                                                 for j in ("1_s", "2_l", "3_e", "4_u", "5_r", "6_b",
+                                                                           "7_t")],
+        "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"]},
+    "fanuc_m10ia": {
+        "joint-limits": [f"joint_{i}" for i in range(1, 7)],
+        "massless-moving": [f"link_{i}" for i in range(1, 7)],
+        "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"]},
+    # the gripper links' tensor is a placeholder (the same moments on every axis: a 7.75 cm cube)
+    "open_manipulator_x": {
+        "inertia-box": ["gripper_left_link", "gripper_right_link"],
+        "consumer": ["PyBullet (URDF): total mass 1.594057319 kg, the description's is 0.594057319 kg",
+                     "PyBullet (URDF): link 'end_effector_link' weighs 1 kg (its default for a link without "
+                     "<inertial>), the description says 0 kg"]},
+    "shadow_hand": {
+        "inertia": ["rh_fftip", "rh_mftip", "rh_rftip", "rh_lftip", "rh_thtip"],  # zero tensors
+        "consumer": ["PyBullet (URDF): total mass 5.794 kg, the description's is 3.794 kg",
+                     "PyBullet (URDF): link 'rh_imu' weighs 1 kg (its default for a link without <inertial>), the "
+                     "description says 0 kg",
+                     "PyBullet (URDF): link 'rh_manipulator' weighs 1 kg (its default for a link without "
+                     "<inertial>), the description says 0 kg"]},
+    # the sonars' tensor is a placeholder cube; the antennas' has a negative moment
+    "pmb2": {
+        "inertia-box": ["base_sonar_03_link", "base_sonar_02_link", "base_sonar_01_link", "base_cover_link"],
+        "inertia": ["base_antenna_left_link", "base_antenna_right_link"]},
+    # PyBullet's static base (mass 0), which Gazebo drops with everything below it
+    "kuka_iiwa_bullet": {
+        "mass": ["lbr_iiwa_link_0"],
+        "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"]},
+    # hand-typed chassis tensor; the camera's 10 mg with a 0.78 m cube's tensor
+    "racecar_bullet": {"inertia-box": ["chassis", "zed_camera_link"], "implied-density": ["zed_camera_link"]},
+    # PyBullet's own dialect: <capsule>, massless links between the three joints of a ball joint, no name
+    "humanoid_bullet": {
+        "check_urdf": ["Error:   Unknown geometry type 'capsule'"],
+        "massless-moving": ["link1_2", "link1_7", "link1_8", "link1_13", "link1_16", "link1_17", "link1_22",
+                            "link1_25", "link1_30"],
+        "consumer": ["Gazebo (URDF) refuses the robot: Error:   Unknown geometry type 'capsule'",
+                     'Drake (URDF) refuses the robot: the robot has no name (<robot name="">): Drake stops the whole '
+                     "program on it (model_instance.cc: condition '!name.empty()' failed)"]},
+}
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_check_names_the_real_defects_of_each_original(name):
+    """`robotkit check` on each original (the xacro with its package paths, or the URDF): the
+    errors are exactly the robot's real defects (a consumer's own limit, such as Drake reading
+    no STL collision mesh, is a warning)."""
+    from robotkit.check import check
+
+    spec = CORPUS[name]
+    found: dict[str, list[str]] = {}
+    for f in check(str(spec["entry"]), package_paths=spec["packages"], args=spec["args"]):
+        if f.severity == "error":
+            what = f.message if f.check in ("consumer", "check_urdf") else f.subject.split("'")[1]
+            found.setdefault(f.check, []).append(what)
+    assert found == DEFECTS[name]
+
+
+def test_check_passes_a_clean_original():
+    """The turret bot's URDF (a ROS package beside the corpus) has no defect: exit 0, with
+    Drake's own limit (no STL collision meshes) as a warning."""
+    turret = ROBOTS_DIR.parent / "turret_bot"
+    proc = run_cli("check", turret / "urdf" / "turret_bot.urdf", "--package-path", f"turret_bot={turret}")
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert proc.stdout.splitlines()[-1] == f"{turret / 'urdf' / 'turret_bot.urdf'}: 0 errors, 2 warnings"
+    assert "  warning: Drake (URDF) refuses the robot: MakeConvexHull only applies to .obj, .vtk, and .gltf meshes; " \
+           f"unsupported extension '.stl' for geometry data: {turret / 'meshes' / 'base.stl'}. [consumer]" \
+           in proc.stdout.splitlines()

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import GOLDEN, assert_golden, RECIPES, example_robots, run_cli, write_recipe
+from conftest import GOLDEN, assert_golden, example_robots, run_cli, write_recipe
 from robotkit.build import build
 from robotkit.check.equivalence import equivalence
 from robotkit.check.simulation import smoke_test
@@ -28,14 +28,6 @@ def assert_equivalent(robot_dir: Path, configs: int = 100):
     mujoco()
     result = equivalence(robot_dir, tol=1e-9, configs=configs)
     assert result == {k: [] for k in result}, json.dumps(result, indent=1)
-
-
-@pytest.fixture(scope="module")
-def examples(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("examples")
-    result = build(sorted(RECIPES.glob("*.yaml")), out)
-    assert not result.errors
-    return out
 
 
 @pytest.mark.parametrize("name", EXAMPLES)

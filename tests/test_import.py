@@ -877,3 +877,120 @@ def test_metadata_comes_from_the_package_xml(tmp_path):
     build([tmp_path / "box.yaml"], tmp_path / "out")
     assert '<maintainer email="support@kinova.ca">Kinova Support</maintainer>' in (
         tmp_path / "out" / "box" / "package.xml").read_text()
+
+
+# ---------------------------------------------------------------- the recipe written for people: defaults
+
+
+SHARED_VALUES = """
+    <robot name="d">
+      <link name="l0"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="l4"/><link name="l5"/>
+      <joint name="j1" type="revolute"><parent link="l0"/><child link="l1"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="10" velocity="2"/><dynamics damping="0.5"/></joint>
+      <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/>
+        <limit lower="-2" upper="2" effort="10" velocity="2"/><dynamics damping="0.5"/></joint>
+      <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" effort="10" velocity="2"/><dynamics damping="0.5" friction="1"/></joint>
+      <joint name="j4" type="continuous"><parent link="l3"/><child link="l4"/>
+        <dynamics damping="0.5"/></joint>
+      <joint name="tool" type="fixed"><parent link="l4"/><child link="l5"/></joint>
+    </robot>
+"""
+
+
+def test_shared_joint_values_go_to_defaults(tmp_path):
+    """Values more than half of the joints hold (and at least three) are written once in
+    ``defaults``; a joint with another value keeps its own, one with none says so (the schema's
+    default, or null); a default limit or axis does not go to a fixed joint.  The recipe builds
+    the same robot as the URDF."""
+    urdf = _write(tmp_path / "d.urdf", SHARED_VALUES)
+    for i in range(6):
+        urdf.write_text(urdf.read_text().replace(f'<link name="l{i}"/>', f'<link name="l{i}"><inertial><mass value="1"/>'
+                        '<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>'))
+    result = import_file(urdf, tmp_path / "d.yaml", {}, {})
+    text = result.recipe_path.read_text(encoding="utf-8")
+    assert text.split("\njoints:\n")[1] == "  " + textwrap.dedent("""\
+          j1:
+            parent: l0
+            child: l1
+            limit: {lower: -1, upper: 1}
+          j2:
+            parent: l1
+            child: l2
+            limit: {lower: -2, upper: 2}
+          j3:
+            parent: l2
+            child: l3
+            limit: {lower: -3, upper: 3}
+            dynamics: {friction: 1}
+          j4:
+            type: continuous
+            parent: l3
+            child: l4
+            axis: [1, 0, 0]
+            limit: null
+          tool:
+            type: fixed
+            parent: l4
+            child: l5
+            dynamics: null
+        """).replace("\n", "\n  ").rstrip(" ")
+    assert "\ndefaults:\n  joint: {type: revolute, axis: [0, 0, 1], limit: {effort: 10, velocity: 2}, " \
+           "dynamics: {damping: 0.5}}\n" in text
+    built = build([result.recipe_path], tmp_path / "build")
+    assert not built.errors, built.errors
+    assert compare(read_urdf(urdf), read_urdf(tmp_path / "build/d/urdf/d.urdf"), TOL) == []
+
+
+def test_prismatic_joint_with_equal_limits_is_fixed_where_it_can_be(tmp_path):
+    """lower == upper: the joint can only be there (Gazebo, Drake, Pinocchio hold it; MuJoCo would
+    let it slide), so the recipe fixes it there and says so; a mimic it had goes with it."""
+    inertia = '<inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>'
+    urdf = _write(tmp_path / "p.urdf", f"""
+        <robot name="p">
+          <link name="a">{inertia}</link><link name="b">{inertia}</link><link name="c">{inertia}</link>
+          <joint name="lead" type="prismatic"><parent link="a"/><child link="b"/>
+            <limit lower="0" upper="0.1" effort="1" velocity="1"/></joint>
+          <joint name="slide" type="prismatic"><parent link="b"/><child link="c"/><origin xyz="0.5 0 0"/>
+            <limit lower="0" upper="0" effort="0" velocity="0"/><mimic joint="lead"/></joint>
+        </robot>
+    """)
+    result = import_file(urdf, tmp_path / "p.yaml", {}, {})
+    assert result.joint_notes == {"slide": "limit lower == upper (0.0) in the original: the joint can only be at "
+                                           "that position, so it is fixed there; MuJoCo would ignore the equal limits "
+                                           "and let it slide freely; its mimic is dropped"}
+    assert "joint 'slide': a fixed joint follows no other joint: its <mimic> is dropped" in result.warnings
+    data = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
+    assert data["joints"]["slide"] == {"type": "fixed", "parent": "b", "child": "c", "origin": {"xyz": [0.5, 0, 0]}}
+
+
+def test_a_build_imports_back_into_the_same_robot(examples, tmp_path):
+    """build -> import -> build: the URDF of every example imports (its massless frame links,
+    written as 1e-300 kg with no inertia, come back massless) and builds into the same robot:
+    masses, tensors, frames and limits at 1e-9."""
+    urdfs = sorted(examples.glob("*/urdf/*.urdf"))
+    assert len(urdfs) == 7 and sum('<mass value="1e-300"/>' in u.read_text(encoding="utf-8") for u in urdfs) >= 5
+    for urdf in urdfs:
+        name = urdf.stem
+        result = import_file(urdf, tmp_path / name / "robot.yaml", {name: str(examples / name)}, {})
+        assert not any("massless" in w for w in result.warnings), result.warnings
+        built = build([result.recipe_path], tmp_path / name / "build")
+        assert not built.errors, (name, built.errors)
+        again = tmp_path / name / "build" / result.robot / "urdf" / f"{result.robot}.urdf"
+        assert compare(read_urdf(urdf), read_urdf(again), TOL, configs=20) == [], name
+
+
+def test_a_tiny_mass_without_inertia_is_a_massless_link(tmp_path):
+    urdf = _write(tmp_path / "t.urdf", """
+        <robot name="t">
+          <link name="base"><inertial><mass value="1"/>
+            <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+          <joint name="j" type="fixed"><parent link="base"/><child link="tip"/></joint>
+          <link name="tip"><inertial><mass value="1e-12"/><inertia ixx="0" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/>
+            </inertial></link>
+        </robot>
+    """)
+    result = import_file(urdf, tmp_path / "t.yaml", {}, {})
+    assert "link 'tip': mass 1e-12 kg with no inertia, below the smallest mass a recipe takes (1e-9 kg): read " \
+           "as a massless link" in result.warnings
+    assert yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))["links"]["tip"] == {}

@@ -7,6 +7,7 @@ SDF or MJCF file written anywhere (meshes resolved relative to it or via --packa
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -54,13 +55,15 @@ def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, 
     """A xacro file expanded in the import's sandbox (``$(find)`` through ``package_paths``,
     ``args`` as xacro arguments), then checked as the URDF it expands to; findings name the
     xacro file."""
-    import re
     import tempfile
 
     from robotkit.importer.xacro_expand import check_package_paths, expand
 
+    import xml.dom.minidom
+
     packages = check_package_paths(package_paths)
-    text = expand(path, packages, args).text
+    # indented as the xacro command writes it: PyBullet's reader fails on a long single line
+    text = xml.dom.minidom.parseString(expand(path, packages, args).text).toprettyxml(indent="  ")
 
     def absolute(m: re.Match) -> str:  # relative mesh paths stay relative to the xacro file
         uri = m.group(2)
@@ -87,7 +90,10 @@ def urdf_tree(path: Path) -> tuple[dict[str, int], list[Finding]]:
     from lxml import etree
 
     try:
-        root = etree.parse(str(path), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+        data = path.read_bytes()
+        # urdfdom (TinyXML2) reads any declared version (PyBullet's humanoid says "0.0"); libxml2 only 1.x
+        data = re.sub(rb'^(\s*<\?xml\s+version\s*=\s*["\'])(?!1\.)[^"\']*', rb"\g<1>1.0", data)
+        root = etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True))
     except (etree.XMLSyntaxError, OSError) as exc:
         raise RobotkitError(Problem(f"not well-formed XML: {exc}", file=str(path))) from None
     lines = {f"{e.tag} '{e.get('name')}'": e.sourceline for e in root if e.tag in ("link", "joint")}

@@ -29,6 +29,7 @@ BOX_ERROR, BOX_WARNING = 3.0, 1.5
 FACE_BUDGET = 200_000  # visual faces per link before rendering rates suffer
 COLLISION_VOLUME_RANGE = (0.5, 2.0)  # collision / visual volume
 MASS_TOLERANCE = 0.10  # declared total mass vs computed
+MARKER = 1e-3  # m: geometry no larger marks a frame (an IMU's 1 mm box) and says nothing of the part
 
 
 @dataclass
@@ -51,9 +52,17 @@ class LinkFacts:
     com: np.ndarray | None = None
     inertia: np.ndarray | None = None  # about com, link axes
     geoms: list[GeomFacts] = field(default_factory=list)
+    unread: set[str] = field(default_factory=set)  # roles with a shape that could not be read (PyBullet's capsule)
 
     def role(self, role: str) -> list[GeomFacts]:
         return [g for g in self.geoms if g.role == role]
+
+    def shape(self, role: str) -> list[GeomFacts]:
+        """The role's geometry when it shows the part: all of it read, and larger than a marker."""
+        geoms = self.role(role)
+        if role in self.unread or not geoms or max(float(np.ptp(g.points, axis=0).max()) for g in geoms) <= MARKER:
+            return []
+        return geoms
 
 
 @dataclass
@@ -215,6 +224,8 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
                 gf = _geom_facts(g, role, path.parent, package_paths, subject, problems, cache)
                 if gf is not None:
                     facts.geoms.append(gf)
+                elif g.find("geometry") is not None and len(g.find("geometry")):
+                    facts.unread.add(role)
         links.append(facts)
     joints = []
     for el in root.findall("joint"):
@@ -321,7 +332,7 @@ def lint_link(link: LinkFacts) -> list[Finding]:
             add("warning", "com-outside", f"centre of mass {np.round(link.com, 6).tolist()} lies outside the "
                 f"link's geometry (box {np.round(lo, 6).tolist()} .. {np.round(hi, 6).tolist()})",
                 "an inertial origin in the wrong frame or left out")
-    vis, col = _volume(link.role("visual")), _volume(link.role("collision"))
+    vis, col = _volume(link.shape("visual")), _volume(link.shape("collision"))
     if vis and col and not (COLLISION_VOLUME_RANGE[0] <= col / vis <= COLLISION_VOLUME_RANGE[1]):
         add("warning", "collision-volume", f"collision geometry has {col / vis:.3g}x the visual volume",
             "the collision proxy is far from the visual shape")
@@ -335,11 +346,11 @@ def _volume(geoms: list[GeomFacts]) -> float | None:
 
 
 def _link_volume(link: LinkFacts) -> float | None:
-    return _volume(link.role("visual")) or _volume(link.role("collision"))
+    return _volume(link.shape("visual")) or _volume(link.shape("collision"))
 
 
 def _geometry_points(link: LinkFacts) -> np.ndarray | None:
-    geoms = link.role("visual") or link.role("collision")
+    geoms = link.shape("visual") or link.shape("collision")
     if not geoms:
         return None
     return np.vstack([g.points for g in geoms])
@@ -349,7 +360,7 @@ def _geometry_props(link: LinkFacts):
     """(volume, com, unit-density inertia) of the link's closed geometry, or None."""
     from robotkit.mesh.inertia import combine
 
-    geoms = link.role("visual") or link.role("collision")
+    geoms = link.shape("visual") or link.shape("collision")
     if not geoms or any(g.inertia is None for g in geoms):
         return None
     volume, com, I = combine([(g.volume, g.com, g.inertia) for g in geoms])

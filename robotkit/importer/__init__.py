@@ -89,6 +89,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     ``copy_meshes`` copies the meshes below the recipe's folder (``meshes/``) instead of
     referencing them where they are.
     """
+    from robotkit.importer.defaults import factor_defaults
     from robotkit.importer.meshes import _open_meshes
     from robotkit.importer.package_xml import package_metadata
     from robotkit.importer.recipe_writer import name_mesh_folders
@@ -132,6 +133,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     _open_meshes(conv, recipe, warnings, recompute_inertials)
     name_mesh_folders(recipe)
     _validate(recipe, source)
+    factor_defaults(recipe)  # after the check: the schema reads links and joints with their defaults merged
 
     from robotkit.paths import inside
 

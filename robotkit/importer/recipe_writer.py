@@ -10,7 +10,8 @@ import re
 from collections import Counter
 
 
-TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "values", "materials", "links", "joints", "urdf_extras")
+TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "values", "materials", "defaults", "links", "joints",
+            "urdf_extras")
 
 
 def fmt(x: float) -> str:
@@ -103,28 +104,34 @@ def dump_recipe(recipe: dict, header: list[str] | None = None,
     opts = dict(Dumper=dumper, default_flow_style=False, sort_keys=False, width=10**9, allow_unicode=True)
     parts.append(yaml.dump({k: recipe[k] for k in scalars}, **opts))
     for key in sections:
-        value = recipe[key]
-        if key == "values":
-            styled = dict(value)
-        elif key == "materials":
-            styled = {name: _styled(m, 200) for name, m in value.items()}
-        elif key in ("links", "joints"):
-            notes = (comments or {}).get(key, {})
-            if notes:
-                text = [f"\n{key}:\n"]
-                for name, entry in value.items():
-                    for line in _wrap(notes.get(name, "")):
-                        text.append(f"  # {line}\n")
-                    entry_text = yaml.dump({name: _styled_entry(entry)}, **opts)
-                    text.append("".join(f"  {line}" if line.strip() else line
-                                        for line in entry_text.splitlines(keepends=True)))
-                parts.append("".join(text))
-                continue
-            styled = {name: _styled_entry(entry) for name, entry in value.items()}
-        else:
-            styled = _styled(value, 100)
-        parts.append("\n" + yaml.dump({key: styled}, **opts))
+        parts.append("\n" + section_text(key, recipe[key], (comments or {}).get(key)))
     return "".join(parts)
+
+
+def section_text(key: str, value, notes: dict[str, str] | None = None) -> str:
+    """One top-level section as :func:`dump_recipe` writes it; ``notes[name]`` goes above that
+    entry of ``links`` or ``joints``."""
+    import yaml
+
+    opts = dict(Dumper=_dumper(), default_flow_style=False, sort_keys=False, width=10**9, allow_unicode=True)
+    if key == "values":
+        styled = dict(value)
+    elif key == "materials":
+        styled = {name: _styled(m, 200) for name, m in value.items()}
+    elif key in ("links", "joints"):
+        if notes:
+            text = [f"{key}:\n"]
+            for name, entry in value.items():
+                for line in _wrap(notes.get(name, "")):
+                    text.append(f"  # {line}\n")
+                entry_text = yaml.dump({name: _styled_entry(entry)}, **opts)
+                text.append("".join(f"  {line}" if line.strip() else line
+                                    for line in entry_text.splitlines(keepends=True)))
+            return "".join(text)
+        styled = {name: _styled_entry(entry) for name, entry in value.items()}
+    else:
+        styled = _styled(value, 100)
+    return yaml.dump({key: styled}, **opts)
 
 
 def _wrap(text: str, width: int = 96) -> list[str]:

@@ -37,7 +37,8 @@ from robotkit.importer.names import _material_name, _name_hint, _valid_frame_nam
 from robotkit.importer.parsing import _Problems, _float, _floats, _fmt_list, _local, _origin, _origin_dict
 from robotkit.importer.recipe_writer import dump_recipe, fmt  # noqa: F401  (the import's writer)
 from robotkit.errors import Problem, RobotkitError, display_path
-from robotkit.recipe.schema import FRAME_NAME_RE, NAME_RE, UNITS
+from robotkit.emit.urdf import MASSLESS
+from robotkit.recipe.schema import FRAME_NAME_RE, MIN_MASS, NAME_RE, UNITS, _g
 
 GREY = [0.5, 0.5, 0.5, 1.0]
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
@@ -209,6 +210,12 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
 
         inertial_el = el.find("inertial")
         given = _inertial(inertial_el, name, problems) if inertial_el is not None else None
+        if given is not None and 0 < given["mass"] < MIN_MASS and not any(given["inertia"].values()):
+            # robotkit's own URDF writes a massless link as 1e-300 kg with no inertia: read back as massless
+            if given["mass"] != MASSLESS:
+                warnings.append(f"link '{name}': mass {given['mass']!r} kg with no inertia, below the smallest mass "
+                                f"a recipe takes ({_g(MIN_MASS)} kg): read as a massless link")
+            given = dict(given, mass=0.0)
         if given is not None and given["mass"] > 0:
             out.explicit[name] = given
             geometry = visuals or collisions
@@ -519,6 +526,23 @@ def _joint(el: ET.Element, name: str, problems: _Problems, warnings: list[str]) 
                 joint["__note"] = note
                 kept = {k: abs(limit[k]) for k in ("effort", "velocity")}
                 joint["limit"] = kept
+            elif limit["lower"] == limit["upper"]:  # prismatic
+                # it can only be at that position: consumers that keep limits (Gazebo, Drake,
+                # Pinocchio) hold it there; MuJoCo ignores equal limits and lets it slide away
+                at = limit["lower"]
+                note = (f"limit lower == upper ({at!r}) in the original: the joint can only be at that position, "
+                        f"so it is fixed there{_moved(at)}; MuJoCo would ignore the equal limits and let it slide "
+                        "freely")
+                warnings.append(f"{what}: {note}")
+                axis = joint.pop("axis", [1.0, 0.0, 0.0])
+                if at != 0:
+                    joint.pop("origin", None)
+                    origin = _slid(el, what, problems, axis, at)
+                    if origin:
+                        joint["origin"] = origin
+                joint["type"] = "fixed"
+                joint["__note"] = note
+                el = _without_mimic(el, joint, what, warnings)
             elif limit["lower"] >= limit["upper"]:
                 problems.add(f"{what}: limit lower ({limit['lower']!r}) is not below upper ({limit['upper']!r}); "
                              "a recipe cannot express a locked revolute or prismatic joint (make it fixed)")
@@ -573,6 +597,37 @@ def _joint(el: ET.Element, name: str, problems: _Problems, warnings: list[str]) 
         if tag not in ("parent", "child", "origin", "axis", "limit", "dynamics", "mimic"):
             warnings.append(f"{what}: <{tag}> is dropped (the recipe has no place for it)")
     return joint
+
+
+def _moved(at: float) -> str:
+    return "" if at == 0 else f", its origin moved {fmt(at)} along the axis"
+
+
+def _slid(el: ET.Element, what: str, problems: _Problems, axis: list[float], at: float) -> dict | None:
+    """The joint's origin with the child slid ``at`` along the (unit) axis: where the prismatic
+    joint puts it at position ``at``."""
+    import numpy as np
+
+    from robotkit.model.robot import rpy_matrix
+
+    xyz, rpy = _origin(el.find("origin"), what, problems)
+    a = np.asarray(axis, dtype=float)
+    moved = np.asarray(xyz, dtype=float) + rpy_matrix(rpy) @ (a / np.linalg.norm(a)) * at
+    return _origin_dict([float(v) + 0.0 for v in moved], rpy)
+
+
+def _without_mimic(el: ET.Element, joint: dict, what: str, warnings: list[str]) -> ET.Element:
+    """A copy of the joint element without <mimic> when it has one (a fixed joint follows no joint)."""
+    import copy
+
+    mimic = el.find("mimic")
+    if mimic is None:
+        return el
+    warnings.append(f"{what}: a fixed joint follows no other joint: its <mimic> is dropped")
+    joint["__note"] += "; its mimic is dropped"
+    el = copy.deepcopy(el)
+    el.remove(el.find("mimic"))
+    return el
 
 
 # ---------------------------------------------------------------- gazebo blocks

@@ -293,6 +293,25 @@ def _copy_marks(src: Path_, dst: Path_, marks: Marks):
     marks.from_defaults[dst] = src
 
 
+LIMITED = ("revolute", "prismatic", "continuous")
+"""The joint types that take a ``limit``."""
+UNAXED = ("fixed", "floating")
+"""The joint types that have no ``axis``."""
+
+
+def default_applies(kind: str, key: str, item: dict, base: dict) -> bool:
+    """Whether the default ``key`` of ``defaults.<kind>`` goes under this link or joint:
+    a joint's ``limit`` only under the types that take one (revolute, prismatic, continuous),
+    its ``axis`` only under those that move along one (not fixed, floating); everything else
+    under every item.  The type is the item's own, else the default's."""
+    if kind != "joint" or key not in ("limit", "axis"):
+        return True
+    jtype = item.get("type", base.get("type"))
+    if not isinstance(jtype, str):
+        return True  # the schema reports it
+    return jtype in LIMITED if key == "limit" else jtype not in UNAXED
+
+
 def _apply_defaults(data: dict, marks: Marks):
     defaults = data.get("defaults")
     if not isinstance(defaults, dict):
@@ -306,7 +325,8 @@ def _apply_defaults(data: dict, marks: Marks):
             if value is None:
                 value = {}
             if isinstance(value, dict):
-                items[name] = _deep_merge(base, value, ("defaults", kind), (section, name), marks)
+                applied = {k: v for k, v in base.items() if default_applies(kind, k, value, base)}
+                items[name] = _deep_merge(applied, value, ("defaults", kind), (section, name), marks)
 
 
 def _absolute_meshes(data: dict, marks: Marks):

@@ -554,7 +554,10 @@ class Metadata(Strict):
 
 
 class Defaults(Strict):
-    """Values merged under every link and joint; a link's or joint's own keys win."""
+    """Values merged under every link and joint; a link's or joint's own keys win (``null``
+    removes a default: ``limit: null``).  A joint's ``limit`` goes only to the types that take
+    one (revolute, prismatic, continuous) and its ``axis`` only to those that move along one
+    (not fixed, floating)."""
 
     link: dict = {}
     """Keys merged under every link (same keys as a link)."""

@@ -39,6 +39,12 @@ class Refused(Exception):
     """The program refused to load the robot (its own message)."""
 
 
+class Unreadable(Refused):
+    """The program refused the robot for a mesh format that the description's own format
+    allows (Drake and STL or DAE collision meshes): a limit of the program, not a defect of the
+    description, so a warning (robotkit's builds write every collision mesh as OBJ)."""
+
+
 class Missing(Exception):
     """The program is not installed (the message says how to install it)."""
 
@@ -156,6 +162,11 @@ def consumer_findings(build: Build, consumers=None, configs: int = 20) -> tuple[
             # a plain install has MuJoCo but not Drake, Pinocchio, PyBullet: say what was skipped
             findings.append(Finding("warning", "consumer", subject, f"{consumer}: not checked: {exc}"))
             summary[consumer] = {"loaded": None, "reason": str(exc)}
+            continue
+        except Unreadable as exc:
+            findings.append(Finding("warning", "consumer", subject, f"{consumer} refuses the robot: {exc}",
+                                    "a limit of the program: robotkit import and build write OBJ collision meshes"))
+            summary[consumer] = {"loaded": False, "reason": str(exc)}
             continue
         except Refused as exc:
             findings.append(Finding("error", "consumer", subject, f"{consumer} refuses the robot: {exc}"))

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View
+from robotkit.check.consumers import Missing, Refused, Unreadable, View
 
 
 def _load(build, path) -> View:
@@ -19,17 +19,22 @@ def _load(build, path) -> View:
     import logging
 
     logging.getLogger("drake").setLevel(logging.ERROR)  # its warnings (joint friction, sensors) are not failures
+    if _unnamed(path):
+        raise Refused('the robot has no name (<robot name="">): Drake stops the whole program on it '
+                      "(model_instance.cc: condition '!name.empty()' failed)")
     plant, _ = AddMultibodyPlantSceneGraph(DiagramBuilder(), 0.0)
     parser = Parser(plant)
-    parser.package_map().Add(build.name, str(build.dir))
-    for pkg, d in build.package_paths.items():
+    for pkg, d in build.package_paths.items():  # the folders given first: a foreign URDF's own package
         if not parser.package_map().Contains(pkg):
             parser.package_map().Add(pkg, d)
+    if not parser.package_map().Contains(build.name):  # a build folder is its robot's package
+        parser.package_map().Add(build.name, str(build.dir))
     try:
         (model,) = parser.AddModels(str(path))
         plant.Finalize()
     except Exception as exc:  # Drake raises RuntimeError with its parser's message
-        raise Refused(" ".join(str(exc).split())[:400]) from None
+        message = " ".join(str(exc).split())[:400]
+        raise (Unreadable if "unsupported extension" in message else Refused)(message) from None
     bodies = [plant.get_body(i) for i in plant.GetBodyIndices(model)]
     masses = {b.name(): float(b.default_mass()) for b in bodies}
     frames = [plant.get_frame(i) for i in plant.GetFrameIndices(model)]
@@ -49,6 +54,18 @@ def _load(build, path) -> View:
         return {f.name(): f.CalcPoseInWorld(context).GetAsMatrix4() for f in frames}
 
     return View(masses, poses)
+
+
+def _unnamed(path) -> bool:
+    """A URDF whose robot name is empty (checked before Drake, which aborts the process on it)."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        for _, el in ET.iterparse(str(path), events=("start",)):
+            return el.tag == "robot" and not el.get("name")
+    except ET.ParseError:
+        return False  # Drake's parser names the problem
+    return False
 
 
 def from_urdf(build) -> View:

@@ -40,17 +40,46 @@ def _T(pos, orn) -> np.ndarray:
     return T
 
 
+@contextlib.contextmanager
+def _located(build):
+    """The URDF as a PyBullet user loads a ROS package's: PyBullet knows no package paths, so
+    ``package://PKG/`` of the packages given (``--package-path``) becomes their folder, in a
+    temporary copy (relative mesh paths made absolute)."""
+    import re
+    import tempfile
+
+    text = build.urdf.read_text(encoding="utf-8") if build.package_paths else ""
+    if not any(f"package://{pkg}/" in text for pkg in build.package_paths):
+        yield build.urdf
+        return
+
+    def located(m: re.Match) -> str:
+        uri = m.group(2)
+        pkg = re.match(r"package://([^/]+)/(.*)", uri)
+        if pkg and pkg.group(1) in build.package_paths:
+            uri = os.path.join(os.path.abspath(build.package_paths[pkg.group(1)]), pkg.group(2))
+        elif "://" not in uri and not os.path.isabs(uri):
+            uri = os.path.join(os.path.abspath(build.urdf.parent), uri)
+        return m.group(1) + uri + m.group(3)
+
+    with tempfile.TemporaryDirectory(prefix="robotkit-pybullet-") as tmp:
+        copy = os.path.join(tmp, build.urdf.name)
+        with open(copy, "w", encoding="utf-8") as f:
+            f.write(re.sub(r'(\bfilename=")([^"]*)(")', located, text))
+        yield copy
+
+
 def from_urdf(build) -> View:
     try:
         with _quiet():
             import pybullet as p
     except ImportError:
         raise Missing("PyBullet is not installed (pip install pybullet)") from None
-    with _quiet():
+    with _quiet(), _located(build) as urdf:
         client = p.connect(p.DIRECT)
         try:
             # loaded free, so the base keeps its mass from the file (a fixed base is reported massless)
-            body = p.loadURDF(str(build.urdf), useFixedBase=False,
+            body = p.loadURDF(str(urdf), useFixedBase=False,
                               flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
         except p.error as exc:
             p.disconnect(client)
