@@ -41,6 +41,28 @@ def vec(values) -> str:
     return " ".join(fmt(v) for v in values)
 
 
+def each(items, line) -> str:
+    """``line``, a ``str.format`` pattern naming the item ``it`` (``{it.pos}``), for every item, joined.
+
+    For long lists (a world's 10^5 collision boxes): one ``str.format`` per item instead of a
+    Jinja loop's attribute lookup and escaping per value.  The values are escaped all the
+    same: when the text holds more markup characters than the pattern's own, it is made
+    again through markupsafe's escaping formatter.
+    """
+    import string
+
+    import markupsafe
+
+    items = list(items)
+    pattern = str(line)
+    text = "".join([pattern.format(it=it) for it in items])
+    own = "".join(literal for literal, *_ in string.Formatter().parse(pattern))
+    if any(text.count(c) != own.count(c) * len(items) for c in "<>&\"'"):
+        safe = markupsafe.Markup(pattern)
+        text = "".join([safe.format(it=it) for it in items])
+    return markupsafe.Markup(text)
+
+
 @functools.lru_cache(maxsize=8)
 def environment(extra: tuple[str, ...] = ()):
     import jinja2
@@ -56,6 +78,7 @@ def environment(extra: tuple[str, ...] = ()):
     )
     env.filters["fmt"] = fmt
     env.filters["vec"] = vec
+    env.filters["each"] = each
     env.filters["py"] = lambda v: markupsafe.Markup(repr(v))  # a Python literal, for launch/*.launch.py
     return env
 

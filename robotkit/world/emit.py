@@ -17,6 +17,7 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 from robotkit.errors import MapError, Problem
 
@@ -25,8 +26,7 @@ GROUND_MARGIN = 5.0  # metres of floor around the map
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 
 
-@dataclass(frozen=True)
-class Box:
+class Box(NamedTuple):
     """One collision box as the MJCF attributes read: three numbers each, as text."""
 
     pos: str
@@ -82,19 +82,13 @@ def world_context(name: str, occupancy_map, height: float, rects) -> WorldContex
     # 10^5 boxes and a few thousand distinct k).
     from robotkit.emit.env import fmt
 
-    text: dict[int, str] = {}
-
-    def num(k: int) -> str:
-        t = text.get(k)
-        if t is None:
-            t = text[k] = fmt(round(res * k / 2, 9) + 0.0)  # + 0.0: no -0
-        return t
-
+    x0, y0, x1, y1 = np.asarray(rects, dtype=np.int64).reshape(-1, 4).T
+    k = np.stack([x0 + x1, y0 + y1, x1 - x0, y1 - y0])
+    distinct, which = np.unique(k, return_inverse=True)
+    text = np.array([fmt(round(res * v / 2, 9) + 0.0) for v in distinct.tolist()], dtype=object)  # + 0.0: no -0
+    px, py, sx, sy = text[which.reshape(k.shape)].tolist()
     z = fmt(round(height / 2, 9) + 0.0)
-    boxes = tuple(
-        Box(pos=f"{num(x0 + x1)} {num(y0 + y1)} {z}", size=f"{num(x1 - x0)} {num(y1 - y0)} {z}")
-        for x0, y0, x1, y1 in rects.tolist()
-    )
+    boxes = tuple(map(Box, [f"{a} {b} {z}" for a, b in zip(px, py)], [f"{a} {b} {z}" for a, b in zip(sx, sy)]))
     stem = Path(om.yaml_path).name
     description = (f"Walls {_num(height)} m high from the occupancy map {stem} "
                    f"({om.cols} x {om.rows} cells of {_num(res)} m), built by robotkit.")
