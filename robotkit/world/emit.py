@@ -88,7 +88,8 @@ def world_context(name: str, occupancy_map, height: float, rects) -> WorldContex
     text = np.array([fmt(round(res * v / 2, 9) + 0.0) for v in distinct.tolist()], dtype=object)  # + 0.0: no -0
     px, py, sx, sy = text[which.reshape(k.shape)].tolist()
     z = fmt(round(height / 2, 9) + 0.0)
-    boxes = tuple(map(Box, [f"{a} {b} {z}" for a, b in zip(px, py)], [f"{a} {b} {z}" for a, b in zip(sx, sy)]))
+    boxes = tuple(map(Box._make, zip([f"{a} {b} {z}" for a, b in zip(px, py)],
+                                     [f"{a} {b} {z}" for a, b in zip(sx, sy)])))
     stem = Path(om.yaml_path).name
     description = (f"Walls {_num(height)} m high from the occupancy map {stem} "
                    f"({om.cols} x {om.rows} cells of {_num(res)} m), built by robotkit.")

