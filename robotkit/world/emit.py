@@ -128,10 +128,12 @@ def render_world(name: str, occupancy_map, height: float = 2.0, unknown_as_wall:
     from robotkit.world.walls import extrude, rectangles, to_map, wall_cells
 
     mask = wall_cells(occupancy_map, unknown_as_wall)
+    rects = rectangles(mask)
     vertices, faces = extrude(mask, height)  # as walls.mask_mesh, without importing trimesh (0.8 s)
+    del mask  # a whole-grid array: not kept while the files are made
     vertices[:, :2] = to_map(vertices[:, :2], occupancy_map.grid_to_map())
     mesh = SimpleNamespace(vertices=vertices, faces=faces)
-    w = world_context(name, occupancy_map, height, rectangles(mask))
+    w = world_context(name, occupancy_map, height, rects)
     return {
         "model.config": render("world/model.config.j2", w=w).encode("utf-8"),
         "model.sdf": render("world/model.sdf.j2", w=w).encode("utf-8"),

@@ -97,17 +97,17 @@ def rectangles(mask: np.ndarray) -> np.ndarray:
 
 
 class _Grid:
-    """The padded wall mask and what the outline needs from it.
+    """The wall mask and what the outline needs from it.
 
     Only the points where the outline turns are kept (as coordinate lists), not whole
     arrays per grid point: a 5000 x 5000 map has 25 million grid points and a few hundred
-    thousand turns.
+    thousand turns.  The padded copy of the mask is dropped once the turns are found.
     """
 
     def __init__(self, mask: np.ndarray):
         self.mask = mask
         self.rows, self.cols = mask.shape
-        self.g = g = _padded(mask)
+        g = _padded(mask)
         # The outline changes direction at a grid point (y, x) where one or three of the four
         # cells around it are walls, or at a pinch (two walls touching at a corner): where the
         # row below (y - 1) changes at x and the row above (y) does not, or the other way
@@ -131,7 +131,15 @@ class _Grid:
         self.turn_y, self.turn_x = np.divmod(keys, width)  # row-major order
         self._pinch_keys = point[1:][twice]  # sorted
         self.pinch_y, self.pinch_x = np.divmod(self._pinch_keys, width)
-        self._pinch_ne_sw = g[self.pinch_y, self.pinch_x] > 0  # the south-west cell; else the north-west / south-east pinch
+        # whether the south-west cell is a wall (else the north-west and south-east ones are)
+        self._pinch_ne_sw = self.cell(self.pinch_y - 1, self.pinch_x - 1) > 0
+
+    def cell(self, y: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """The mask at the cells (row y, column x) as int8, 0 outside the grid."""
+        inside = (y >= 0) & (y < self.rows) & (x >= 0) & (x < self.cols)
+        out = np.zeros(len(y), dtype=np.int8)
+        out[inside] = self.mask[y[inside], x[inside]]
+        return out
 
     def pinch_index(self, y: np.ndarray, x: np.ndarray, ne_sw: bool | None = None) -> np.ndarray:
         """The index of the pinch at each grid point (y, x) (of that kind, unless None), -1 where there is none."""
@@ -154,10 +162,10 @@ class _Grid:
         Returns ax, ay, bx, by, am, bm: am / bm is the pinch index when the wall face of this
         segment must split its vertical edge at A / B (see the module docstring), else -1.
         """
-        g = self.g
+        cell = self.cell
         same = py[1:] == py[:-1]
         j, xa, xb = py[:-1][same], px[:-1][same], px[1:][same]
-        kind = g[j, xa + 1] - g[j + 1, xa + 1]
+        kind = cell(j - 1, xa) - cell(j, xa)
         keep = kind != 0
         j, xa, xb, west = j[keep], xa[keep], xb[keep], kind[keep] > 0
         low = self.pinch_index(j, xa)  # a pinch at the segment's west end belongs to this segment's cell
@@ -167,7 +175,7 @@ class _Grid:
         vy, vx = py[order], px[order]
         same = vx[1:] == vx[:-1]
         i, ya, yb = vx[:-1][same], vy[:-1][same], vy[1:][same]
-        kind = g[ya + 1, i] - g[ya + 1, i + 1]
+        kind = cell(ya, i - 1) - cell(ya, i)
         keep = kind != 0
         i, ya, yb, north = i[keep], ya[keep], yb[keep], kind[keep] > 0
         low = self.pinch_index(ya, i, ne_sw=True)
@@ -482,9 +490,14 @@ def _closed(faces: np.ndarray, n_vertices: int) -> bool:
     One sort: each edge as (its smaller end, its larger end, whether it runs downwards); then
     the keys must come in pairs k, k + 1 (both directions of each edge, once each).
     """
-    e = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    lo, hi = np.minimum(e[:, 0], e[:, 1]), np.maximum(e[:, 0], e[:, 1])
-    key = (lo * n_vertices + hi) * 2 + (e[:, 0] > e[:, 1])
+    a = np.ascontiguousarray(faces, dtype=np.int64).ravel()
+    b = faces[:, [1, 2, 0]].astype(np.int64).ravel()  # edge a -> b
+    key = np.minimum(a, b)  # in place from here on: a big mesh has millions of edges
+    key *= n_vertices
+    key += np.maximum(a, b)
+    key *= 2
+    key += a > b
+    del b
     key.sort()
     return bool(len(key) % 2 == 0 and (key[0::2] % 2 == 0).all() and np.array_equal(key[0::2] + 1, key[1::2]))
 
