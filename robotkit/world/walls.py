@@ -250,8 +250,8 @@ def _outer_loops(grid: _Grid, seg, idx: np.ndarray, starts: np.ndarray, sizes: n
     Left of a hole's lowest point on its leftmost side is a wall cell; the run of wall cells
     through it starts at an outline edge of the same piece of wall (further left), on the
     outer loop or on another hole of that piece, which is then followed the same way
-    (pointer doubling; each step moves left, so it ends on the outer loop).  None when
-    there is no hole, or if something does not add up (then every loop goes in one group).
+    (pointer doubling; each step moves left, so it ends on the outer loop).  None if
+    something does not add up (then every loop goes in one group).
     """
     ax, ay, bx, by = seg[:4]
     n, n_loops = len(idx), len(sizes)
@@ -261,7 +261,7 @@ def _outer_loops(grid: _Grid, seg, idx: np.ndarray, starts: np.ndarray, sizes: n
     area = np.add.reduceat(px * py[nxt] - px[nxt] * py, starts)  # twice the signed area
     hole = np.flatnonzero(area < 0)
     if len(hole) == 0:
-        return None
+        return np.arange(n_loops)
     # the hole's lowest point on its leftmost side, and the wall run left of it
     height = grid.rows + 2
     low = np.minimum.reduceat(px * height + py, starts)[hole]
@@ -301,22 +301,24 @@ def _triangulate(manifold3d, polygons, starts, sizes, outer) -> np.ndarray:
     Its cost grows faster than the number of loops (0.49 s for the 6,691 loops of a
     5000 x 5000 map in one call), so each outer loop goes in a call of its own, with its
     holes: 0.1 s, and the same triangles (each piece of wall is triangulated the same way
-    alone).  Without ``outer`` (no hole, or holes not placed), one call.
+    alone).  Without ``outer`` (holes not placed), one call.
     """
     if outer is None:
         return np.asarray(manifold3d.triangulate(polygons), dtype=np.int64).reshape(-1, 3)
     loops = np.lexsort((np.arange(len(sizes)), outer != np.arange(len(sizes)), outer))  # outer loop first
     bounds = np.flatnonzero(np.diff(outer[loops])) + 1
-    parts = []
-    for group in np.split(loops, bounds):
-        if len(group) == 1:
-            k = int(group[0])
-            parts.append(np.asarray(manifold3d.triangulate([polygons[k]]), dtype=np.int64).reshape(-1, 3) + starts[k])
-        else:
-            point = np.concatenate([np.arange(starts[k], starts[k] + sizes[k]) for k in group])
-            local = manifold3d.triangulate([polygons[k] for k in group])
-            parts.append(point[np.asarray(local, dtype=np.int64).reshape(-1, 3)])
-    return np.concatenate(parts)
+    # the groups' points in call order (each group's loops one after the other), and each
+    # call's triangles, indexing its own points, shifted by where the group's points begin
+    size = sizes[loops]
+    begin = np.cumsum(size) - size  # where each loop's points begin in call order
+    point = np.arange(int(size.sum())) + np.repeat(starts[loops] - begin, size)
+    first = begin[np.r_[0, bounds]]
+    polys = [polygons[k] for k in loops.tolist()]
+    cut = np.r_[0, bounds, len(loops)].tolist()
+    parts = [manifold3d.triangulate(polys[a:b]) for a, b in zip(cut[:-1], cut[1:])]
+    counts = np.array([len(t) for t in parts], dtype=np.int64)
+    local = np.concatenate(parts).astype(np.int64).reshape(-1, 3) + np.repeat(first, counts)[:, None]
+    return point[local]
 
 
 def _cycles(succ: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
