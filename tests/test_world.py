@@ -641,3 +641,118 @@ def test_closed_check_of_the_wall_mesh():
     flipped = faces.copy()
     flipped[0] = flipped[0, ::-1]
     assert not _closed(flipped, len(box.vertices))  # one face the wrong way round
+
+
+def turns_by_the_grid(mask):
+    """The outline's turns from the four cells around every grid point: one or three walls, or
+    two walls touching at a corner (a pinch); with, for a pinch, whether the south-west cell is a wall."""
+    g = np.pad(mask, 1).astype(np.int64)
+    sw, se, nw, ne = g[:-1, :-1], g[:-1, 1:], g[1:, :-1], g[1:, 1:]
+    count = sw + se + nw + ne
+    pinch = (count == 2) & (sw == ne)
+    ty, tx = np.nonzero((count % 2 == 1) | pinch)
+    py, px = np.nonzero(pinch)
+    return ty, tx, py, px, sw[py, px] > 0
+
+
+def nested_mask():
+    """Walls in walls: a ring, an island ring in its hole, a block in the island's hole, two holes
+    in one piece, holes touching their wall at a corner, and pieces side by side."""
+    m = np.zeros((40, 60), dtype=bool)
+    m[2:38, 2:40] = True
+    m[5:35, 5:37] = False  # the big hole
+    m[8:30, 8:30] = True
+    m[11:27, 11:27] = False  # the island's hole
+    m[15:20, 15:20] = True  # a block in it
+    m[12, 12] = True  # touching the hole's wall at a corner
+    m[31:34, 31:34] = True  # in the big hole, beside the island
+    m[2:20, 44:58] = True
+    m[5:8, 47:50] = m[11:16, 47:55] = False  # one piece, two holes
+    m[8, 50] = True
+    m[24:38, 44:58] = True
+    m[27:29, 47:49] = False
+    m[29, 49] = False  # a hole cell touching the other by a corner: one hole or two
+    return m
+
+
+def masks_with_holes():
+    yield nested_mask()
+    yield rooms_map(60, 80)[::-1] == 0
+    rng = np.random.default_rng(11)
+    for _ in range(40):
+        rows, cols = rng.integers(3, 30, 2)
+        yield rng.random((rows, cols)) < rng.uniform(0.3, 0.8)
+
+
+def test_turns_come_from_the_row_changes_as_from_the_whole_grid():
+    from robotkit.world.walls import _Grid
+
+    for mask in [*random_masks(), *masks_with_holes()]:
+        grid = _Grid(mask)
+        ty, tx, py, px, ne_sw = turns_by_the_grid(mask)
+        np.testing.assert_array_equal(grid.turn_y, ty)
+        np.testing.assert_array_equal(grid.turn_x, tx)
+        np.testing.assert_array_equal(grid.pinch_y, py)
+        np.testing.assert_array_equal(grid.pinch_x, px)
+        np.testing.assert_array_equal(grid._pinch_ne_sw, ne_sw)
+
+
+def test_rectangles_from_the_row_and_column_changes_cover_the_mask_once():
+    for mask in [*random_masks(), *masks_with_holes()]:
+        rects = rectangles(mask)
+        cover = np.zeros(mask.shape, dtype=np.int64)
+        for x0, y0, x1, y1 in rects:
+            cover[y0:y1, x0:x1] += 1
+        np.testing.assert_array_equal(cover, mask.astype(np.int64))
+
+
+def test_each_hole_is_triangulated_with_the_outer_loop_of_its_piece_of_wall():
+    """Every loop's outer loop bounds the same 4-connected piece of wall (scipy's labels), and
+    the triangles are those of one call on all the loops, only in another order."""
+    import manifold3d
+    from scipy import ndimage
+
+    from robotkit.world.walls import _cycles, _Grid, _outer_loops, _outline_caps, _triangulate
+
+    def canonical(tris):
+        return sorted(tuple(np.roll(t, -int(np.argmin(t)))) for t in tris.tolist())
+
+    n_holes = 0
+    for mask in masks_with_holes():
+        grid = _Grid(mask)
+        seg = grid.outline(grid.turn_y, grid.turn_x)
+        caps = _outline_caps(grid, seg)
+        assert caps is not None, "the outline path was taken, not the rectangles fallback"
+        ax, ay, bx, by = seg[:4]
+        # rebuild the loops as _outline_caps does
+        width = grid.cols + 1
+        dx, dy = np.sign(bx - ax), np.sign(by - ay)
+        code = np.where(dx > 0, 0, np.where(dy > 0, 1, np.where(dx < 0, 2, 3)))
+        key = (ay * width + ax) * 4 + code
+        lookup = {k: i for i, k in enumerate(key.tolist())}
+        end = (by * width + bx) * 4
+        succ = np.array([lookup.get(e + (c + 1) % 4, lookup.get(e + (c + 3) % 4)) for e, c in zip(end, code)])
+        idx, sizes = _cycles(succ)
+        starts = np.cumsum(sizes) - sizes
+        outer = _outer_loops(grid, seg, idx, starts, sizes)
+        assert outer is not None
+        # the wall cell on the left of each loop's first segment, and its piece of wall
+        s = idx[starts]
+        sdx, sdy = np.sign(bx[s] - ax[s]), np.sign(by[s] - ay[s])
+        cx = np.where(sdx > 0, ax[s], np.where(sdy > 0, ax[s] - 1, np.where(sdx < 0, ax[s] - 1, ax[s])))
+        cy = np.where(sdx > 0, ay[s], np.where(sdy > 0, ay[s], ay[s] - 1))
+        assert mask[cy, cx].all()
+        piece = ndimage.label(mask)[0][cy, cx]
+        np.testing.assert_array_equal(piece[outer], piece)
+        px, py = ax[idx], ay[idx]
+        nxt = np.arange(1, len(idx) + 1)
+        nxt[starts + sizes - 1] = starts
+        area = np.add.reduceat(px * py[nxt] - px[nxt] * py, starts)
+        assert (area[outer] > 0).all()
+        assert len(np.unique(outer)) == (area > 0).sum() == ndimage.label(mask)[1]
+        n_holes += int((area < 0).sum())
+        polygons = np.split(np.column_stack([px, py]).astype(np.float64), starts[1:])
+        grouped = _triangulate(manifold3d, polygons, starts, sizes, outer)
+        whole = _triangulate(manifold3d, polygons, starts, sizes, None)
+        assert canonical(grouped) == canonical(whole)
+    assert n_holes > 50
