@@ -756,3 +756,21 @@ def test_each_hole_is_triangulated_with_the_outer_loop_of_its_piece_of_wall():
         whole = _triangulate(manifold3d, polygons, starts, sizes, None)
         assert canonical(grouped) == canonical(whole)
     assert n_holes > 50
+
+
+def test_each_filter_writes_what_a_jinja_loop_writes_and_escapes_values():
+    """The scene's boxes go through the ``each`` filter; its text is the Jinja loop's, escapes included."""
+    from robotkit.emit.env import environment
+    from robotkit.world.emit import Box
+
+    env = environment()
+    loop = env.from_string('{% for b in boxes %}  <geom pos="{{ b.pos }}" size="{{ b.size }}"/>\n{% endfor %}')
+    fast = env.from_string('{% set line %}  <geom pos="{it.pos}" size="{it.size}"/>\n{% endset %}'
+                           '{{ boxes | each(line) }}')
+    plain = [Box(f"{i} {i / 7} 1", f"0.5 {i} 1") for i in range(500)]
+    hostile = plain + [Box('1 "2" 3', "<a> & 'b'")]
+    for boxes in (plain, hostile, []):
+        assert fast.render(boxes=boxes) == loop.render(boxes=boxes)
+    assert "&lt;a&gt; &amp; &#39;b&#39;" in fast.render(boxes=hostile)
+    plain_fields = env.from_string('{% set line %}{it}:{it!r};{% endset %}{{ xs | each(line) }}')
+    assert plain_fields.render(xs=[1, "<"]) == "1:1;&lt;:&#39;&lt;&#39;;"
