@@ -774,3 +774,27 @@ def test_each_filter_writes_what_a_jinja_loop_writes_and_escapes_values():
     assert "&lt;a&gt; &amp; &#39;b&#39;" in fast.render(boxes=hostile)
     plain_fields = env.from_string('{% set line %}{it}:{it!r};{% endset %}{{ xs | each(line) }}')
     assert plain_fields.render(xs=[1, "<"]) == "1:1;&lt;:&#39;&lt;&#39;;"
+
+
+def test_grey_images_read_from_the_file_as_pillow_decodes_them(tmp_path):
+    """Binary PGMs are read straight from the file at the header's offset; every other layout
+    (bottom-up BMP, TIFF, ASCII PGM, maxval other than 255) is left to Pillow: same grid each way."""
+    rng = np.random.default_rng(5)
+    pixels = rng.choice(np.array([0, 100, 205, 254, 255], dtype=np.uint8), size=(23, 37))
+    reference = load_map(write_map(tmp_path, pixels, name="ref", image="ref.png")).grid
+    header = b"P5\n# a comment, as map_saver writes\n37 23\n255\n"
+    handmade = {"comment.pgm": header + pixels.tobytes(), "trailing.pgm": header + pixels.tobytes() + b"\n\0\0",
+                "ascii.pgm": b"P2\n37 23\n255\n" + " ".join(map(str, pixels.ravel())).encode() + b"\n"}
+    for image, data in handmade.items():
+        (tmp_path / image).write_bytes(data)
+    for image in ("pillow.pgm", "grey.bmp", "grey.tif"):
+        Image.fromarray(pixels).save(tmp_path / image)
+    for image in [*handmade, "pillow.pgm", "grey.bmp", "grey.tif"]:
+        om = load_map(write_map(tmp_path, None, name=image.replace(".", "_"), image=image))
+        np.testing.assert_array_equal(om.grid, reference, err_msg=image)
+    # maxval 100: Pillow scales the values to 0..255, so it is not read as raw bytes
+    (tmp_path / "max100.pgm").write_bytes(b"P5\n37 23\n100\n" + (pixels // 3).tobytes())
+    scaled = load_map(write_map(tmp_path, None, name="max100", image="max100.pgm")).grid
+    expected = load_map(write_map(tmp_path, np.asarray(Image.open(tmp_path / "max100.pgm")), name="m100",
+                                  image="m100.png")).grid
+    np.testing.assert_array_equal(scaled, expected)

@@ -326,11 +326,12 @@ def _read_image(path: Path, name: str, bad) -> tuple[np.ndarray, np.ndarray | No
                 bad(f"'{name}' is {size[0]} x {size[1]} pixels, more than robotkit reads "
                     f"({MAX_CELLS:,} pixels; crop or downsample the map)")
                 return None
-            im.load()
-            mode = im.mode
-            if mode == "L":  # 8-bit grey, nearly every map: the bytes as they are (classify's table)
+            colours, alpha, mode = _raw_grey(im, path), None, ""  # a binary PGM: nearly every map
+            if colours is None:
+                im.load()
+                mode = im.mode
+            if mode == "L":  # other 8-bit grey images: the bytes as they are (classify's table)
                 colours = np.asarray(im)[..., None]
-                alpha = None
                 mode = ""
             if mode in ("1", "P", "PA", "CMYK", "YCbCr", "LAB", "HSV", "La", "RGBa", "RGBX"):
                 has_alpha = mode in ("PA", "La", "RGBa") or "transparency" in im.info
@@ -369,6 +370,26 @@ def _read_image(path: Path, name: str, bad) -> tuple[np.ndarray, np.ndarray | No
     return colours, alpha
 
 
+def _raw_grey(im, path: Path) -> np.ndarray | None:
+    """The pixels of an uncompressed 8-bit grey image (a binary PGM: nearly every map) as
+    (rows, cols, 1) uint8, read straight from the file at the offset Pillow's header parser
+    found; None for any other image, or a file shorter than its header says (Pillow then
+    decodes it and reports what is wrong).
+
+    Pillow would map the file and copy it into a ``bytes`` for numpy; one read into a numpy
+    array is twice as fast on a 5000 x 5000 map and costs 30 times fewer page faults.
+    """
+    if im.mode != "L" or len(im.tile) != 1:
+        return None
+    codec, extents, offset, args = tuple(im.tile[0])[:4]
+    rawmode, layout = (args, ()) if isinstance(args, str) else (args[0] if args else None, tuple(args[1:]))
+    cols, rows = im.size
+    if codec != "raw" or tuple(extents) != (0, 0, cols, rows) or rawmode != "L" or layout not in ((), (0,), (0, 1)):
+        return None
+    data = np.fromfile(path, dtype=np.uint8, count=rows * cols, offset=offset)
+    return data.reshape(rows, cols, 1) if data.size == rows * cols else None
+
+
 def _open_header(Image, path: Path):
     """``Image.open`` (which reads the header only) without Pillow's decompression-bomb check:
     the size is checked against :data:`MAX_CELLS` before decoding, into one clean problem."""
@@ -401,18 +422,14 @@ def classify(pixels, *, mode: str, negate: bool, occupied_thresh: float, free_th
 
     8-bit single-channel pixels without alpha (``uint8``) go through a table of the 256
     values, made by this same function on the 256 shades as floats: the same result, one
-    byte per cell instead of several float64 arrays.  Pillow's ``Image.point`` applies the
-    table (twice as fast as numpy's indexing on a 5000 x 5000 map); that grid is read-only.
+    byte per cell instead of several float64 arrays.
     """
     colours, alpha = pixels
     if colours.dtype == np.uint8 and colours.shape[-1] == 1 and alpha is None:
-        from PIL import Image
-
         shades = (np.arange(256, dtype=np.float64) / 255.0).reshape(256, 1, 1)
         table = classify((shades, None), mode=mode, negate=negate, occupied_thresh=occupied_thresh,
                          free_thresh=free_thresh).reshape(256)
-        grey = Image.fromarray(np.ascontiguousarray(colours[..., 0]))
-        return np.asarray(grey.point(table.view(np.uint8).tolist())).view(np.int8)
+        return table[colours[..., 0]]
     channels = colours.shape[-1]
     rgb_mean = colours.mean(axis=-1) if channels > 1 else colours[..., 0]
     if mode == "raw":
