@@ -125,12 +125,13 @@ def render_world(name: str, occupancy_map, height: float = 2.0, unknown_as_wall:
 
     from robotkit.emit.env import render
     from robotkit.mesh.export import stl_bytes
-    from robotkit.world.walls import extrude, rectangles, to_map, wall_cells
+    from robotkit.world.walls import extrude, padded_wall_cells, rectangles, to_map
 
-    mask = wall_cells(occupancy_map, unknown_as_wall)
-    rects = rectangles(mask)
-    vertices, faces = extrude(mask, height)  # as walls.mask_mesh, without importing trimesh (0.8 s)
-    del mask  # a whole-grid array: not kept while the files are made
+    padded = padded_wall_cells(occupancy_map, unknown_as_wall)
+    mask = padded[1:-1, 1:-1]
+    rects = rectangles(mask, padded=padded)
+    vertices, faces = extrude(mask, height, padded=padded)  # as walls.mask_mesh, without trimesh (0.8 s)
+    del mask, padded  # the whole grid: not kept while the files are made
     vertices[:, :2] = to_map(vertices[:, :2], occupancy_map.grid_to_map())
     mesh = SimpleNamespace(vertices=vertices, faces=faces)
     w = world_context(name, occupancy_map, height, rects)

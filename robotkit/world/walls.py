@@ -37,9 +37,9 @@ def grid_mask(walls_image: np.ndarray) -> np.ndarray:
 
 
 def _padded(mask: np.ndarray) -> np.ndarray:
-    """``mask`` as int8 with a ring of zeros around it: shape (rows + 2, cols + 2)."""
+    """``mask`` with a ring of False around it: shape (rows + 2, cols + 2), ``mask`` is its [1:-1, 1:-1]."""
     rows, cols = mask.shape
-    g = np.zeros((rows + 2, cols + 2), dtype=np.int8)
+    g = np.zeros((rows + 2, cols + 2), dtype=bool)
     g[1:-1, 1:-1] = mask
     return g
 
@@ -83,13 +83,14 @@ def _runs_merged(line: np.ndarray, pos: np.ndarray) -> np.ndarray:
     return np.stack([xs[first], ys[first], xe[first], ys[last] + 1], axis=1).astype(np.int64)
 
 
-def rectangles(mask: np.ndarray) -> np.ndarray:
+def rectangles(mask: np.ndarray, *, padded: np.ndarray | None = None) -> np.ndarray:
     """Disjoint rectangles covering the True cells of a grid-order ``mask`` exactly.
 
     Returns an int64 array (n, 4) of [x0, y0, x1, y1] (cells x0 <= x < x1, y0 <= y < y1),
-    sorted by y0 then x0.
+    sorted by y0 then x0.  ``padded``: the mask with a ring of False around it, when the
+    caller has it (:func:`padded_wall_cells`), saves a copy of the whole grid.
     """
-    g = _padded(mask)
+    g = _padded(mask) if padded is None else padded
     by_rows = _runs_merged(*_row_transitions(g)[:2])
     by_cols = _runs_merged(*_column_transitions(g)[:2])[:, [1, 0, 3, 2]]
     rects = by_rows if len(by_rows) <= len(by_cols) else by_cols
@@ -104,10 +105,10 @@ class _Grid:
     thousand turns.  The padded copy of the mask is dropped once the turns are found.
     """
 
-    def __init__(self, mask: np.ndarray):
+    def __init__(self, mask: np.ndarray, padded: np.ndarray | None = None):
         self.mask = mask
         self.rows, self.cols = mask.shape
-        g = _padded(mask)
+        g = _padded(mask) if padded is None else padded
         # The outline changes direction at a grid point (y, x) where one or three of the four
         # cells around it are walls, or at a pinch (two walls touching at a corner): where the
         # row below (y - 1) changes at x and the row above (y) does not, or the other way
@@ -504,18 +505,18 @@ def _closed(faces: np.ndarray, n_vertices: int) -> bool:
     return bool(len(key) % 2 == 0 and (key[0::2] % 2 == 0).all() and np.array_equal(key[0::2] + 1, key[1::2]))
 
 
-def extrude(mask: np.ndarray, height: float, method: str = "outline"):
+def extrude(mask: np.ndarray, height: float, method: str = "outline", *, padded: np.ndarray | None = None):
     """Closed wall mesh of a grid-order ``mask``, in grid coordinates (z in metres).
 
     ``method`` "outline" triangulates the top and bottom inside the outline (fewest
     faces), falling back to "rectangles" if that fails its checks; "rectangles" builds
     them from :func:`rectangles`.  Returns (vertices (n, 3) float64, faces (m, 3) int64);
-    x and y are in cells.
+    x and y are in cells.  ``padded`` as for :func:`rectangles`.
     """
     if method not in ("outline", "rectangles"):
         raise ValueError(f"unknown method {method!r} (outline or rectangles)")
     mask = np.asarray(mask, dtype=bool)
-    grid = _Grid(mask)
+    grid = _Grid(mask, padded)
     z = float(height)
     width = grid.cols + 1
     area = int(mask.sum())
@@ -529,7 +530,7 @@ def extrude(mask: np.ndarray, height: float, method: str = "outline"):
             cx, cy, cap = caps
             centres = np.zeros((0, 2))
         else:
-            corner, cx, cy, cap, centres = _rectangle_caps(grid, rectangles(mask))
+            corner, cx, cy, cap, centres = _rectangle_caps(grid, rectangles(mask, padded=padded))
             breaks = np.union1d(cy * width + cx, grid.turn_y * width + grid.turn_x)  # sorted: row-major
             seg = grid.outline(*np.divmod(breaks, width))
         ax, ay, bx, by, am, bm = seg
@@ -566,6 +567,17 @@ def extrude(mask: np.ndarray, height: float, method: str = "outline"):
 
 def wall_cells(occupancy_map, unknown_as_wall: bool = False) -> np.ndarray:
     """Grid-order mask of the cells that become walls; MapError when there is none."""
+    return grid_mask(_walls_image(occupancy_map, unknown_as_wall))
+
+
+def padded_wall_cells(occupancy_map, unknown_as_wall: bool = False) -> np.ndarray:
+    """:func:`wall_cells` with a ring of False around it, made in one copy: shape (rows + 2,
+    cols + 2), the mask is its [1:-1, 1:-1] (for ``padded`` of :func:`extrude` and :func:`rectangles`)."""
+    return _padded(_walls_image(occupancy_map, unknown_as_wall)[::-1])
+
+
+def _walls_image(occupancy_map, unknown_as_wall: bool) -> np.ndarray:
+    """The image-order mask of wall cells; MapError when there is none."""
     from robotkit.errors import MapError
 
     walls = occupancy_map.walls(unknown_as_wall)
@@ -578,7 +590,7 @@ def wall_cells(occupancy_map, unknown_as_wall: bool = False) -> np.ndarray:
             detail = (f"no occupied cell in '{om.image_name}' ({size}: {int(om.free.sum())} free, "
                       f"{int(om.unknown.sum())} unknown)")
         raise MapError(om.problem(f"{detail}, so there is no wall to build"))
-    return grid_mask(walls)
+    return walls
 
 
 def check_height(height) -> float:
