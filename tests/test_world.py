@@ -798,3 +798,17 @@ def test_grey_images_read_from_the_file_as_pillow_decodes_them(tmp_path):
     expected = load_map(write_map(tmp_path, np.asarray(Image.open(tmp_path / "max100.pgm")), name="m100",
                                   image="m100.png")).grid
     np.testing.assert_array_equal(scaled, expected)
+
+
+def test_the_padded_wall_cells_give_the_same_mesh_and_rectangles(tmp_path):
+    from robotkit.world.walls import padded_wall_cells
+
+    om = load_map(write_map(tmp_path, rooms_map(50, 70), origin="[1.0, 2.0, 0.4]"))
+    for unknown in (False, True):
+        mask = wall_cells(om, unknown)
+        padded = padded_wall_cells(om, unknown)
+        assert padded.shape == (om.rows + 2, om.cols + 2) and not padded[[0, -1]].any() and not padded[:, [0, -1]].any()
+        np.testing.assert_array_equal(padded[1:-1, 1:-1], mask)
+        np.testing.assert_array_equal(rectangles(padded[1:-1, 1:-1], padded=padded), rectangles(mask))
+        for got, want in zip(extrude(padded[1:-1, 1:-1], 2.0, padded=padded), extrude(mask, 2.0)):
+            np.testing.assert_array_equal(got, want)
