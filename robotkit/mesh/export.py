@@ -33,8 +33,9 @@ def stl_bytes(mesh) -> bytes:
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     norm = np.linalg.norm(n, axis=1)
     ok = norm > 0
-    n[ok] /= norm[ok, None]
-    n[~ok] = 0.0
+    n /= np.where(ok, norm, 1.0)[:, None]  # whole rows, not a masked copy
+    if not ok.all():
+        n[~ok] = 0.0
     # the file is filled in place and copied once (a big world mesh has 10^5 triangles)
     out = np.zeros(84 + 50 * len(F), dtype=np.uint8)
     out[:80] = np.frombuffer(STL_HEADER, dtype=np.uint8)
