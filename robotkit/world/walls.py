@@ -8,8 +8,9 @@ into the map frame (resolution, origin and yaw), so every step is exact:
    between a wall cell and a non-wall cell, merged into straight segments, each extruded
    into a quad that faces away from the wall.
 2. The top and bottom are the region inside the outline loops, triangulated by
-   manifold3d's polygon triangulator (which keeps every outline edge), with any flat
-   triangle it returns removed by an edge flip.  The result is checked (every cap
+   manifold3d's polygon triangulator (which keeps every outline edge), one piece of wall
+   (an outer loop and its holes) at a time, with any flat triangle it returns removed by
+   an edge flip.  The result is checked (every cap
    triangle faces up, the caps add up to the wall area, every edge has exactly two
    faces); should a check fail, the caps are built from rectangles instead: the wall
    cells merged into rectangles (:func:`rectangles`), each triangulated through every
@@ -102,7 +103,7 @@ class _Grid:
 
     Only the points where the outline turns are kept (as coordinate lists), not whole
     arrays per grid point: a 5000 x 5000 map has 25 million grid points and a few hundred
-    thousand turns.  The padded copy of the mask is dropped once the turns are found.
+    thousand turns.  The padded mask is only read while the turns are found.
     """
 
     def __init__(self, mask: np.ndarray, padded: np.ndarray | None = None):
