@@ -234,7 +234,7 @@ def _outline_caps(grid: _Grid, seg):
     pts = np.empty((n, 2), dtype=np.float64)
     pts[:, 0], pts[:, 1] = px, py
     starts = np.cumsum(sizes) - sizes
-    polygons = np.split(pts, starts[1:])
+    polygons = [pts[a:b] for a, b in zip(starts.tolist(), (starts + sizes).tolist())]  # np.split: 3x slower
     outer = _outer_loops(grid, seg, idx, starts, sizes)
     try:
         tris = _triangulate(manifold3d, polygons, starts, sizes, outer)
