@@ -812,3 +812,17 @@ def test_the_padded_wall_cells_give_the_same_mesh_and_rectangles(tmp_path):
         np.testing.assert_array_equal(rectangles(padded[1:-1, 1:-1], padded=padded), rectangles(mask))
         for got, want in zip(extrude(padded[1:-1, 1:-1], 2.0, padded=padded), extrude(mask, 2.0)):
             np.testing.assert_array_equal(got, want)
+
+
+def test_a_piece_of_wall_with_too_many_holes_gets_rectangle_caps(monkeypatch):
+    """manifold3d's time grows with holes x points in one piece: past MAX_HOLE_WORK the caps come
+    from rectangles (exact too, linear); below it, from the outline (fewer faces)."""
+    from robotkit.world import walls
+
+    mask = nested_mask()
+    outline = extrude(mask, 1.0)
+    by_rectangles = extrude(mask, 1.0, method="rectangles")
+    assert len(outline[1]) < len(by_rectangles[1])
+    monkeypatch.setattr(walls, "MAX_HOLE_WORK", 100)
+    for got, want in zip(extrude(mask, 1.0), by_rectangles):
+        np.testing.assert_array_equal(got, want)
