@@ -706,55 +706,49 @@ def test_rectangles_from_the_row_and_column_changes_cover_the_mask_once():
         np.testing.assert_array_equal(cover, mask.astype(np.int64))
 
 
-def test_each_hole_is_triangulated_with_the_outer_loop_of_its_piece_of_wall():
+def test_each_hole_is_triangulated_with_the_outer_loop_of_its_piece_of_wall(monkeypatch):
     """Every loop's outer loop bounds the same 4-connected piece of wall (scipy's labels), and
     the triangles are those of one call on all the loops, only in another order."""
     import manifold3d
     from scipy import ndimage
 
-    from robotkit.world.walls import _cycles, _Grid, _outer_loops, _outline_caps, _triangulate
+    from robotkit.world import walls
 
     def canonical(tris):
         return sorted(tuple(np.roll(t, -int(np.argmin(t)))) for t in tris.tolist())
 
+    calls = []
+    triangulate = walls._triangulate
+
+    def spy(*args):
+        calls.append(args[1:])
+        return triangulate(*args)
+
+    monkeypatch.setattr(walls, "_triangulate", spy)
     n_holes = 0
     for mask in masks_with_holes():
-        grid = _Grid(mask)
-        seg = grid.outline(grid.turn_y, grid.turn_x)
-        caps = _outline_caps(grid, seg)
-        assert caps is not None, "the outline path was taken, not the rectangles fallback"
-        ax, ay, bx, by = seg[:4]
-        # rebuild the loops as _outline_caps does
-        width = grid.cols + 1
-        dx, dy = np.sign(bx - ax), np.sign(by - ay)
-        code = np.where(dx > 0, 0, np.where(dy > 0, 1, np.where(dx < 0, 2, 3)))
-        key = (ay * width + ax) * 4 + code
-        lookup = {k: i for i, k in enumerate(key.tolist())}
-        end = (by * width + bx) * 4
-        succ = np.array([lookup.get(e + (c + 1) % 4, lookup.get(e + (c + 3) % 4)) for e, c in zip(end, code)])
-        idx, sizes = _cycles(succ)
-        starts = np.cumsum(sizes) - sizes
-        outer = _outer_loops(grid, seg, idx, starts, sizes)
+        calls.clear()
+        grid = walls._Grid(mask)
+        assert walls._outline_caps(grid, grid.outline(grid.turn_y, grid.turn_x)) is not None, \
+            "the outline path was taken, not the rectangles fallback"
+        (polygons, starts, sizes, outer), = calls
         assert outer is not None
-        # the wall cell on the left of each loop's first segment, and its piece of wall
-        s = idx[starts]
-        sdx, sdy = np.sign(bx[s] - ax[s]), np.sign(by[s] - ay[s])
-        cx = np.where(sdx > 0, ax[s], np.where(sdy > 0, ax[s] - 1, np.where(sdx < 0, ax[s] - 1, ax[s])))
-        cy = np.where(sdx > 0, ay[s], np.where(sdy > 0, ay[s], ay[s] - 1))
+        # each loop's first edge a -> b has the wall on its left: that cell's piece of wall
+        a = np.array([p[0] for p in polygons], dtype=np.int64)
+        b = np.array([p[1] for p in polygons], dtype=np.int64)
+        d = np.sign(b - a)
+        cx = np.where((d[:, 0] > 0) | (d[:, 1] < 0), a[:, 0], a[:, 0] - 1)
+        cy = np.where((d[:, 0] > 0) | (d[:, 1] > 0), a[:, 1], a[:, 1] - 1)
         assert mask[cy, cx].all()
-        piece = ndimage.label(mask)[0][cy, cx]
+        labels, n_pieces = ndimage.label(mask)
+        piece = labels[cy, cx]
         np.testing.assert_array_equal(piece[outer], piece)
-        px, py = ax[idx], ay[idx]
-        nxt = np.arange(1, len(idx) + 1)
-        nxt[starts + sizes - 1] = starts
-        area = np.add.reduceat(px * py[nxt] - px[nxt] * py, starts)
+        area = np.array([np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]) for p in polygons])
         assert (area[outer] > 0).all()
-        assert len(np.unique(outer)) == (area > 0).sum() == ndimage.label(mask)[1]
+        assert len(np.unique(outer)) == (area > 0).sum() == n_pieces
         n_holes += int((area < 0).sum())
-        polygons = np.split(np.column_stack([px, py]).astype(np.float64), starts[1:])
-        grouped = _triangulate(manifold3d, polygons, starts, sizes, outer)
-        whole = _triangulate(manifold3d, polygons, starts, sizes, None)
-        assert canonical(grouped) == canonical(whole)
+        whole = triangulate(manifold3d, polygons, starts, sizes, None)
+        assert canonical(triangulate(manifold3d, polygons, starts, sizes, outer)) == canonical(whole)
     assert n_holes > 50
 
 
