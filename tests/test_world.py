@@ -641,3 +641,182 @@ def test_closed_check_of_the_wall_mesh():
     flipped = faces.copy()
     flipped[0] = flipped[0, ::-1]
     assert not _closed(flipped, len(box.vertices))  # one face the wrong way round
+
+
+def turns_by_the_grid(mask):
+    """The outline's turns from the four cells around every grid point: one or three walls, or
+    two walls touching at a corner (a pinch); with, for a pinch, whether the south-west cell is a wall."""
+    g = np.pad(mask, 1).astype(np.int64)
+    sw, se, nw, ne = g[:-1, :-1], g[:-1, 1:], g[1:, :-1], g[1:, 1:]
+    count = sw + se + nw + ne
+    pinch = (count == 2) & (sw == ne)
+    ty, tx = np.nonzero((count % 2 == 1) | pinch)
+    py, px = np.nonzero(pinch)
+    return ty, tx, py, px, sw[py, px] > 0
+
+
+def nested_mask():
+    """Walls in walls: a ring, an island ring in its hole, a block in the island's hole, two holes
+    in one piece, holes touching their wall at a corner, and pieces side by side."""
+    m = np.zeros((40, 60), dtype=bool)
+    m[2:38, 2:40] = True
+    m[5:35, 5:37] = False  # the big hole
+    m[8:30, 8:30] = True
+    m[11:27, 11:27] = False  # the island's hole
+    m[15:20, 15:20] = True  # a block in it
+    m[12, 12] = True  # touching the hole's wall at a corner
+    m[31:34, 31:34] = True  # in the big hole, beside the island
+    m[2:20, 44:58] = True
+    m[5:8, 47:50] = m[11:16, 47:55] = False  # one piece, two holes
+    m[8, 50] = True
+    m[24:38, 44:58] = True
+    m[27:29, 47:49] = False
+    m[29, 49] = False  # a hole cell touching the other by a corner: one hole or two
+    return m
+
+
+def masks_with_holes():
+    yield nested_mask()
+    yield rooms_map(60, 80)[::-1] == 0
+    rng = np.random.default_rng(11)
+    for _ in range(40):
+        rows, cols = rng.integers(3, 30, 2)
+        yield rng.random((rows, cols)) < rng.uniform(0.3, 0.8)
+
+
+def test_turns_come_from_the_row_changes_as_from_the_whole_grid():
+    from robotkit.world.walls import _Grid
+
+    for mask in [*random_masks(), *masks_with_holes()]:
+        grid = _Grid(mask)
+        ty, tx, py, px, ne_sw = turns_by_the_grid(mask)
+        np.testing.assert_array_equal(grid.turn_y, ty)
+        np.testing.assert_array_equal(grid.turn_x, tx)
+        np.testing.assert_array_equal(grid.pinch_y, py)
+        np.testing.assert_array_equal(grid.pinch_x, px)
+        np.testing.assert_array_equal(grid._pinch_ne_sw, ne_sw)
+
+
+def test_rectangles_from_the_row_and_column_changes_cover_the_mask_once():
+    for mask in [*random_masks(), *masks_with_holes()]:
+        rects = rectangles(mask)
+        cover = np.zeros(mask.shape, dtype=np.int64)
+        for x0, y0, x1, y1 in rects:
+            cover[y0:y1, x0:x1] += 1
+        np.testing.assert_array_equal(cover, mask.astype(np.int64))
+
+
+def test_each_hole_is_triangulated_with_the_outer_loop_of_its_piece_of_wall(monkeypatch):
+    """Every loop's outer loop bounds the same 4-connected piece of wall (scipy's labels), and
+    the triangles are those of one call on all the loops, only in another order."""
+    import manifold3d
+    from scipy import ndimage
+
+    from robotkit.world import walls
+
+    def canonical(tris):
+        return sorted(tuple(np.roll(t, -int(np.argmin(t)))) for t in tris.tolist())
+
+    calls = []
+    triangulate = walls._triangulate
+
+    def spy(*args):
+        calls.append(args[1:])
+        return triangulate(*args)
+
+    monkeypatch.setattr(walls, "_triangulate", spy)
+    n_holes = 0
+    for mask in masks_with_holes():
+        calls.clear()
+        grid = walls._Grid(mask)
+        assert walls._outline_caps(grid, grid.outline(grid.turn_y, grid.turn_x)) is not None, \
+            "the outline path was taken, not the rectangles fallback"
+        (polygons, starts, sizes, outer), = calls
+        assert outer is not None
+        # each loop's first edge a -> b has the wall on its left: that cell's piece of wall
+        a = np.array([p[0] for p in polygons], dtype=np.int64)
+        b = np.array([p[1] for p in polygons], dtype=np.int64)
+        d = np.sign(b - a)
+        cx = np.where((d[:, 0] > 0) | (d[:, 1] < 0), a[:, 0], a[:, 0] - 1)
+        cy = np.where((d[:, 0] > 0) | (d[:, 1] > 0), a[:, 1], a[:, 1] - 1)
+        assert mask[cy, cx].all()
+        labels, n_pieces = ndimage.label(mask)
+        piece = labels[cy, cx]
+        np.testing.assert_array_equal(piece[outer], piece)
+        area = np.array([np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]) for p in polygons])
+        assert (area[outer] > 0).all()
+        assert len(np.unique(outer)) == (area > 0).sum() == n_pieces
+        n_holes += int((area < 0).sum())
+        whole = triangulate(manifold3d, polygons, starts, sizes, None)
+        assert canonical(triangulate(manifold3d, polygons, starts, sizes, outer)) == canonical(whole)
+    assert n_holes > 50
+
+
+def test_each_filter_writes_what_a_jinja_loop_writes_and_escapes_values():
+    """The scene's boxes go through the ``each`` filter; its text is the Jinja loop's, escapes included."""
+    from robotkit.emit.env import environment
+    from robotkit.world.emit import Box
+
+    env = environment()
+    loop = env.from_string('{% for b in boxes %}  <geom pos="{{ b.pos }}" size="{{ b.size }}"/>\n{% endfor %}')
+    fast = env.from_string('{% set line %}  <geom pos="{it.pos}" size="{it.size}"/>\n{% endset %}'
+                           '{{ boxes | each(line) }}')
+    plain = [Box(f"{i} {i / 7} 1", f"0.5 {i} 1") for i in range(500)]
+    hostile = plain + [Box('1 "2" 3', "<a> & 'b'")]
+    for boxes in (plain, hostile, []):
+        assert fast.render(boxes=boxes) == loop.render(boxes=boxes)
+    assert "&lt;a&gt; &amp; &#39;b&#39;" in fast.render(boxes=hostile)
+    plain_fields = env.from_string('{% set line %}{it}:{it!r};{% endset %}{{ xs | each(line) }}')
+    assert plain_fields.render(xs=[1, "<"]) == "1:1;&lt;:&#39;&lt;&#39;;"
+
+
+def test_grey_images_read_from_the_file_as_pillow_decodes_them(tmp_path):
+    """Binary PGMs are read straight from the file at the header's offset; every other layout
+    (bottom-up BMP, TIFF, ASCII PGM, maxval other than 255) is left to Pillow: same grid each way."""
+    rng = np.random.default_rng(5)
+    pixels = rng.choice(np.array([0, 100, 205, 254, 255], dtype=np.uint8), size=(23, 37))
+    reference = load_map(write_map(tmp_path, pixels, name="ref", image="ref.png")).grid
+    header = b"P5\n# a comment, as map_saver writes\n37 23\n255\n"
+    handmade = {"comment.pgm": header + pixels.tobytes(), "trailing.pgm": header + pixels.tobytes() + b"\n\0\0",
+                "ascii.pgm": b"P2\n37 23\n255\n" + " ".join(map(str, pixels.ravel())).encode() + b"\n"}
+    for image, data in handmade.items():
+        (tmp_path / image).write_bytes(data)
+    for image in ("pillow.pgm", "grey.bmp", "grey.tif"):
+        Image.fromarray(pixels).save(tmp_path / image)
+    for image in [*handmade, "pillow.pgm", "grey.bmp", "grey.tif"]:
+        om = load_map(write_map(tmp_path, None, name=image.replace(".", "_"), image=image))
+        np.testing.assert_array_equal(om.grid, reference, err_msg=image)
+    # maxval 100: Pillow scales the values to 0..255, so it is not read as raw bytes
+    (tmp_path / "max100.pgm").write_bytes(b"P5\n37 23\n100\n" + (pixels // 3).tobytes())
+    scaled = load_map(write_map(tmp_path, None, name="max100", image="max100.pgm")).grid
+    expected = load_map(write_map(tmp_path, np.asarray(Image.open(tmp_path / "max100.pgm")), name="m100",
+                                  image="m100.png")).grid
+    np.testing.assert_array_equal(scaled, expected)
+
+
+def test_the_padded_wall_cells_give_the_same_mesh_and_rectangles(tmp_path):
+    from robotkit.world.walls import padded_wall_cells
+
+    om = load_map(write_map(tmp_path, rooms_map(50, 70), origin="[1.0, 2.0, 0.4]"))
+    for unknown in (False, True):
+        mask = wall_cells(om, unknown)
+        padded = padded_wall_cells(om, unknown)
+        assert padded.shape == (om.rows + 2, om.cols + 2) and not padded[[0, -1]].any() and not padded[:, [0, -1]].any()
+        np.testing.assert_array_equal(padded[1:-1, 1:-1], mask)
+        np.testing.assert_array_equal(rectangles(padded[1:-1, 1:-1], padded=padded), rectangles(mask))
+        for got, want in zip(extrude(padded[1:-1, 1:-1], 2.0, padded=padded), extrude(mask, 2.0)):
+            np.testing.assert_array_equal(got, want)
+
+
+def test_a_piece_of_wall_with_too_many_holes_gets_rectangle_caps(monkeypatch):
+    """manifold3d's time grows with holes x points in one piece: past MAX_HOLE_WORK the caps come
+    from rectangles (exact too, linear); below it, from the outline (fewer faces)."""
+    from robotkit.world import walls
+
+    mask = nested_mask()
+    outline = extrude(mask, 1.0)
+    by_rectangles = extrude(mask, 1.0, method="rectangles")
+    assert len(outline[1]) < len(by_rectangles[1])
+    monkeypatch.setattr(walls, "MAX_HOLE_WORK", 0)  # any hole is too many
+    for got, want in zip(extrude(mask, 1.0), by_rectangles):
+        np.testing.assert_array_equal(got, want)

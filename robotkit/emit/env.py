@@ -41,6 +41,43 @@ def vec(values) -> str:
     return " ".join(fmt(v) for v in values)
 
 
+def each(items, line) -> str:
+    """``line``, a ``str.format`` pattern naming the item ``it`` (``{it.pos}``), for every item, joined.
+
+    For long lists (a world's 10^5 collision boxes): the pattern is read once, each field
+    taken from all the items at once (``operator.attrgetter``) and the pieces joined, instead
+    of a Jinja loop's attribute lookup and escaping per value.  The values are escaped all
+    the same: when the text holds more markup characters than the pattern's own, it is made
+    again through markupsafe's escaping formatter.
+    """
+    import itertools
+    import operator
+    import string
+
+    import markupsafe
+
+    items = list(items)
+    pattern = str(line)
+    parts = list(string.Formatter().parse(pattern))
+    own = "".join(literal for literal, *_ in parts)
+    fields = [f for _, f, spec, conv in parts if f is not None]
+    if all(f == "it" or (f.startswith("it.") and "[" not in f) for f in fields) and \
+            not any(spec or conv for _, f, spec, conv in parts if f is not None):
+        columns = []
+        for literal, f, _, _ in parts:
+            columns.append(itertools.repeat(literal, len(items)))
+            if f is not None:
+                values = items if f == "it" else map(operator.attrgetter(f[3:]), items)
+                columns.append(map(format, values))
+        text = "".join(itertools.chain.from_iterable(zip(*columns)))
+    else:
+        text = "".join([pattern.format(it=it) for it in items])
+    if any(text.count(c) != own.count(c) * len(items) for c in "<>&\"'"):
+        safe = markupsafe.Markup(pattern)
+        text = "".join([safe.format(it=it) for it in items])
+    return markupsafe.Markup(text)
+
+
 @functools.lru_cache(maxsize=8)
 def environment(extra: tuple[str, ...] = ()):
     import jinja2
@@ -56,6 +93,7 @@ def environment(extra: tuple[str, ...] = ()):
     )
     env.filters["fmt"] = fmt
     env.filters["vec"] = vec
+    env.filters["each"] = each
     env.filters["py"] = lambda v: markupsafe.Markup(repr(v))  # a Python literal, for launch/*.launch.py
     return env
 

@@ -33,12 +33,21 @@ def stl_bytes(mesh) -> bytes:
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     norm = np.linalg.norm(n, axis=1)
     ok = norm > 0
-    n[ok] /= norm[ok, None]
-    n[~ok] = 0.0
-    rec = np.zeros(len(F), dtype=np.dtype([("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")]))
-    rec["n"] = n + 0.0
-    rec["v"] = tri + 0.0  # -0.0 -> 0.0 so that equal geometry gives equal bytes
-    return STL_HEADER + np.uint32(len(F)).astype("<u4").tobytes() + rec.tobytes()
+    n /= np.where(ok, norm, 1.0)[:, None]  # whole rows, not a masked copy
+    if not ok.all():
+        n[~ok] = 0.0
+    # the file is filled in place and copied once (a big world mesh has 10^5 triangles)
+    out = np.zeros(84 + 50 * len(F), dtype=np.uint8)
+    out[:80] = np.frombuffer(STL_HEADER, dtype=np.uint8)
+    out[80:84] = np.frombuffer(np.uint32(len(F)).astype("<u4").tobytes(), dtype=np.uint8)
+    rec = out[84:].view(np.dtype([("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")]))
+    n += 0.0  # -0.0 -> 0.0 so that equal geometry gives equal bytes
+    rec["n"] = n
+    del n
+    tri += 0.0
+    rec["v"] = tri
+    del tri, rec
+    return out.tobytes()
 
 
 def obj_bytes(mesh, name: str | None = None) -> bytes:

@@ -17,6 +17,7 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 from robotkit.errors import MapError, Problem
 
@@ -25,8 +26,7 @@ GROUND_MARGIN = 5.0  # metres of floor around the map
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
 
 
-@dataclass(frozen=True)
-class Box:
+class Box(NamedTuple):
     """One collision box as the MJCF attributes read: three numbers each, as text."""
 
     pos: str
@@ -82,19 +82,14 @@ def world_context(name: str, occupancy_map, height: float, rects) -> WorldContex
     # 10^5 boxes and a few thousand distinct k).
     from robotkit.emit.env import fmt
 
-    text: dict[int, str] = {}
-
-    def num(k: int) -> str:
-        t = text.get(k)
-        if t is None:
-            t = text[k] = fmt(round(res * k / 2, 9) + 0.0)  # + 0.0: no -0
-        return t
-
+    x0, y0, x1, y1 = np.asarray(rects, dtype=np.int64).reshape(-1, 4).T
+    k = np.stack([x0 + x1, y0 + y1, x1 - x0, y1 - y0])
+    distinct, which = np.unique(k, return_inverse=True)
+    text = np.array([fmt(round(res * v / 2, 9) + 0.0) for v in distinct.tolist()], dtype=object)  # + 0.0: no -0
+    px, py, sx, sy = text[which.reshape(k.shape)].tolist()
     z = fmt(round(height / 2, 9) + 0.0)
-    boxes = tuple(
-        Box(pos=f"{num(x0 + x1)} {num(y0 + y1)} {z}", size=f"{num(x1 - x0)} {num(y1 - y0)} {z}")
-        for x0, y0, x1, y1 in rects.tolist()
-    )
+    boxes = tuple(map(Box._make, zip([f"{a} {b} {z}" for a, b in zip(px, py)],
+                                     [f"{a} {b} {z}" for a, b in zip(sx, sy)])))
     stem = Path(om.yaml_path).name
     description = (f"Walls {_num(height)} m high from the occupancy map {stem} "
                    f"({om.cols} x {om.rows} cells of {_num(res)} m), built by robotkit.")
@@ -130,13 +125,16 @@ def render_world(name: str, occupancy_map, height: float = 2.0, unknown_as_wall:
 
     from robotkit.emit.env import render
     from robotkit.mesh.export import stl_bytes
-    from robotkit.world.walls import extrude, rectangles, to_map, wall_cells
+    from robotkit.world.walls import extrude, padded_wall_cells, rectangles, to_map
 
-    mask = wall_cells(occupancy_map, unknown_as_wall)
-    vertices, faces = extrude(mask, height)  # as walls.mask_mesh, without importing trimesh (0.8 s)
+    padded = padded_wall_cells(occupancy_map, unknown_as_wall)
+    mask = padded[1:-1, 1:-1]
+    rects = rectangles(mask, padded=padded)
+    vertices, faces = extrude(mask, height, padded=padded)  # as walls.mask_mesh, without trimesh (0.8 s)
+    del mask, padded  # the whole grid: not kept while the files are made
     vertices[:, :2] = to_map(vertices[:, :2], occupancy_map.grid_to_map())
     mesh = SimpleNamespace(vertices=vertices, faces=faces)
-    w = world_context(name, occupancy_map, height, rectangles(mask))
+    w = world_context(name, occupancy_map, height, rects)
     return {
         "model.config": render("world/model.config.j2", w=w).encode("utf-8"),
         "model.sdf": render("world/model.sdf.j2", w=w).encode("utf-8"),

@@ -8,10 +8,12 @@ into the map frame (resolution, origin and yaw), so every step is exact:
    between a wall cell and a non-wall cell, merged into straight segments, each extruded
    into a quad that faces away from the wall.
 2. The top and bottom are the region inside the outline loops, triangulated by
-   manifold3d's polygon triangulator (which keeps every outline edge), with any flat
-   triangle it returns removed by an edge flip.  The result is checked (every cap
-   triangle faces up, the caps add up to the wall area, every edge has exactly two
-   faces); should a check fail, the caps are built from rectangles instead: the wall
+   manifold3d's polygon triangulator (which keeps every outline edge), one piece of wall
+   (an outer loop and its holes) at a time, with any flat triangle it returns removed by
+   an edge flip.  The result is checked (every cap triangle faces up, the caps add up to
+   the wall area, every edge has exactly two faces); should a check fail, or a piece of
+   wall have too many holes for the triangulator (:data:`MAX_HOLE_WORK`), the caps are
+   built from rectangles instead: the wall
    cells merged into rectangles (:func:`rectangles`), each triangulated through every
    rectangle corner on its perimeter so that faces meet edge to edge (no T-junctions),
    with the side walls split at those corners too.
@@ -31,30 +33,54 @@ from __future__ import annotations
 import numpy as np
 
 
+# manifold3d's time on a piece of wall grows with its holes times its points (about 7e-9 s
+# each: 31 s for the 16,632 holes in 227,238 points of a 600 x 600 map of 70 % noise); past
+# this (0.35 s) the caps come from rectangles instead, whose time is linear (1 s there)
+MAX_HOLE_WORK = 50_000_000
+
+
 def grid_mask(walls_image: np.ndarray) -> np.ndarray:
     """Image-order mask (row 0 at the top) -> grid-order mask (row 0 at the bottom)."""
     return np.ascontiguousarray(walls_image[::-1, :], dtype=bool)
 
 
-def _runs_merged(mask: np.ndarray, axis: int = 1) -> np.ndarray:
-    """Runs of ``mask`` along its rows (``axis`` 1) or columns (0), each merged with identical
-    runs in the next lines: (n, 4) [start, line0, end, line1 + 1] (for columns: y, x, not x, y).
-
-    The columns are read in place (a difference down the columns, then the few transitions
-    sorted), not from a transposed copy of the mask.
-    """
+def _padded(mask: np.ndarray) -> np.ndarray:
+    """``mask`` with a ring of False around it: shape (rows + 2, cols + 2), ``mask`` is its [1:-1, 1:-1]."""
     rows, cols = mask.shape
-    if axis == 1:
-        pad = np.zeros((rows, cols + 2), dtype=np.int8)
-        pad[:, 1:-1] = mask
-        line, pos = np.nonzero(np.diff(pad, axis=1))  # row by row, left to right
-    else:
-        pad = np.zeros((rows + 2, cols), dtype=np.int8)
-        pad[1:-1] = mask
-        pos, line = np.nonzero(np.diff(pad, axis=0))
-        order = np.lexsort((pos, line))  # column by column, bottom to top
-        line, pos = line[order], pos[order]
-    # along a line a run starts (+1) and ends (-1) in turn
+    g = np.zeros((rows + 2, cols + 2), dtype=bool)
+    g[1:-1, 1:-1] = mask
+    return g
+
+
+def _row_transitions(g: np.ndarray):
+    """Where the cells of a :func:`_padded` mask change along each row, row by row, left to right.
+
+    Returns (row, x, start): grid row, grid x of the change (between cells x - 1 and x) and
+    whether a run of wall cells starts there.  One comparison of the flat array with itself
+    shifted by one: the zero columns keep the rows apart.
+    """
+    width = g.shape[1]
+    flat = g.ravel()
+    p = np.flatnonzero(flat[1:] != flat[:-1]) + 1  # the cell right of each change
+    row, col = np.divmod(p, width)
+    return row - 1, col - 1, flat[p] > 0
+
+
+def _column_transitions(g: np.ndarray):
+    """As :func:`_row_transitions` down the columns: (column, y, start), column by column, bottom to top."""
+    width = g.shape[1]
+    flat = g.ravel()
+    p = np.flatnonzero(flat[width:] != flat[:-width]) + width  # the cell above each change
+    row, col = np.divmod(p, width)
+    # a stable sort on the column alone keeps each column bottom to top (radix sort for 16 bits)
+    order = np.argsort(col.astype(np.uint16) if width <= 1 << 16 else col, kind="stable")
+    return col[order] - 1, row[order] - 1, flat[p[order]] > 0
+
+
+def _runs_merged(line: np.ndarray, pos: np.ndarray) -> np.ndarray:
+    """Runs from the changes along lines (``line``, ``pos``: line by line, in order along each),
+    each merged with identical runs in the next lines: (n, 4) [start, line0, end, line1 + 1]."""
+    # along a line a run starts and ends in turn
     ys, xs, xe = line[0::2], pos[0::2], pos[1::2]
     order = np.lexsort((ys, xe, xs))
     xs, xe, ys = xs[order], xe[order], ys[order]
@@ -65,46 +91,64 @@ def _runs_merged(mask: np.ndarray, axis: int = 1) -> np.ndarray:
     return np.stack([xs[first], ys[first], xe[first], ys[last] + 1], axis=1).astype(np.int64)
 
 
-def rectangles(mask: np.ndarray) -> np.ndarray:
+def rectangles(mask: np.ndarray, *, padded: np.ndarray | None = None) -> np.ndarray:
     """Disjoint rectangles covering the True cells of a grid-order ``mask`` exactly.
 
     Returns an int64 array (n, 4) of [x0, y0, x1, y1] (cells x0 <= x < x1, y0 <= y < y1),
-    sorted by y0 then x0.
+    sorted by y0 then x0.  ``padded``: the mask with a ring of False around it, when the
+    caller has it (:func:`padded_wall_cells`), saves a copy of the whole grid.
     """
-    by_rows = _runs_merged(mask)
-    by_cols = _runs_merged(mask, axis=0)[:, [1, 0, 3, 2]]
+    g = _padded(mask) if padded is None else padded
+    by_rows = _runs_merged(*_row_transitions(g)[:2])
+    by_cols = _runs_merged(*_column_transitions(g)[:2])[:, [1, 0, 3, 2]]
     rects = by_rows if len(by_rows) <= len(by_cols) else by_cols
     return rects[np.lexsort((rects[:, 0], rects[:, 1]))]
 
 
 class _Grid:
-    """The padded wall mask and what the outline needs from it.
+    """The wall mask and what the outline needs from it.
 
     Only the points where the outline turns are kept (as coordinate lists), not whole
     arrays per grid point: a 5000 x 5000 map has 25 million grid points and a few hundred
-    thousand turns.
+    thousand turns.  The padded mask is only read while the turns are found.
     """
 
-    def __init__(self, mask: np.ndarray):
+    def __init__(self, mask: np.ndarray, padded: np.ndarray | None = None):
         self.mask = mask
         self.rows, self.cols = mask.shape
-        g = np.zeros((self.rows + 2, self.cols + 2), dtype=np.int8)
-        g[1:-1, 1:-1] = mask
-        self.g = g
-        # the four cells around each grid point (y, x), shape (rows + 1, cols + 1)
-        sw, se, nw, ne = g[:-1, :-1], g[:-1, 1:], g[1:, :-1], g[1:, 1:]
-        count = sw + se
-        count += nw
-        count += ne
-        # the outline changes direction where one or three of the four cells are walls, and at
-        # a pinch: two walls touching at a corner (then sw == ne)
-        turns = (count & 1).astype(bool)
-        turns |= (count == 2) & (sw == ne)
-        self.turn_y, self.turn_x = np.nonzero(turns)  # row-major order
-        pinch = count[self.turn_y, self.turn_x] == 2
-        self.pinch_y, self.pinch_x = self.turn_y[pinch], self.turn_x[pinch]
-        self._pinch_keys = self.pinch_y * (self.cols + 1) + self.pinch_x  # sorted
-        self._pinch_ne_sw = sw[self.pinch_y, self.pinch_x] > 0  # else the north-west / south-east pinch
+        g = _padded(mask) if padded is None else padded
+        # The outline changes direction at a grid point (y, x) where one or three of the four
+        # cells around it are walls, or at a pinch (two walls touching at a corner): where the
+        # row below (y - 1) changes at x and the row above (y) does not, or the other way
+        # round, or both change the other way.  So the turns come from the changes along the
+        # rows (a few hundred thousand on a 5000 x 5000 map) rather than from whole-grid arrays.
+        self.trans_row, self.trans_x, self.trans_start = row, x, start = _row_transitions(g)
+        width = self.cols + 1
+        key = row * width + x
+        self.trans_keys = key  # sorted: row by row, left to right
+        # each change as seen from the grid line below its row and from the one above it, with
+        # its kind; a change seen from both sides with the same kind is a straight wall face
+        seen = np.concatenate([2 * key + start, 2 * (key + width) + start])
+        seen.sort(kind="stable")  # two sorted runs: a merge
+        same = seen[1:] == seen[:-1]
+        drop = np.zeros(len(seen), dtype=bool)
+        drop[1:] = same
+        drop[:-1] |= same
+        point = seen[~drop] >> 1
+        twice = point[1:] == point[:-1]  # both changes, of opposite kinds: a pinch
+        keys = point[np.r_[True, ~twice]]
+        self.turn_y, self.turn_x = np.divmod(keys, width)  # row-major order
+        self._pinch_keys = point[1:][twice]  # sorted
+        self.pinch_y, self.pinch_x = np.divmod(self._pinch_keys, width)
+        # whether the south-west cell is a wall (else the north-west and south-east ones are)
+        self._pinch_ne_sw = self.cell(self.pinch_y - 1, self.pinch_x - 1) > 0
+
+    def cell(self, y: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """The mask at the cells (row y, column x) as int8, 0 outside the grid."""
+        inside = (y >= 0) & (y < self.rows) & (x >= 0) & (x < self.cols)
+        out = np.zeros(len(y), dtype=np.int8)
+        out[inside] = self.mask[y[inside], x[inside]]
+        return out
 
     def pinch_index(self, y: np.ndarray, x: np.ndarray, ne_sw: bool | None = None) -> np.ndarray:
         """The index of the pinch at each grid point (y, x) (of that kind, unless None), -1 where there is none."""
@@ -127,10 +171,10 @@ class _Grid:
         Returns ax, ay, bx, by, am, bm: am / bm is the pinch index when the wall face of this
         segment must split its vertical edge at A / B (see the module docstring), else -1.
         """
-        g = self.g
+        cell = self.cell
         same = py[1:] == py[:-1]
         j, xa, xb = py[:-1][same], px[:-1][same], px[1:][same]
-        kind = g[j, xa + 1] - g[j + 1, xa + 1]
+        kind = cell(j - 1, xa) - cell(j, xa)
         keep = kind != 0
         j, xa, xb, west = j[keep], xa[keep], xb[keep], kind[keep] > 0
         low = self.pinch_index(j, xa)  # a pinch at the segment's west end belongs to this segment's cell
@@ -140,7 +184,7 @@ class _Grid:
         vy, vx = py[order], px[order]
         same = vx[1:] == vx[:-1]
         i, ya, yb = vx[:-1][same], vy[:-1][same], vy[1:][same]
-        kind = g[ya + 1, i] - g[ya + 1, i + 1]
+        kind = cell(ya, i - 1) - cell(ya, i)
         keep = kind != 0
         i, ya, yb, north = i[keep], ya[keep], yb[keep], kind[keep] > 0
         low = self.pinch_index(ya, i, ne_sw=True)
@@ -193,16 +237,108 @@ def _outline_caps(grid: _Grid, seg):
     if (succ < 0).any():
         return None
     idx, sizes = _cycles(succ)
+    px, py = ax[idx], ay[idx]
     pts = np.empty((n, 2), dtype=np.float64)
-    pts[:, 0], pts[:, 1] = ax[idx], ay[idx]
-    polygons = np.split(pts, np.cumsum(sizes)[:-1])
+    pts[:, 0], pts[:, 1] = px, py
+    starts = np.cumsum(sizes) - sizes
+    polygons = [pts[a:b] for a, b in zip(starts.tolist(), (starts + sizes).tolist())]  # np.split: 3x slower
+    outer = _outer_loops(grid, seg, idx, starts, sizes)
+    if _hole_work(outer, sizes) > MAX_HOLE_WORK:
+        return None
     try:
-        tris = np.asarray(manifold3d.triangulate(polygons), dtype=np.int64).reshape(-1, 3)
+        tris = _triangulate(manifold3d, polygons, starts, sizes, outer)
     except Exception:  # noqa: BLE001 - any failure of the optional fast path falls back
         return None
-    px, py = ax[idx], ay[idx]
     tris = _flip_flat(px, py, tris)
     return None if tris is None else (px, py, tris)
+
+
+def _hole_work(outer: np.ndarray | None, sizes: np.ndarray) -> int:
+    """The largest (holes x points) of one triangulation call (see :data:`MAX_HOLE_WORK`)."""
+    if outer is None:  # one call
+        return (len(sizes) - 1) * int(sizes.sum())
+    loops = np.bincount(outer, minlength=len(sizes))
+    points = np.bincount(outer, weights=sizes, minlength=len(sizes))
+    return int(((loops - 1) * points).max())
+
+
+def _outer_loops(grid: _Grid, seg, idx: np.ndarray, starts: np.ndarray, sizes: np.ndarray):
+    """For each outline loop (``idx``/``starts``/``sizes`` as :func:`_cycles` gives them), the
+    outer loop of its piece of wall: itself for an outer loop, the loop around it for a hole.
+
+    An outer loop runs counter-clockwise (the wall on its left, inside), a hole clockwise.
+    Left of a hole's lowest point on its leftmost side is a wall cell; the run of wall cells
+    through it starts at an outline edge of the same piece of wall (further left), on the
+    outer loop or on another hole of that piece, which is then followed the same way
+    (pointer doubling; each step moves left, so it ends on the outer loop).  None if
+    something does not add up (then every loop goes in one group).
+    """
+    ax, ay, bx, by = seg[:4]
+    n, n_loops = len(idx), len(sizes)
+    px, py = ax[idx], ay[idx]
+    nxt = np.arange(1, n + 1)
+    nxt[starts + sizes - 1] = starts
+    area = np.add.reduceat(px * py[nxt] - px[nxt] * py, starts)  # twice the signed area
+    hole = np.flatnonzero(area < 0)
+    if len(hole) == 0:
+        return np.arange(n_loops)
+    # the hole's lowest point on its leftmost side, and the wall run left of it
+    height = grid.rows + 2
+    low = np.minimum.reduceat(px * height + py, starts)[hole]
+    hx, hy = np.divmod(low, height)
+    i = np.searchsorted(grid.trans_keys, hy * (grid.cols + 1) + hx - 1, side="right") - 1
+    if (i < 0).any():
+        return None
+    i = np.maximum(i, 0)
+    run_x = grid.trans_x[i]
+    if not ((grid.trans_row[i] == hy) & grid.trans_start[i] & (run_x < hx)).all():
+        return None
+    # the vertical outline segment at the start of that run, and its loop
+    vertical = np.flatnonzero(ax == bx)
+    y0, y1 = np.minimum(ay, by)[vertical], np.maximum(ay, by)[vertical]
+    vkey = ax[vertical] * (grid.rows + 1) + y0
+    order = np.argsort(vkey)
+    j = np.searchsorted(vkey[order], run_x * (grid.rows + 1) + hy, side="right") - 1
+    if (j < 0).any():
+        return None
+    j = order[np.maximum(j, 0)]
+    if not ((ax[vertical[j]] == run_x) & (y0[j] <= hy) & (hy < y1[j])).all():
+        return None
+    loop_of = np.empty(n, dtype=np.int64)
+    loop_of[idx] = np.repeat(np.arange(n_loops), sizes)
+    parent = np.arange(n_loops)
+    parent[hole] = loop_of[vertical[j]]
+    for _ in range(int(n_loops).bit_length() + 1):
+        parent = parent[parent]
+    if not (area[parent] > 0).all():
+        return None
+    return parent
+
+
+def _triangulate(manifold3d, polygons, starts, sizes, outer) -> np.ndarray:
+    """manifold3d's triangulation of the loops: (m, 3) indices into the loops' points in order.
+
+    Its cost grows faster than the number of loops (0.49 s for the 6,691 loops of a
+    5000 x 5000 map in one call), so each outer loop goes in a call of its own, with its
+    holes: 0.1 s, and the same triangles (each piece of wall is triangulated the same way
+    alone).  Without ``outer`` (holes not placed), one call.
+    """
+    if outer is None:
+        return np.asarray(manifold3d.triangulate(polygons), dtype=np.int64).reshape(-1, 3)
+    loops = np.lexsort((np.arange(len(sizes)), outer != np.arange(len(sizes)), outer))  # outer loop first
+    bounds = np.flatnonzero(np.diff(outer[loops])) + 1
+    # the groups' points in call order (each group's loops one after the other), and each
+    # call's triangles, indexing its own points, shifted by where the group's points begin
+    size = sizes[loops]
+    begin = np.cumsum(size) - size  # where each loop's points begin in call order
+    point = np.arange(int(size.sum())) + np.repeat(starts[loops] - begin, size)
+    first = begin[np.r_[0, bounds]]
+    polys = [polygons[k] for k in loops.tolist()]
+    cut = np.r_[0, bounds, len(loops)].tolist()
+    parts = [manifold3d.triangulate(polys[a:b]) for a, b in zip(cut[:-1], cut[1:])]
+    counts = np.array([len(t) for t in parts], dtype=np.int64)
+    local = np.concatenate(parts).astype(np.int64).reshape(-1, 3) + np.repeat(first, counts)[:, None]
+    return point[local]
 
 
 def _cycles(succ: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -371,29 +507,35 @@ def _rectangle_caps(grid: _Grid, rects: np.ndarray):
 
 
 def _closed(faces: np.ndarray, n_vertices: int) -> bool:
-    """Every directed edge once, and its reverse once: closed and consistently oriented."""
-    e = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    key = e[:, 0] * n_vertices + e[:, 1]
-    rev = e[:, 1] * n_vertices + e[:, 0]
-    key_sorted = np.sort(key)
-    if (key_sorted[1:] == key_sorted[:-1]).any():
-        return False
-    rev.sort()  # the directed edges are unique: every reverse is there iff both sets are equal
-    return bool(np.array_equal(key_sorted, rev))
+    """Every directed edge once, and its reverse once: closed and consistently oriented.
+
+    One sort: each edge as (its smaller end, its larger end, whether it runs downwards); then
+    the keys must come in pairs k, k + 1 (both directions of each edge, once each).
+    """
+    a = np.ascontiguousarray(faces, dtype=np.int64).ravel()
+    b = faces[:, [1, 2, 0]].astype(np.int64).ravel()  # edge a -> b
+    key = np.minimum(a, b)  # in place from here on: a big mesh has millions of edges
+    key *= n_vertices
+    key += np.maximum(a, b)
+    key *= 2
+    key += a > b
+    del b
+    key.sort()
+    return bool(len(key) % 2 == 0 and (key[0::2] % 2 == 0).all() and np.array_equal(key[0::2] + 1, key[1::2]))
 
 
-def extrude(mask: np.ndarray, height: float, method: str = "outline"):
+def extrude(mask: np.ndarray, height: float, method: str = "outline", *, padded: np.ndarray | None = None):
     """Closed wall mesh of a grid-order ``mask``, in grid coordinates (z in metres).
 
     ``method`` "outline" triangulates the top and bottom inside the outline (fewest
     faces), falling back to "rectangles" if that fails its checks; "rectangles" builds
     them from :func:`rectangles`.  Returns (vertices (n, 3) float64, faces (m, 3) int64);
-    x and y are in cells.
+    x and y are in cells.  ``padded`` as for :func:`rectangles`.
     """
     if method not in ("outline", "rectangles"):
         raise ValueError(f"unknown method {method!r} (outline or rectangles)")
     mask = np.asarray(mask, dtype=bool)
-    grid = _Grid(mask)
+    grid = _Grid(mask, padded)
     z = float(height)
     width = grid.cols + 1
     area = int(mask.sum())
@@ -407,7 +549,7 @@ def extrude(mask: np.ndarray, height: float, method: str = "outline"):
             cx, cy, cap = caps
             centres = np.zeros((0, 2))
         else:
-            corner, cx, cy, cap, centres = _rectangle_caps(grid, rectangles(mask))
+            corner, cx, cy, cap, centres = _rectangle_caps(grid, rectangles(mask, padded=padded))
             breaks = np.union1d(cy * width + cx, grid.turn_y * width + grid.turn_x)  # sorted: row-major
             seg = grid.outline(*np.divmod(breaks, width))
         ax, ay, bx, by, am, bm = seg
@@ -444,6 +586,17 @@ def extrude(mask: np.ndarray, height: float, method: str = "outline"):
 
 def wall_cells(occupancy_map, unknown_as_wall: bool = False) -> np.ndarray:
     """Grid-order mask of the cells that become walls; MapError when there is none."""
+    return grid_mask(_walls_image(occupancy_map, unknown_as_wall))
+
+
+def padded_wall_cells(occupancy_map, unknown_as_wall: bool = False) -> np.ndarray:
+    """:func:`wall_cells` with a ring of False around it, made in one copy: shape (rows + 2,
+    cols + 2), the mask is its [1:-1, 1:-1] (for ``padded`` of :func:`extrude` and :func:`rectangles`)."""
+    return _padded(_walls_image(occupancy_map, unknown_as_wall)[::-1])
+
+
+def _walls_image(occupancy_map, unknown_as_wall: bool) -> np.ndarray:
+    """The image-order mask of wall cells; MapError when there is none."""
     from robotkit.errors import MapError
 
     walls = occupancy_map.walls(unknown_as_wall)
@@ -456,7 +609,7 @@ def wall_cells(occupancy_map, unknown_as_wall: bool = False) -> np.ndarray:
             detail = (f"no occupied cell in '{om.image_name}' ({size}: {int(om.free.sum())} free, "
                       f"{int(om.unknown.sum())} unknown)")
         raise MapError(om.problem(f"{detail}, so there is no wall to build"))
-    return grid_mask(walls)
+    return walls
 
 
 def check_height(height) -> float:
