@@ -161,16 +161,18 @@ def one(path: str, keep: float, repeat: int, samples: int, tools: list[str]) -> 
         except Exception as exc:  # noqa: BLE001 - a tool's failure is a result
             row["tools"][name] = {"error": f"{type(exc).__name__}: {exc}"[:120]}
     times = {n: [] for n in tools if n not in row["tools"]}
+    cpus = {n: [] for n in times}
     results = {}
     for _ in range(repeat):
         for name in times:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             results[name] = TOOLS[name](V, F, target)
+            cpus[name].append(time.process_time() - c0)  # CPU of every thread of this process
             times[name].append(time.perf_counter() - t0)
     for name, (v, f) in results.items():
         f = np.asarray(f, np.int64)
-        row["tools"][name] = {"faces": int(len(f)), "time": min(times[name]), "closed": is_closed(f),
-                              "hausdorff": hausdorff(V, F, np.asarray(v, np.float64), f, samples)}
+        row["tools"][name] = {"faces": int(len(f)), "time": min(times[name]), "cpu": min(cpus[name]),
+                              "closed": is_closed(f), "hausdorff": hausdorff(V, F, np.asarray(v, np.float64), f, samples)}
     return row
 
 
@@ -240,6 +242,7 @@ def main() -> int:
                          f"{r['faces']:>6} {r['time'] * 1000:7.1f}ms {r['hausdorff']:.1e} {'C' if r['closed'] else 'o'}")
         print(f"{os.path.relpath(path, REPO.parent)[-44:]:44} {row['faces']:>7} {row['target']:>6} "
               f"{'C' if row['closed'] else 'o'} | " + " | ".join(cells), flush=True)
+    print(f"load average at the end {os.getloadavg()[0]:.1f}")
     summary(rows, tools)
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
@@ -268,10 +271,11 @@ def summary(rows, tools):
                 and "error" not in r["tools"].get(other, {"error": 1})]
         if not both or other not in tools:
             continue
-        ratio = np.array([r["tools"][other]["time"] / r["tools"]["robotkit"]["time"] for r in both])
-        total = sum(r["tools"][other]["time"] for r in both) / sum(r["tools"]["robotkit"]["time"] for r in both)
-        print(f"  time {other} / robotkit: median {np.median(ratio):.2f}, over the sum {total:.2f}, "
-              f"min {ratio.min():.2f} ({len(both)} meshes)")
+        for clock in ("time", "cpu"):
+            ratio = np.array([r["tools"][other][clock] / r["tools"]["robotkit"][clock] for r in both])
+            total = sum(r["tools"][other][clock] for r in both) / sum(r["tools"]["robotkit"][clock] for r in both)
+            print(f"  {'wall' if clock == 'time' else 'CPU '} {other} / robotkit: median {np.median(ratio):.2f}, "
+                  f"over the sum {total:.2f}, min {ratio.min():.2f} ({len(both)} meshes)")
 
 
 if __name__ == "__main__":
