@@ -54,7 +54,7 @@ DEFAULT_SAMPLES = 4000
 NORMALISED_DIAGONAL = 1000.0
 LIBRARY = "meshlib"
 PREPASS_LIBRARY = "meshoptimizer"
-PREPASS_FACTORS = (2.0, 3.0, 4.0)  # meshoptimizer's first pass goes to this many times the target
+PREPASS_FACTORS = (2.0, 4.0)  # meshoptimizer's first pass goes to this many times the target
 PREPASS_LIMIT = 0.7  # ... when that removes at least 30 % of the faces
 PREPASS_ERROR = 1e-2  # meshoptimizer's error bound, relative to the mesh's extent
 
@@ -119,8 +119,11 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
         centre = 0.5 * (V.min(axis=0) + V.max(axis=0))
         diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
         k = NORMALISED_DIAGONAL / diag
-        closed = vol_in is not None or _edge_census(F, len(V)) == (False, False, 0)  # maybe inside out
-        v, f, details = _decimate_core((V - centre) * k, F, target, closed)
+        # degenerate faces are dropped by both libraries: the UR5's meshes are closed without them
+        _, over_two, _ = census = _edge_census(F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2])
+                                                       & (F[:, 2] != F[:, 0])], len(V))
+        closed = vol_in is not None or census == (False, False, 0)
+        v, f, details = _decimate_core((V - centre) * k, F, target, closed, prepass=not over_two)
         out = trimesh.Trimesh(v / k + centre, f, process=False)  # MeshLib packs: every vertex is used
     vol_out = closed_volume(out)
     report = {
@@ -136,18 +139,21 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     return out, report
 
 
-def _decimate_core(V: np.ndarray, F: np.ndarray, target: int, closed: bool) -> tuple[np.ndarray, np.ndarray, dict]:
+def _decimate_core(V: np.ndarray, F: np.ndarray, target: int, closed: bool,
+                   prepass: bool = True) -> tuple[np.ndarray, np.ndarray, dict]:
     """Decimate (V, F), already normalised, to ``target`` faces: (float64 vertices, int64 faces, details).
 
-    A meshoptimizer pass first when it keeps the topology (:func:`_prepass`), MeshLib to the
-    target; when MeshLib stops above the target and the input has missing triangles (holes of
-    three edges, which an edge collapse cannot remove), again on the input with those filled.
+    A meshoptimizer pass first when it keeps the topology (:func:`_prepass`; not tried when
+    ``prepass`` is false: an input with edges of three or more faces, which meshoptimizer
+    keeps, so its result would be refused), then MeshLib to the target.  When MeshLib stops
+    above the target and the input has missing triangles (holes of three edges, which edge
+    collapses cannot remove), the same again on the input with those filled.
     Details: ``prepass`` (the factor of the target the first pass went to, or None) and
     ``holes_filled``.
     """
     Vf = np.ascontiguousarray(V, dtype=np.float32)
     F = np.asarray(F)
-    first, factor = _prepass(Vf, F, target, closed)
+    first, factor = _prepass(Vf, F, target, closed) if prepass else (F, None)
     v, f = _meshlib_decimate(Vf, first, target)
     details = {"prepass": factor, "holes_filled": 0}
     if len(f) > target:
@@ -170,14 +176,10 @@ def _prepass(Vf: np.ndarray, F: np.ndarray, target: int, closed: bool) -> tuple[
     directed edge repeats, no face is degenerate and, for a closed input, no edge is a border
     (:func:`_edge_census`), trying ``PREPASS_FACTORS`` times the target in turn; else the
     input goes to MeshLib unchanged.  The result indexes the input's vertices (MeshLib drops
-    the unused ones).  An input with edges of three or more faces goes to MeshLib directly:
-    meshoptimizer keeps such edges, so its result would be refused.  Returns (faces, the factor
-    used or None).
+    the unused ones).  Returns (faces, the factor used or None).
     """
     import meshoptimizer
 
-    if _edge_census(F, len(Vf))[1]:
-        return F, None  # edges of three or more faces (bodies sharing edges): meshoptimizer keeps them
     indices = np.ascontiguousarray(F, dtype=np.uint32).ravel()
     for factor in PREPASS_FACTORS:
         count = int(factor * target)
