@@ -110,20 +110,21 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
             raise ValueError(f"cannot decimate to {target} faces: the mesh has only {n} faces "
                              "(decimation only removes faces)")
     V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
-    F = np.asarray(mesh.faces)
-    vol_in = closed_volume(mesh)
+    F = np.asarray(mesh.faces, dtype=np.int64)
+    census = _edge_census(F, len(V))
+    vol_in = _closed_volume(V, F, census)
     details = {"prepass": None, "holes_filled": 0}
     if target >= n:
-        out = trimesh.Trimesh(V.copy(), F.astype(np.int64), process=False)
+        out = trimesh.Trimesh(V.copy(), F.copy(), process=False)
     else:
         centre = 0.5 * (V.min(axis=0) + V.max(axis=0))
         diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
         k = NORMALISED_DIAGONAL / diag
-        # degenerate faces are dropped by both libraries: the UR5's meshes are closed without them
-        _, over_two, _ = census = _edge_census(F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2])
-                                                       & (F[:, 2] != F[:, 0])], len(V))
-        closed = vol_in is not None or census == (False, False, 0)
-        v, f, details = _decimate_core((V - centre) * k, F, target, closed, prepass=not over_two)
+        degenerate = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
+        if degenerate.any():  # dropped by both libraries: the UR5's meshes are closed without them
+            census = _edge_census(F[~degenerate], len(V))
+        closed = vol_in is not None or census == CLOSED  # CLOSED and no volume: inside out
+        v, f, details = _decimate_core((V - centre) * k, F, target, closed, prepass=not census[1])
         out = trimesh.Trimesh(v / k + centre, f, process=False)  # MeshLib packs: every vertex is used
     vol_out = closed_volume(out)
     report = {
@@ -174,7 +175,9 @@ def _prepass(Vf: np.ndarray, F: np.ndarray, target: int, closed: bool) -> tuple[
     and edges of three or four faces, and MeshLib would keep those as separate sheets (a closed
     mesh comes out open).  So its result is used only if every edge has at most two faces, no
     directed edge repeats, no face is degenerate and, for a closed input, no edge is a border
-    (:func:`_edge_census`), trying ``PREPASS_FACTORS`` times the target in turn; else the
+    (:func:`_edge_census`), and no two faces have the same corners (two faces back to back
+    pass the edge test, and MeshLib makes a hole of them: measured, the PAL antenna at 1.5
+    times the target), trying ``PREPASS_FACTORS`` times the target in turn; else the
     input goes to MeshLib unchanged.  The result indexes the input's vertices (MeshLib drops
     the unused ones).  Returns (faces, the factor used or None).
     """
@@ -189,7 +192,7 @@ def _prepass(Vf: np.ndarray, F: np.ndarray, target: int, closed: bool) -> tuple[
         n = meshoptimizer.simplify(out, indices, Vf, target_index_count=3 * count, target_error=PREPASS_ERROR)
         faces = out[:n].reshape(-1, 3)
         defective, _, borders = _edge_census(faces, len(Vf))
-        if not defective and not (closed and borders):
+        if not defective and not (closed and borders) and not _repeated_faces(faces):
             return faces, factor
     return F, None
 
@@ -199,16 +202,27 @@ def _edge_census(F: np.ndarray, n_vertices: int) -> tuple[bool, bool, int]:
 
     ``defective``: a degenerate face, a directed edge used twice, or an edge of more than two
     faces; ``over_two``: an edge of more than two faces; ``borders``: edges of one face.
+    ``CLOSED`` (no defect, no border): every edge has two faces, in opposite directions.
     """
     F = np.asarray(F, dtype=np.int64)
-    a, b = F.ravel(), np.roll(F, -1, axis=1).ravel()
+    a, b = F.ravel(), F[:, [1, 2, 0]].ravel()
     key = np.sort((np.minimum(a, b) * n_vertices + np.maximum(a, b)) * 2 + (a > b))
     edge = key >> 1
-    starts = np.flatnonzero(np.r_[True, edge[1:] != edge[:-1]])
-    faces_per_edge = np.diff(np.r_[starts, len(edge)])
-    over_two = bool((faces_per_edge > 2).any())
+    pair = edge[1:] == edge[:-1]  # sorted: an edge's faces are neighbours
+    over_two = bool((pair[1:] & pair[:-1]).any())
     defective = over_two or bool((a == b).any()) or bool((key[1:] == key[:-1]).any())
-    return defective, over_two, int((faces_per_edge == 1).sum())
+    borders = len(edge) - 2 * int(pair.sum()) if not over_two else int((~(np.r_[False, pair] | np.r_[pair, False])).sum())
+    return defective, over_two, borders
+
+
+CLOSED = (False, False, 0)
+
+
+def _repeated_faces(F: np.ndarray) -> bool:
+    """Whether two faces of ``F`` have the same three corners (in any order)."""
+    s = np.sort(np.asarray(F, dtype=np.int64), axis=1)
+    s = s[np.lexsort((s[:, 2], s[:, 1], s[:, 0]))]
+    return bool((s[1:] == s[:-1]).all(axis=1).any())
 
 
 def _fill_missing_triangles(Vf: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
@@ -258,23 +272,17 @@ def closed_volume(mesh) -> float | None:
     """The volume of ``mesh`` if it is a closed, consistently wound, outward volume, else None.
 
     The same test as trimesh's ``is_volume`` (every edge used by exactly two faces in
-    opposite directions, positive volume), hand-written with one sort of edge keys:
-    0.1 s instead of 0.7 s on a fresh 500k-face mesh.
+    opposite directions, positive volume), hand-written with one sort of edge keys
+    (:func:`_edge_census`): 0.1 s instead of 0.7 s on a fresh 500k-face mesh.
     """
     F = np.asarray(mesh.faces, dtype=np.int64)
     V = np.asarray(mesh.vertices, dtype=np.float64)
-    if len(F) < 4 or not np.isfinite(V).all():
-        return None
-    if ((F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])).any():
-        return None
-    n = np.int64(len(V))
-    a, b = F.ravel(), np.roll(F, -1, axis=1).ravel()
-    # one sort: every undirected edge must occur exactly twice, once in each direction
-    if len(a) % 2:
-        return None
-    key = np.sort((np.minimum(a, b) * n + np.maximum(a, b)) * 2 + (a > b))
-    pairs = key.reshape(-1, 2)
-    if not ((pairs[:, 0] % 2 == 0).all() and (pairs[:, 1] == pairs[:, 0] + 1).all()):
+    return _closed_volume(V, F, _edge_census(F, len(V)))
+
+
+def _closed_volume(V: np.ndarray, F: np.ndarray, census: tuple) -> float | None:
+    """:func:`closed_volume` of (V, F) whose :func:`_edge_census` is ``census``."""
+    if census != CLOSED or len(F) < 4 or not np.isfinite(V).all():
         return None
     ref = 0.5 * (V.min(axis=0) + V.max(axis=0))
     Vt = np.ascontiguousarray((V - ref).T)
