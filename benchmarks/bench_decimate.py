@@ -1,12 +1,15 @@
-"""Decimation side by side: robotkit (MeshLib) against meshlib called plainly, meshoptimizer,
-fast-simplification (robotkit's library before) and pymeshlab (MeshLab, the tool a user
-would otherwise use), on every visual mesh of the examples (recipes/meshes) and of the
-robots in ../shared/assets.
+"""Decimation side by side: robotkit (a meshoptimizer first pass where it keeps the topology,
+then MeshLib) against meshlib called plainly, meshoptimizer alone, fast-simplification
+(robotkit's library before MeshLib) and pymeshlab (MeshLab, the tool a user would otherwise
+use), on every visual mesh of the examples (recipes/meshes) and of the robots in
+../shared/assets.
 
 Per mesh, in a child process of its own (pymeshlab crashes on some inputs): load it once
 (robotkit.mesh.io.load_mesh: metres, coincident vertices merged), decimate it with every
-tool to the same target (a fraction of its faces), take the best of ``--repeat`` times
-per tool, interleaved, and measure the result independently of robotkit's code:
+tool to the same target (a fraction of its faces), take the best of ``--repeat`` runs per
+tool, interleaved, for wall time (``time.perf_counter``) and CPU time (``time.process_time``:
+every thread of the process, so a threaded library is not flattered on a shared machine),
+and measure the result independently of robotkit's code:
 
 - faces: the result's face count against the target (within 2 %?);
 - closed: closed before -> closed after (every edge used twice in opposite directions);
@@ -16,9 +19,10 @@ per tool, interleaved, and measure the result independently of robotkit's code:
   tolerance of 1e-12 on squared lengths: wrong by up to the triangle size for triangles
   under ~1e-2 units), reported over the diagonal.
 
-Prints one row per mesh and a summary: targets reached, closed meshes kept closed,
-robotkit's Hausdorff over plain meshlib's, pymeshlab's time over robotkit's (median and over
-the sum of times).  ``python benchmarks/bench_decimate.py [--keep 0.1] [--repeat 3]
+Prints the load average before and after, one row per mesh (faces, wall ms, Hausdorff) and
+a summary: targets reached, closed meshes kept closed, robotkit's Hausdorff over plain
+meshlib's, every tool's wall and CPU time over robotkit's (median and over the sum of
+times).  ``python benchmarks/bench_decimate.py [--keep 0.1] [--repeat 3]
 [--samples 5000] [--json out.json] [--only SUBSTRING]``.  Needs ``pip install pymeshlab
 meshoptimizer fast-simplification`` (benchmark only).
 """
