@@ -176,7 +176,8 @@ def one(path: str, keep: float, repeat: int, samples: int, tools: list[str]) -> 
     for name, (v, f) in results.items():
         f = np.asarray(f, np.int64)
         row["tools"][name] = {"faces": int(len(f)), "time": min(times[name]), "cpu": min(cpus[name]),
-                              "closed": is_closed(f), "hausdorff": hausdorff(V, F, np.asarray(v, np.float64), f, samples)}
+                              "closed": is_closed(f),
+                              "hausdorff": hausdorff(V, F, np.asarray(v, np.float64), f, samples)}
     return row
 
 

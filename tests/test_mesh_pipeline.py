@@ -344,11 +344,14 @@ def test_edge_census_against_trimesh():
 
     box = trimesh.creation.box()
     F = np.asarray(box.faces)
+    V = np.vstack([box.vertices, [[2.0, 0.0, 0.0]]])  # vertex 8: a fin on an edge of the box
     cases = {"closed": F, "one missing": F[1:], "two missing": F[2:], "a duplicate face": np.vstack([F, F[:1]]),
-             "a flipped duplicate": np.vstack([F, F[:1, ::-1]]), "degenerate": np.vstack([F, [[0, 0, 1]]])}
+             "a flipped duplicate": np.vstack([F, F[:1, ::-1]]), "degenerate": np.vstack([F, [[0, 0, 1]]]),
+             "an edge of three faces": np.vstack([F, [[F[0, 1], F[0, 0], 8]]]),
+             "an open fin": np.vstack([F[1:], [[F[0, 1], F[0, 0], 8]]])}
     for name, faces in cases.items():
-        defective, over_two, borders = _edge_census(faces, len(box.vertices))
-        m = trimesh.Trimesh(box.vertices, faces, process=False)
+        defective, over_two, borders = _edge_census(faces, len(V))
+        m = trimesh.Trimesh(V, faces, process=False)
         counts = np.unique(m.edges_sorted, axis=0, return_counts=True)[1]
         directed = np.unique(m.edges, axis=0, return_counts=True)[1]
         degenerate = bool((faces[:, 0] == faces[:, 1]).any())
@@ -356,6 +359,7 @@ def test_edge_census_against_trimesh():
         assert defective == (over_two or degenerate or bool((directed > 1).any())), name
         assert borders == int((counts == 1).sum()), name
     assert _edge_census(F, 8) == (False, False, 0) and _edge_census(F[1:], 8)[2] == 3
+    assert _edge_census(cases["an edge of three faces"], 9)[:2] == (True, True)
     # two faces back to back pass the edge test (each edge twice, in opposite directions),
     # and MeshLib would make a hole of them: the first pass is refused for repeated corners
     from robotkit.mesh.decimate import _repeated_faces

@@ -231,8 +231,9 @@ def _edge_census(F: np.ndarray, n_vertices: int) -> tuple[bool, bool, int]:
     pair = edge[1:] == edge[:-1]  # sorted: an edge's faces are neighbours
     over_two = bool((pair[1:] & pair[:-1]).any())
     defective = over_two or bool((a == b).any()) or bool((key[1:] == key[:-1]).any())
-    borders = len(edge) - 2 * int(pair.sum()) if not over_two else int((~(np.r_[False, pair] | np.r_[pair, False])).sum())
-    return defective, over_two, borders
+    if not over_two:  # every edge has one or two faces
+        return defective, over_two, len(edge) - 2 * int(pair.sum())
+    return defective, over_two, int((~(np.r_[False, pair] | np.r_[pair, False])).sum())
 
 
 CLOSED = (False, False, 0)
