@@ -1,12 +1,15 @@
-"""Decimation side by side: robotkit (MeshLib) against meshlib called plainly, meshoptimizer,
-fast-simplification (robotkit's library before) and pymeshlab (MeshLab, the tool a user
-would otherwise use), on every visual mesh of the examples (recipes/meshes) and of the
-robots in ../shared/assets.
+"""Decimation side by side: robotkit (a meshoptimizer first pass where it keeps the topology,
+then MeshLib) against meshlib called plainly, meshoptimizer alone, fast-simplification
+(robotkit's library before MeshLib) and pymeshlab (MeshLab, the tool a user would otherwise
+use), on every visual mesh of the examples (recipes/meshes) and of the robots in
+../shared/assets.
 
 Per mesh, in a child process of its own (pymeshlab crashes on some inputs): load it once
 (robotkit.mesh.io.load_mesh: metres, coincident vertices merged), decimate it with every
-tool to the same target (a fraction of its faces), take the best of ``--repeat`` times
-per tool, interleaved, and measure the result independently of robotkit's code:
+tool to the same target (a fraction of its faces), take the best of ``--repeat`` runs per
+tool, interleaved, for wall time (``time.perf_counter``) and CPU time (``time.process_time``:
+every thread of the process, so a threaded library is not flattered on a shared machine),
+and measure the result independently of robotkit's code:
 
 - faces: the result's face count against the target (within 2 %?);
 - closed: closed before -> closed after (every edge used twice in opposite directions);
@@ -16,9 +19,10 @@ per tool, interleaved, and measure the result independently of robotkit's code:
   tolerance of 1e-12 on squared lengths: wrong by up to the triangle size for triangles
   under ~1e-2 units), reported over the diagonal.
 
-Prints one row per mesh and a summary: targets reached, closed meshes kept closed,
-robotkit's Hausdorff over plain meshlib's, pymeshlab's time over robotkit's (median and over
-the sum of times).  ``python benchmarks/bench_decimate.py [--keep 0.1] [--repeat 3]
+Prints the load average before and after, one row per mesh (faces, wall ms, Hausdorff) and
+a summary: targets reached, closed meshes kept closed, robotkit's Hausdorff over plain
+meshlib's, every tool's wall and CPU time over robotkit's (median and over the sum of
+times).  ``python benchmarks/bench_decimate.py [--keep 0.1] [--repeat 3]
 [--samples 5000] [--json out.json] [--only SUBSTRING]``.  Needs ``pip install pymeshlab
 meshoptimizer fast-simplification`` (benchmark only).
 """
@@ -161,15 +165,18 @@ def one(path: str, keep: float, repeat: int, samples: int, tools: list[str]) -> 
         except Exception as exc:  # noqa: BLE001 - a tool's failure is a result
             row["tools"][name] = {"error": f"{type(exc).__name__}: {exc}"[:120]}
     times = {n: [] for n in tools if n not in row["tools"]}
+    cpus = {n: [] for n in times}
     results = {}
     for _ in range(repeat):
         for name in times:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             results[name] = TOOLS[name](V, F, target)
+            cpus[name].append(time.process_time() - c0)  # CPU of every thread of this process
             times[name].append(time.perf_counter() - t0)
     for name, (v, f) in results.items():
         f = np.asarray(f, np.int64)
-        row["tools"][name] = {"faces": int(len(f)), "time": min(times[name]), "closed": is_closed(f),
+        row["tools"][name] = {"faces": int(len(f)), "time": min(times[name]), "cpu": min(cpus[name]),
+                              "closed": is_closed(f),
                               "hausdorff": hausdorff(V, F, np.asarray(v, np.float64), f, samples)}
     return row
 
@@ -240,6 +247,7 @@ def main() -> int:
                          f"{r['faces']:>6} {r['time'] * 1000:7.1f}ms {r['hausdorff']:.1e} {'C' if r['closed'] else 'o'}")
         print(f"{os.path.relpath(path, REPO.parent)[-44:]:44} {row['faces']:>7} {row['target']:>6} "
               f"{'C' if row['closed'] else 'o'} | " + " | ".join(cells), flush=True)
+    print(f"load average at the end {os.getloadavg()[0]:.1f}")
     summary(rows, tools)
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
@@ -268,10 +276,11 @@ def summary(rows, tools):
                 and "error" not in r["tools"].get(other, {"error": 1})]
         if not both or other not in tools:
             continue
-        ratio = np.array([r["tools"][other]["time"] / r["tools"]["robotkit"]["time"] for r in both])
-        total = sum(r["tools"][other]["time"] for r in both) / sum(r["tools"]["robotkit"]["time"] for r in both)
-        print(f"  time {other} / robotkit: median {np.median(ratio):.2f}, over the sum {total:.2f}, "
-              f"min {ratio.min():.2f} ({len(both)} meshes)")
+        for clock in ("time", "cpu"):
+            ratio = np.array([r["tools"][other][clock] / r["tools"]["robotkit"][clock] for r in both])
+            total = sum(r["tools"][other][clock] for r in both) / sum(r["tools"]["robotkit"][clock] for r in both)
+            print(f"  {'wall' if clock == 'time' else 'CPU '} {other} / robotkit: median {np.median(ratio):.2f}, "
+                  f"over the sum {total:.2f}, min {ratio.min():.2f} ({len(both)} meshes)")
 
 
 if __name__ == "__main__":

@@ -2,8 +2,8 @@
 
 **Key.**  sha256 over canonical JSON of: the cache format version, the
 operation name, the effective parameters, the versions of the libraries that
-can change a result (trimesh, coacd, meshlib (decimation), manifold3d, numpy,
-scipy) and robotkit's version, followed by the digest of every input (raw
+can change a result (trimesh, coacd, meshlib and meshoptimizer (decimation),
+manifold3d, numpy, scipy) and robotkit's version, followed by the digest of every input (raw
 bytes, or :func:`mesh_digest` of a mesh).  Changing any of them is a miss.
 
 **Location.**  ``Cache(root)``; by default ``$ROBOTKIT_CACHE``, else
@@ -55,7 +55,7 @@ import numpy as np
 
 CACHE_FORMAT = 1
 REPORT_ENV = "ROBOTKIT_CACHE_REPORT"
-LIBRARIES = ("trimesh", "coacd", "meshlib", "manifold3d", "numpy", "scipy")
+LIBRARIES = ("trimesh", "coacd", "meshlib", "meshoptimizer", "manifold3d", "numpy", "scipy")
 
 
 def default_root() -> Path:
