@@ -44,7 +44,7 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     findings = notes + lint(links, joints) + tree
     if not tree:
         findings = validate_urdf(path) + findings
-        build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths)
+        build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths, foreign=True)
         findings += _stage("consumers", f"robot '{path.stem}'", lambda: consumer_findings(build, URDF_CONSUMERS)[0])
     return locate([f if f.file or f.subject not in lines else replace(f, file=str(path), line=lines[f.subject])
                    for f in findings], path)

@@ -118,7 +118,8 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         warnings.append(f"robot name '{robot_name}' is not a valid recipe name; using '{fixed}'")
         robot_name = fixed
 
-    # global materials (first definition of a name wins, as in urdfdom)
+    # global materials (first definition of a name wins, as in urdfdom; a definition inside a link's
+    # visual joins them for the name-only references of the links after it)
     global_materials: dict[str, ET.Element] = {}
     for el in et_children:
         if _local(el.tag) == "material" and el.get("name") and el.get("name") not in global_materials:
@@ -132,6 +133,8 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         name = vis_mat.get("name") or ""
         rgba = _rgba(vis_mat, f"link '{link}': material '{name}'", problems, warnings)
         texture = vis_mat.find("texture")
+        if (rgba is not None or texture is not None) and name:  # urdfdom: a link's definition serves later links
+            global_materials.setdefault(name, vis_mat)
         if rgba is None and name in global_materials:
             g = global_materials[name]
             rgba = _rgba(g, f"material '{name}'", problems, warnings)

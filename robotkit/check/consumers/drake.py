@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View
+from robotkit.check.consumers import Missing, Refused, View, with_mesh_paths
 
 
 def _load(build, path) -> View:
@@ -51,8 +51,20 @@ def _load(build, path) -> View:
     return View(masses, poses)
 
 
+DRAKE_MESHES = (".obj", ".vtk", ".gltf")
+
+
 def from_urdf(build) -> View:
-    return _load(build, build.urdf)
+    if not build.foreign:
+        return _load(build, build.urdf)
+    with with_mesh_paths(build, DRAKE_MESHES) as (urdf, converted):
+        view = _load(build, urdf)
+    if converted:  # the robot is fine; Drake needs the conversion a build makes
+        shown = ", ".join(f"'{u}'" for u in converted[:3]) + (f" and {len(converted) - 3} more"
+                                                                  if len(converted) > 3 else "")
+        view.notes.append(f"reads meshes only as OBJ, VTK or glTF: {shown} given to it as OBJ here "
+                          "(a build converts them)")
+    return view
 
 
 def from_sdf(build) -> View:

@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View
+from robotkit.check.consumers import Missing, Refused, View, with_mesh_paths
 
 
 MAX_LINKS = 128
@@ -31,6 +31,16 @@ def _quiet():
                 os.close(fd)
 
 
+DEFAULT_MASS = 1.0  # what PyBullet gives a link without <inertial>
+
+
+def _without_inertial(urdf) -> set[str]:
+    from lxml import etree
+
+    root = etree.parse(str(urdf), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+    return {el.get("name") for el in root.iter("link") if el.find("inertial") is None}
+
+
 def _T(pos, orn) -> np.ndarray:
     import pybullet as p
 
@@ -46,11 +56,11 @@ def from_urdf(build) -> View:
             import pybullet as p
     except ImportError:
         raise Missing("PyBullet is not installed (pip install pybullet)") from None
-    with _quiet():
+    with _quiet(), with_mesh_paths(build) as (urdf, _):  # PyBullet knows no ROS packages
         client = p.connect(p.DIRECT)
         try:
             # loaded free, so the base keeps its mass from the file (a fixed base is reported massless)
-            body = p.loadURDF(str(build.urdf), useFixedBase=False,
+            body = p.loadURDF(str(urdf), useFixedBase=False,
                               flags=p.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
         except p.error as exc:
             p.disconnect(client)
@@ -67,6 +77,15 @@ def from_urdf(build) -> View:
     masses = {base: p.getDynamicsInfo(body, -1, physicsClientId=client)[0]}
     masses.update({info[i][12].decode(): p.getDynamicsInfo(body, i, physicsClientId=client)[0] for i in range(n)})
     local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+    notes = []
+    defaulted = sorted(n for n in _without_inertial(build.urdf) if masses.get(n) == DEFAULT_MASS)
+    if defaulted:  # URDF's frames (no <inertial>, massless to urdfdom): PyBullet's own default, not the robot's
+        shown = ", ".join(f"'{n}'" for n in defaulted[:4]) + (f" and {len(defaulted) - 4} more"
+                                                               if len(defaulted) > 4 else "")
+        notes.append(f"gives each link without <inertial> {DEFAULT_MASS:g} kg: {shown} "
+                     f"({len(defaulted) * DEFAULT_MASS:g} kg more than the description; a build writes a token "
+                     "mass that PyBullet keeps)")
+        masses.update({n: 0.0 for n in defaulted})
 
     def poses(q: dict[str, float]) -> dict[str, np.ndarray]:
         for i in range(n):
@@ -80,4 +99,4 @@ def from_urdf(build) -> View:
             out[info[i][12].decode()] = _T(s[4], s[5])
         return out
 
-    return View(masses, poses, pose_tol=PRECISION)
+    return View(masses, poses, pose_tol=PRECISION, notes=notes)
