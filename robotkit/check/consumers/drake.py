@@ -59,6 +59,7 @@ def from_urdf(build) -> View:
         return _load(build, build.urdf)
     with with_mesh_paths(build, DRAKE_MESHES) as (urdf, converted):
         view = _load(build, urdf)
+    converted = list(dict.fromkeys(converted))  # a mesh named twice is listed once
     if converted:  # the robot is fine; Drake needs the conversion a build makes
         shown = ", ".join(f"'{u}'" for u in converted[:3]) + (f" and {len(converted) - 3} more"
                                                                   if len(converted) > 3 else "")
