@@ -57,7 +57,8 @@ PANEL = 1.0 / 6 * 0.1 ** 2  # a 1 kg cube of 0.1 m: its principal moments
 
 def make_arm_kit(root: Path) -> Path:
     """A package 'arm_kit': a chain of segments made by a recursive macro from YAML limits (in
-    degrees), a frame 'tool0' without <inertial>, STL collision and DAE visual meshes."""
+    degrees), a frame 'tool0' without <inertial>, STL collision and DAE visual meshes, and text
+    in <robot> outside any element."""
     pkg = root / "arm_kit"
     _write(pkg / "package.xml", """
         <?xml version="1.0"?>
@@ -119,6 +120,7 @@ def make_arm_kit(root: Path) -> Path:
             <shape><geometry><mesh filename="package://arm_kit/meshes/segment.stl"/></geometry></shape>
           </xacro:arm>
           <link name="tool0"/>
+            the tool frame, a note left outside any comment (ANYmal's URDF has one) -->
           <joint name="flange" type="fixed"><parent link="seg${count}"/><child link="tool0"/>
             <origin xyz="0 0 0.1"/></joint>
         </robot>

@@ -87,10 +87,9 @@ def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
     from robotkit.mesh.export import obj_bytes
     from robotkit.mesh.io import load_mesh
 
-    # one element a line: PyBullet loses characters of long lines (measured with 3.2.7: a URDF written
-    # on one line of 9 kB, as xacro expansions are, fails to parse)
-    tree = etree.parse(str(build.urdf), etree.XMLParser(resolve_entities=False, no_network=True,
-                                                        remove_blank_text=True))
+    tree = etree.parse(str(build.urdf), etree.XMLParser(resolve_entities=False, no_network=True))
+    for el in tree.getroot().iter():  # a line after each element: PyBullet loses characters of long lines
+        el.tail = (el.tail or "") + "\n"  # (measured with 3.2.7: a xacro expansion on one line of 9 kB fails)
     converted = []
     with tempfile.TemporaryDirectory(prefix="robotkit-consumer-") as tmp:
         for k, mesh in enumerate(tree.getroot().iter("mesh")):
@@ -105,7 +104,7 @@ def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
                 path = obj
             mesh.set("filename", str(path.absolute()))
         copy = Path(tmp) / build.urdf.name
-        tree.write(str(copy), xml_declaration=True, encoding="utf-8", pretty_print=True)
+        tree.write(str(copy), xml_declaration=True, encoding="utf-8")
         yield copy, converted
 
 
