@@ -289,3 +289,54 @@ def test_a_material_defined_in_a_link_colours_the_links_that_name_it_after(tmp_p
     assert data["materials"] == {"black": {"rgba": [0.2, 0.2, 0.2, 1]}}
     assert [v["material"] for v in data["links"]["finger"]["visual"]] == ["black", "black"]
     assert not [w for w in result.warnings if "material" in w], result.warnings
+
+
+# ---------------------------------------------------------------- xacro's generated elements and attributes
+
+
+TRAITS_XACRO = """
+    <robot xmlns:xacro="http://wiki.ros.org/xacro" name="traits">
+      <xacro:property name="late" value="${early * 2}"/>
+      <xacro:property name="early" value="0.25"/>
+      <xacro:include filename="parts.xacro" ns="parts"/>
+      <xacro:parts.box name="base"/>
+      <xacro:call macro="parts.box" name="arm"/>
+      <xacro:element xacro:name="joint" name="shoulder" type="revolute">
+        <parent link="base"/><child link="arm"/>
+        <origin xyz="0 ${late} 0.3" rpy="${radians(90)} 0 ${pi/4}"/>
+        <axis xyz="0 0 1"/>
+        <limit effort="10" velocity="1"><xacro:attribute name="lower" value="LOWER"/>
+          <xacro:attribute name="upper" value="UPPER"/></limit>
+      </xacro:element>
+    </robot>
+"""
+
+
+def test_a_number_set_by_xacro_attribute_is_written_as_xacro_writes_attributes(tmp_path):
+    """``<xacro:attribute value="${-pi/2}"/>`` leaves a number where xacro's writer wants text
+    (xacro 2.1 fails with AttributeError on such a file); robotkit writes it as xacro writes every
+    other attribute, str() of the value, and the robot equals xacro's expansion of the same file
+    with the value given as text."""
+    _write(tmp_path / "parts.xacro", """
+        <robot xmlns:xacro="http://wiki.ros.org/xacro">
+          <xacro:macro name="box" params="name">
+            <link name="${name}">
+              <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+              <visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>
+            </link>
+          </xacro:macro>
+        </robot>
+    """)
+    source = _write(tmp_path / "traits.urdf.xacro",
+                    TRAITS_XACRO.replace("LOWER", "${-pi/2}").replace("UPPER", "${math.pi/2}"))
+    text = _write(tmp_path / "traits_text.urdf.xacro",
+                  TRAITS_XACRO.replace("LOWER", "${str(-pi/2)}").replace("UPPER", "${str(math.pi/2)}"))
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    limit = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))["joints"]["shoulder"]["limit"]
+    assert (limit["lower"], limit["upper"]) == (-3.141592653589793 / 2, 3.141592653589793 / 2)
+    built = build([result.recipe_path], tmp_path / "build")
+    assert not built.errors, built.errors
+    original = xacro_reference(text, {}, {}, tmp_path / "original.urdf")
+    assert compare(read_urdf(original), read_urdf(tmp_path / "build" / "traits" / "urdf" / "traits.urdf"), TOL) == []
+    proc = run_cli("check", source, cwd=tmp_path)
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stdout + proc.stderr
