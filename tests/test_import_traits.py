@@ -176,6 +176,17 @@ def test_check_passes_a_clean_original_with_package_meshes_and_frames(arm_kit):
     assert lines[-1].endswith(": 0 errors, 2 warnings"), lines[-1]
 
 
+def test_the_package_around_the_file_needs_no_package_path(arm_kit):
+    """As ROS finds a package's own files, import and check find the package the file sits in
+    (by its package.xml) for its ``$(find)`` and ``package://``."""
+    root, entry, packages, result, robot_dir, errors = arm_kit
+    again = import_file(entry, root / "recipe_own" / "robot.yaml", {}, {})
+    assert yaml.safe_load(again.recipe_path.read_text(encoding="utf-8")) == \
+        yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
+    proc = run_cli("check", entry, cwd=root)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
 # ---------------------------------------------------------------- a massless link welded above a moving joint
 
 GRIPPER = """

@@ -57,9 +57,10 @@ def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, 
     import re
     import tempfile
 
+    from robotkit.importer.package_xml import with_own_package
     from robotkit.importer.xacro_expand import check_package_paths, expand
 
-    packages = check_package_paths(package_paths)
+    packages = with_own_package(path.absolute(), check_package_paths(package_paths))
     text = expand(path, packages, args).text
 
     def absolute(m: re.Match) -> str:  # relative mesh paths stay relative to the xacro file
