@@ -351,3 +351,25 @@ def test_a_number_set_by_xacro_attribute_is_written_as_xacro_writes_attributes(t
     assert compare(read_urdf(original), read_urdf(tmp_path / "build" / "traits" / "urdf" / "traits.urdf"), TOL) == []
     proc = run_cli("check", source, cwd=tmp_path)
     assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stdout + proc.stderr
+
+
+def test_gazebo_s_reading_of_a_planar_joint_is_a_refusal_not_a_crash(tmp_path):
+    """libsdformat's URDF conversion drops a planar joint and leaves its child posed relative to
+    it: the model it prints cannot load, which check reports (it raised KeyError)."""
+    urdf = _write(tmp_path / "cart.urdf", """
+        <robot name="cart">
+          <link name="world"/>
+          <joint name="floor" type="planar"><parent link="world"/><child link="base"/><axis xyz="0 0 1"/></joint>
+          <link name="base">
+            <inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>
+          </link>
+          <joint name="spin" type="continuous"><parent link="base"/><child link="wheel"/><axis xyz="0 1 0"/></joint>
+          <link name="wheel">
+            <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+          </link>
+        </robot>
+    """)
+    findings, summary = consumer_findings(Build("cart", tmp_path, urdf, None, None), ["Gazebo (URDF)"])
+    assert [str(f) for f in findings] == [
+        "error: robot 'cart': Gazebo (URDF) refuses the robot: libsdformat's reading is not a model it can load: "
+        "a pose is relative to 'floor', which the model does not define [consumer]"]
