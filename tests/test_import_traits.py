@@ -373,3 +373,48 @@ def test_gazebo_s_reading_of_a_planar_joint_is_a_refusal_not_a_crash(tmp_path):
     assert [str(f) for f in findings] == [
         "error: robot 'cart': Gazebo (URDF) refuses the robot: libsdformat's reading is not a model it can load: "
         "a pose is relative to 'floor', which the model does not define [consumer]"]
+
+
+# ---------------------------------------------------------------- ros2_control's transmissions
+
+ROS2_TRANSMISSION = """
+    <robot name="wrist">
+      <link name="base">
+        <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+      </link>
+      <joint name="roll_joint" type="revolute"><parent link="base"/><child link="hand"/><axis xyz="1 0 0"/>
+        <limit lower="-2" upper="2" effort="3" velocity="2"/></joint>
+      <link name="hand">
+        <inertial><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>
+      </link>
+      <transmission name="roll_trans">
+        <plugin>transmission_interface/SimpleTransmission</plugin>
+        <actuator name="roll_motor" role="actuator1"/>
+        <joint name="roll_joint" role="joint1"><mechanical_reduction>1.0</mechanical_reduction></joint>
+      </transmission>
+    </robot>
+"""
+
+
+def test_a_transmission_in_ros2_control_s_form_loads_in_drake(tmp_path):
+    """TIAGo's transmissions name their class in <plugin>, ros2_control's form, and have no
+    <type>, without which Drake refuses the URDF: the build's URDF carries both (and says so),
+    and check gives Drake the original that way, with a note instead of a refusal."""
+    urdf = _write(tmp_path / "wrist.urdf", ROS2_TRANSMISSION)
+    result = import_file(urdf, tmp_path / "recipe" / "robot.yaml", {}, {})
+    built = build([result.recipe_path], tmp_path / "build")
+    assert not built.errors, built.errors
+    robot_dir = tmp_path / "build" / "wrist"
+    text = (robot_dir / "urdf" / "wrist.urdf").read_text(encoding="utf-8")
+    assert ("<transmission name=\"roll_trans\"><type>transmission_interface/SimpleTransmission</type>\n"
+            "  <plugin>transmission_interface/SimpleTransmission</plugin>") in text
+    findings, summary = consumer_findings(Build("wrist", robot_dir, robot_dir / "urdf" / "wrist.urdf", None, None),
+                                          ["Drake (URDF)"])
+    assert [str(f) for f in findings] == [] and summary["Drake (URDF)"]["loaded"]
+    report = (robot_dir / "report.json").read_text(encoding="utf-8")
+    assert ("transmission 'roll_trans' names its class in <plugin> only: written with "
+            "<type>transmission_interface/SimpleTransmission</type> too, without which Drake refuses the URDF") in report
+    proc = run_cli("check", urdf, cwd=tmp_path)
+    assert ("  warning: Drake (URDF): reads a <transmission> only with a <type>: 'roll_trans' given to it with the "
+            "class of their <plugin> here (a build writes it) [consumer]") in proc.stdout.splitlines(), proc.stdout
+    assert "refuses" not in proc.stdout

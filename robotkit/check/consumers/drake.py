@@ -57,15 +57,25 @@ DRAKE_MESHES = (".obj", ".vtk", ".gltf")
 def from_urdf(build) -> View:
     if not build.foreign:
         return _load(build, build.urdf)
+    from robotkit.emit.urdf import typed_transmissions
+
     with with_mesh_paths(build, DRAKE_MESHES) as (urdf, converted):
+        text, typed = typed_transmissions(urdf.read_text(encoding="utf-8"))
+        urdf.write_text(text, encoding="utf-8")
         view = _load(build, urdf)
-    converted = list(dict.fromkeys(converted))  # a mesh named twice is listed once
+    if typed:  # ros2_control's form: the robot is fine, Drake needs what a build writes
+        view.notes.append(f"reads a <transmission> only with a <type>: {_listed(n for n, _ in typed)} given to it "
+                          "with the class of their <plugin> here (a build writes it)")
     if converted:  # the robot is fine; Drake needs the conversion a build makes
-        shown = ", ".join(f"'{u}'" for u in converted[:3]) + (f" and {len(converted) - 3} more"
-                                                                  if len(converted) > 3 else "")
-        view.notes.append(f"reads meshes only as OBJ, VTK or glTF: {shown} given to it as OBJ here "
+        view.notes.append(f"reads meshes only as OBJ, VTK or glTF: {_listed(converted)} given to it as OBJ here "
                           "(a build converts them)")
     return view
+
+
+def _listed(names) -> str:
+    """The first three names quoted, and how many more (each once)."""
+    names = [f"'{n}'" for n in dict.fromkeys(names)]
+    return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
 
 
 def from_sdf(build) -> View:
