@@ -418,3 +418,20 @@ def test_a_transmission_in_ros2_control_s_form_loads_in_drake(tmp_path):
     assert ("  warning: Drake (URDF): reads a <transmission> only with a <type>: 'roll_trans' given to it with the "
             "class of their <plugin> here (a build writes it) [consumer]") in proc.stdout.splitlines(), proc.stdout
     assert "refuses" not in proc.stdout
+
+
+def test_verbatim_elements_do_not_depend_on_whether_xacro_was_imported(tmp_path):
+    """xacro replaces minidom's writer for the whole process when it is imported (attributes
+    sorted, whitespace dropped): the recipe's urdf_extras keep the source's attribute order and
+    layout all the same."""
+    import xacro  # noqa: F401  (the import is the point)
+
+    urdf = _write(tmp_path / "wrist.urdf", ROS2_TRANSMISSION.replace(
+        "</robot>", '  <gazebo reference="hand">\n    <sensor type="ray" name="lidar"/>\n  </gazebo>\n</robot>'))
+    result = import_file(urdf, tmp_path / "recipe" / "robot.yaml", {}, {})
+    extras = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))["urdf_extras"]
+    assert extras == [
+        '<transmission name="roll_trans">\n  <plugin>transmission_interface/SimpleTransmission</plugin>\n'
+        '  <actuator name="roll_motor" role="actuator1"/>\n  <joint name="roll_joint" role="joint1">'
+        '<mechanical_reduction>1.0</mechanical_reduction></joint>\n</transmission>',
+        '<gazebo reference="hand">\n  <sensor type="ray" name="lidar"/>\n</gazebo>']
