@@ -69,6 +69,12 @@ class Build:
     foreign: bool = False  # a URDF as its author wrote it (check on an original), not a build's
 
 
+def listed(names) -> str:
+    """The first three names quoted, and how many more (each once): for a note on many links."""
+    names = [f"'{n}'" for n in dict.fromkeys(names)]
+    return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+
+
 @contextlib.contextmanager
 def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
     """A foreign URDF as a program that knows no ROS packages reads it: a copy whose mesh URIs are

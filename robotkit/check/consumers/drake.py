@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View, with_mesh_paths
+from robotkit.check.consumers import Missing, Refused, View, listed, with_mesh_paths
 
 
 def _load(build, path) -> View:
@@ -64,18 +64,12 @@ def from_urdf(build) -> View:
         urdf.write_text(text, encoding="utf-8")
         view = _load(build, urdf)
     if typed:  # ros2_control's form: the robot is fine, Drake needs what a build writes
-        view.notes.append(f"reads a <transmission> only with a <type>: {_listed(n for n, _ in typed)} given to it "
+        view.notes.append(f"reads a <transmission> only with a <type>: {listed(n for n, _ in typed)} given to it "
                           "with the class of their <plugin> here (a build writes it)")
     if converted:  # the robot is fine; Drake needs the conversion a build makes
-        view.notes.append(f"reads meshes only as OBJ, VTK or glTF: {_listed(converted)} given to it as OBJ here "
+        view.notes.append(f"reads meshes only as OBJ, VTK or glTF: {listed(converted)} given to it as OBJ here "
                           "(a build converts them)")
     return view
-
-
-def _listed(names) -> str:
-    """The first three names quoted, and how many more (each once)."""
-    names = [f"'{n}'" for n in dict.fromkeys(names)]
-    return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
 
 
 def from_sdf(build) -> View:

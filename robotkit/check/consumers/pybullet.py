@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View, with_mesh_paths
+from robotkit.check.consumers import Missing, Refused, View, listed, with_mesh_paths
 
 
 MAX_LINKS = 128
@@ -80,9 +80,7 @@ def from_urdf(build) -> View:
     notes = []
     defaulted = sorted(n for n in _without_inertial(build.urdf) if masses.get(n) == DEFAULT_MASS)
     if defaulted:  # URDF's frames (no <inertial>, massless to urdfdom): PyBullet's own default, not the robot's
-        shown = ", ".join(f"'{n}'" for n in defaulted[:4]) + (f" and {len(defaulted) - 4} more"
-                                                               if len(defaulted) > 4 else "")
-        notes.append(f"gives each link without <inertial> {DEFAULT_MASS:g} kg: {shown} "
+        notes.append(f"gives each link without <inertial> {DEFAULT_MASS:g} kg: {listed(defaulted)} "
                      f"({len(defaulted) * DEFAULT_MASS:g} kg more than the description; a build writes a token "
                      "mass that PyBullet keeps)")
         masses.update({n: 0.0 for n in defaulted})
