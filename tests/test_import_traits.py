@@ -170,7 +170,8 @@ def test_check_passes_a_clean_original_with_package_meshes_and_frames(arm_kit):
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "refuses" not in proc.stdout
     assert ("  warning: Drake (URDF): reads meshes only as OBJ, VTK or glTF: 'package://arm_kit/meshes/segment.dae', "
-            "'package://arm_kit/meshes/segment.stl' given to it as OBJ here (a build converts them) [consumer]") in lines
+            "'package://arm_kit/meshes/segment.stl' given to it as OBJ here (a build converts them) "
+            "[consumer]") in lines
     assert ("  warning: PyBullet (URDF): gives each link without <inertial> 1 kg: 'tool0' (1 kg more than the "
             "description; a build writes a token mass that PyBullet keeps) [consumer]") in lines
     assert lines[-1].endswith(": 0 errors, 2 warnings"), lines[-1]
@@ -413,7 +414,8 @@ def test_a_transmission_in_ros2_control_s_form_loads_in_drake(tmp_path):
     assert [str(f) for f in findings] == [] and summary["Drake (URDF)"]["loaded"]
     report = (robot_dir / "report.json").read_text(encoding="utf-8")
     assert ("transmission 'roll_trans' names its class in <plugin> only: written with "
-            "<type>transmission_interface/SimpleTransmission</type> too, without which Drake refuses the URDF") in report
+            "<type>transmission_interface/SimpleTransmission</type> too, without which Drake refuses the "
+            "URDF") in report
     proc = run_cli("check", urdf, cwd=tmp_path)
     assert ("  warning: Drake (URDF): reads a <transmission> only with a <type>: 'roll_trans' given to it with the "
             "class of their <plugin> here (a build writes it) [consumer]") in proc.stdout.splitlines(), proc.stdout
@@ -435,3 +437,39 @@ def test_verbatim_elements_do_not_depend_on_whether_xacro_was_imported(tmp_path)
         '  <actuator name="roll_motor" role="actuator1"/>\n  <joint name="roll_joint" role="joint1">'
         '<mechanical_reduction>1.0</mechanical_reduction></joint>\n</transmission>',
         '<gazebo reference="hand">\n  <sensor type="ray" name="lidar"/>\n</gazebo>']
+
+
+# ---------------------------------------------------------------- a repaired tensor MuJoCo accepts
+
+
+def test_a_tensor_repaired_to_the_triangle_inequality_stays_inside_it_once_rotated(tmp_path):
+    """A repair that lands exactly on I1 + I2 = I3 comes back from its principal axes a rounding
+    short of it, and MuJoCo refused Romeo's arm for it: the repair lands TRIANGLE_TOL inside."""
+    import numpy as np
+
+    from robotkit.model.inertia_policy import TRIANGLE_TOL, repair
+
+    c, s = np.cos(0.3), np.sin(0.3)
+    R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    given = R @ np.diag([0.00066, 0.00068, 0.0066]) @ R.T
+    fixed = repair(0.57, given, 1e-3).inertia
+    a, b, big = np.linalg.eigvalsh(fixed)
+    assert a + b >= big * (1 + TRIANGLE_TOL / 2)
+    ixx, ixy, ixz, iyy, iyz, izz = (float(given[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)))
+    urdf = _write(tmp_path / "arm.urdf", f"""
+        <robot name="arm">
+          <link name="base"><inertial><mass value="2"/>
+            <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+          <joint name="yaw" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+            <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+          <link name="upper"><inertial><mass value="0.57"/>
+            <inertia ixx="{ixx!r}" ixy="{ixy!r}" ixz="{ixz!r}" iyy="{iyy!r}" iyz="{iyz!r}" izz="{izz!r}"/>
+          </inertial></link>
+        </robot>
+    """)
+    result = import_file(urdf, tmp_path / "recipe" / "robot.yaml", {}, {})
+    assert result.repairs["upper"].startswith("the original's principal moments 0.00066, 0.00068, 0.0066 violate "
+                                              "the triangle inequality")
+    built = build([result.recipe_path], tmp_path / "build")
+    assert not built.errors, built.errors
+    mujoco().MjModel.from_xml_path(str(tmp_path / "build" / "arm" / "mjcf" / "arm.xml"))

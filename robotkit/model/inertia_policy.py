@@ -97,7 +97,10 @@ def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
     a, b, c = new
     excess = c - (a + b)
     if excess > c * TRIANGLE_TOL:
-        new = np.array([a + excess / 3, b + excess / 3, c - excess / 3])
+        # a third of the excess each way, and TRIANGLE_TOL more: a tensor exactly on the boundary
+        # comes back from its rotation a rounding short of it, which MuJoCo refuses (Romeo's arms)
+        d = (excess + c * TRIANGLE_TOL) / (3 + TRIANGLE_TOL)
+        new = np.array([a + d, b + d, c - d])
         changes.append(f"principal moments {_moments((a, b, c))} moved to {_moments(new)} "
                        "to meet the triangle inequality")
     if not changes:
