@@ -1,8 +1,8 @@
 """Issue 14: traits of real robots outside the corpus, each in a small description written here.
 
-Held-back robots of the kinds the issue names (UR, Franka, Robotiq, Allegro, ABB) were rebuilt
-from their public sources and run through import, build, the consumers and check; what broke is
-reproduced below without their files:
+Held-back robots of the kinds the issue names (UR, Franka, Robotiq, Allegro, ABB, KUKA, ANYmal,
+Husky, TIAGo, Kinova, Sawyer, Romeo) were rebuilt from their public sources and run through
+import, build, the consumers and check; what broke is reproduced below without their files:
 
 - a package whose xacro reads YAML (``xacro.load_yaml`` with ``!degrees``), passes the loaded
   dictionaries through macro parameters, takes ``^`` defaults from the caller's scope, computes
@@ -17,7 +17,11 @@ reproduced below without their files:
   it, so import gives it mass, check names it on the original, and a hand-written recipe does
   not build a URDF that Gazebo would read without it;
 - a material defined inside one link's visual and named alone by the next links (Allegro):
-  the colour urdfdom gives them, not grey.
+  the colour urdfdom gives them, not grey;
+- ``xacro:attribute`` with a number (xacro itself fails writing it), a URDF planar joint in
+  Gazebo's reading, transmissions in ros2_control's form (TIAGo: Drake wants ``<type>``),
+  verbatim elements written the same whether or not xacro was imported, and a tensor repaired
+  to the triangle inequality that MuJoCo accepts once rotated (Romeo).
 """
 
 from __future__ import annotations
