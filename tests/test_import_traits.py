@@ -477,3 +477,27 @@ def test_a_tensor_repaired_to_the_triangle_inequality_stays_inside_it_once_rotat
     built = build([result.recipe_path], tmp_path / "build")
     assert not built.errors, built.errors
     mujoco().MjModel.from_xml_path(str(tmp_path / "build" / "arm" / "mjcf" / "arm.xml"))
+
+
+def test_check_finds_the_package_around_a_urdf_in_a_folder_named_otherwise(tmp_path):
+    """A package checked out as 'kit-main' is package 'kit' by its package.xml: check reads its
+    meshes without --package-path (it looked for a folder named 'kit')."""
+    pkg = tmp_path / "kit-main"
+    _write(pkg / "package.xml", """
+        <?xml version="1.0"?>
+        <package format="3"><name>kit</name><version>0.1.0</version><description>kit</description>
+          <maintainer email="kit@example.com">Kit</maintainer><license>BSD</license></package>
+    """)
+    _box_mesh(pkg / "meshes" / "part.stl", 0.1)
+    urdf = _write(pkg / "urdf" / "kit.urdf", f"""
+        <robot name="kit">
+          <link name="base">
+            <inertial><mass value="1"/><inertia ixx="{PANEL!r}" ixy="0" ixz="0" iyy="{PANEL!r}" iyz="0"
+              izz="{PANEL!r}"/></inertial>
+            <visual><geometry><mesh filename="package://kit/meshes/part.stl"/></geometry></visual>
+          </link>
+        </robot>
+    """)
+    proc = run_cli("check", urdf, cwd=tmp_path)
+    assert "[mesh-file]" not in proc.stdout, proc.stdout
+    assert proc.returncode == 0, proc.stdout + proc.stderr

@@ -35,7 +35,9 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     consumers are not given it (check_urdf prints a cycle forever, simulators crash)."""
     from robotkit.check.consumers import Build, consumer_findings
     from robotkit.check.lints import lint, read_urdf_facts
+    from robotkit.importer.package_xml import with_own_package
 
+    package_paths = with_own_package(path.absolute(), package_paths)
     try:
         links, joints, notes = read_urdf_facts(path, package_paths)
     except (ValueError, TypeError) as exc:  # numbers that are not numbers
