@@ -250,8 +250,9 @@ def test_public_robot_imported_built_and_loaded_everywhere(tmp_path, name, entry
 
 def test_check_names_what_each_consumer_sees_on_a_foreign_urdf(assets):
     """PyBullet's KUKA iiwa: a massless root with only moving joints below it, which Gazebo's
-    conversion empties, and STL collision meshes, which Drake refuses; `robotkit check` says so
-    (and still runs every stage after a lint error)."""
+    conversion empties, and STL collision meshes, which Drake reads only as OBJ: `robotkit check`
+    gives them to it converted, says so, and Drake's reading shows the 1 kg it gives the root
+    (and every stage runs after a lint error)."""
     consumers_installed()
     robots = assets / "robots"
     proc = run_cli("check", robots / "kuka_iiwa" / "model.urdf", "--format", "json")
@@ -263,7 +264,9 @@ def test_check_names_what_each_consumer_sees_on_a_foreign_urdf(assets):
     assert "mass is 0.0" in messages  # the lints ran ...
     assert ("Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"
             in messages)  # ... and so did the consumers
-    assert any(m.startswith("Drake (URDF) refuses the robot: MakeConvexHull only applies to .obj") for m in messages)
+    assert "Drake (URDF): link 'lbr_iiwa_link_0' weighs 1 kg, the description says 0 kg" in messages
+    assert ("Drake (URDF): reads meshes only as OBJ, VTK or glTF: 'meshes/link_0.stl', 'meshes/link_1.stl', "
+            "'meshes/link_2.stl' and 5 more given to it as OBJ here (a build converts them)") in messages
 
 
 def test_check_names_the_1_kg_default_of_an_sdf_link(tmp_path):

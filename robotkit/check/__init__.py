@@ -36,7 +36,9 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     consumers are not given it (check_urdf prints a cycle forever, simulators crash)."""
     from robotkit.check.consumers import Build, consumer_findings
     from robotkit.check.lints import lint, read_urdf_facts
+    from robotkit.importer.package_xml import with_own_package
 
+    package_paths = with_own_package(path.absolute(), package_paths)
     try:
         links, joints, notes = read_urdf_facts(path, package_paths)
     except (ValueError, TypeError) as exc:  # numbers that are not numbers
@@ -45,7 +47,7 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     findings = notes + lint(links, joints) + tree
     if not tree:
         findings = validate_urdf(path) + findings
-        build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths)
+        build = Build(path.stem, path.parent, path, None, None, package_paths=package_paths, foreign=True)
         findings += _stage("consumers", f"robot '{path.stem}'", lambda: consumer_findings(build, URDF_CONSUMERS)[0])
     return locate([f if f.file or f.subject not in lines else replace(f, file=str(path), line=lines[f.subject])
                    for f in findings], path)
@@ -57,13 +59,11 @@ def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, 
     xacro file."""
     import tempfile
 
+    from robotkit.importer.package_xml import with_own_package
     from robotkit.importer.xacro_expand import check_package_paths, expand
 
-    import xml.dom.minidom
-
-    packages = check_package_paths(package_paths)
-    # indented as the xacro command writes it: PyBullet's reader fails on a long single line
-    text = xml.dom.minidom.parseString(expand(path, packages, args).text).toprettyxml(indent="  ")
+    packages = with_own_package(path.absolute(), check_package_paths(package_paths))
+    text = expand(path, packages, args).text
 
     def absolute(m: re.Match) -> str:  # relative mesh paths stay relative to the xacro file
         uri = m.group(2)

@@ -246,6 +246,8 @@ def read_sdf_text(text: str, source: str) -> KModel:
             return resolved[name]
         if depth > 100:
             raise ValueError(f"{source}: frame cycle at '{name}'")
+        if name not in frames:
+            raise ValueError(f"{source}: a pose is relative to '{name}', which the model does not define")
         T, rel = frames[name]
         resolved[name] = world(rel, depth + 1) @ T
         return resolved[name]

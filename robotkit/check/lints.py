@@ -465,6 +465,15 @@ def lint_massless_moving(links: list[LinkFacts], joints: list[JointFacts]) -> li
                                f"moves (joint '{j.name}') but has no mass: MuJoCo refuses to load the robot and "
                                "Gazebo drops the link with everything below it",
                                "give it an <inertial>; robotkit import computes one from its geometry"))
+    welded = {j.child for j in joints if j.type == "fixed"}
+    for name in sorted(welded & set(mass)):  # libsdformat weighs a welded link with the links welded below it only
+        moves = next((j for j in joints if j.parent == name and j.type in MOVING), None)
+        if moves is not None and name not in given and not body_mass(name) > 0:
+            out.append(Finding("error", "massless-moving", f"link '{name}'",
+                               f"joint '{moves.name}' moves below it but it has no mass, nor the links welded "
+                               "below it: Gazebo's URDF conversion drops everything that moves below it, though "
+                               "it is welded to a link with mass",
+                               "give it an <inertial>; robotkit import computes one from its geometry"))
     return out
 
 

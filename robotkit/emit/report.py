@@ -11,10 +11,16 @@ from robotkit.model.robot import Robot
 
 
 def urdf_losses(robot: Robot) -> list[str]:
+    from robotkit.emit.urdf import typed_transmissions
+
     out = []
     for j in robot.joints:
         if j.dynamics is not None and j.dynamics.armature:
             out.append(f"joint '{j.name}': armature is not written (URDF has no such joint property)")
+    for extra in robot.urdf_extras:
+        for name, kind in typed_transmissions(extra)[1]:
+            out.append(f"transmission '{name}' names its class in <plugin> only: written with <type>{kind}</type> "
+                       "too, without which Drake refuses the URDF")
     return out
 
 

@@ -22,6 +22,26 @@ def massless_mass(robot: Robot, link) -> float | None:
     return MASSLESS
 
 
+def typed_transmissions(text: str) -> tuple[str, list[tuple[str, str]]]:
+    """``text`` with a ``<type>`` given to each ``<transmission>`` that names its class only in
+    ``<plugin>`` (ros2_control's form): Drake refuses a transmission without ``<type>``, and the
+    readers of ``<plugin>`` do not look at it.  Returns (text, [(transmission, type)])."""
+    import re
+
+    added = []
+
+    def typed(m: re.Match) -> str:
+        block = m.group(0)
+        plugin = re.search(r"<plugin>\s*([^<]*?)\s*</plugin>", block)
+        if re.search(r"<type[\s>]", block) or plugin is None:
+            return block
+        name = re.search(r'\bname\s*=\s*["\']([^"\']*)', m.group(1))
+        added.append((name.group(1) if name else "", plugin.group(1)))
+        return f"{m.group(1)}<type>{plugin.group(1)}</type>{block[len(m.group(1)):]}"
+
+    return re.sub(r"(<transmission\b[^>]*>)[\s\S]*?</transmission>", typed, text), added
+
+
 def mesh_uri(robot: Robot, geom: Geom, role: str = "visual") -> str:
     from robotkit.emit.meshfiles import collision_file
 
@@ -85,6 +105,7 @@ def context(robot: Robot) -> dict:
 
     return {
         "robot": robot,
+        "extras": [typed_transmissions(x)[0] for x in robot.urdf_extras],
         "massless_note": any(link["massless"] for link in links),
         "massless_mass": MASSLESS,
         "sensors": contexts(robot),

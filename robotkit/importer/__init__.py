@@ -91,7 +91,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     """
     from robotkit.importer.defaults import factor_defaults
     from robotkit.importer.meshes import _open_meshes
-    from robotkit.importer.package_xml import package_metadata
+    from robotkit.importer.package_xml import package_metadata, with_own_package
     from robotkit.importer.recipe_writer import name_mesh_folders
     from robotkit.importer.urdf_to_recipe import dump_recipe, urdf_to_recipe
     from robotkit.importer.xacro_expand import check_package_paths
@@ -104,7 +104,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         raise RobotkitError(Problem(f"density must be > 0 (got {density!r})"))
     source = Path(path).absolute()
     out = Path(out_recipe).absolute()
-    packages = check_package_paths(package_paths or {})
+    packages = with_own_package(source, check_package_paths(package_paths or {}))
     try:
         raw = source.read_text(encoding="utf-8")
     except FileNotFoundError:

@@ -109,6 +109,16 @@ def _has_mass(link: dict) -> bool:
     return isinstance(spec, dict) or (spec is None and bool(link.get("visual")))
 
 
+def _welded_below(name: str, children: dict[str, list[dict]]) -> list[str]:
+    """``name`` and the links welded below it by fixed joints, breadth first (a cycle is walked once)."""
+    welded, todo = [], [name]
+    while todo:
+        welded += todo
+        todo = list(dict.fromkeys(j["child"] for n in todo for j in children.get(n, [])
+                                  if j["type"] == "fixed" and j["child"] not in welded))
+    return welded
+
+
 def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
     """A link the build refuses or SDF misreads for having no mass (it moves, or it is a root
     with moving joints below it and no mass welded to it) gets one: computed from its geometry at the
@@ -138,22 +148,24 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
         elif j["type"] in moving and j["child"] in links and not _has_mass(links[j["child"]]):
             refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): SDF keeps "
                                            "it a link, which Gazebo and Drake give 1 kg without an inertial")
-    child_links = {j["child"] for j in joints.values()}
-    roots = [n for n in links if n not in child_links]
-    for root in roots:
-        below = children.get(root, [])
-        if root != "world" and below and not body_mass(root):
-            # the mass goes on the first link with geometry welded to the root, else on the root
-            welded, todo = [], [root]
-            while todo:  # breadth first; a cycle (reported by the tree check) is walked once
-                welded += todo
-                todo = list(dict.fromkeys(j["child"] for n in todo for j in children.get(n, [])
-                                          if j["type"] == "fixed" and j["child"] not in welded))
-            root = next((n for n in welded if links[n].get("visual") or isinstance(links[n].get("collision"),
-                                                                                     (dict, list))), root)
-            refused.setdefault(root, "no mass in the original (nor on the links welded to it), and it is (or is "
-                                     "welded to) the root with moving joints below it: Gazebo's URDF conversion "
-                                     "drops it and everything below it")
+    def bearer(name: str) -> str:
+        """The first link with geometry welded below ``name`` (or ``name``): where its mass goes."""
+        return next((n for n in _welded_below(name, children)
+                     if links[n].get("visual") or isinstance(links[n].get("collision"), (dict, list))), name)
+
+    parent_joint = {j["child"]: j for j in joints.values()}
+    for name in links:
+        if name != "world" and name not in parent_joint and children.get(name) and not body_mass(name):
+            refused.setdefault(bearer(name), "no mass in the original (nor on the links welded to it), and it is (or "
+                                             "is welded to) the root with moving joints below it: Gazebo's URDF "
+                                             "conversion drops it and everything below it")
+    for name in links:  # libsdformat weighs a welded link with the links welded below it only
+        jname = next((n for n, j in joints.items() if j["parent"] == name and j["type"] in moving), None)
+        if (jname is not None and name in parent_joint and parent_joint[name]["type"] == "fixed"
+                and not body_mass(name) and not any(n in refused for n in _welded_below(name, children))):
+            refused.setdefault(bearer(name), f"no mass in the original (nor on the links welded below it), and "
+                                             f"joint '{jname}' moves below it: Gazebo's URDF conversion drops "
+                                             "everything that moves below it, though it is welded to a link with mass")
     given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
     point = 1e-3 * min(given) if given else 1e-3
     for name, why in refused.items():

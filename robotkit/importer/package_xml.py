@@ -25,6 +25,22 @@ def find_package_xml(source: Path) -> Path | None:
     return None
 
 
+def with_own_package(source: Path, packages: dict[str, str]) -> dict[str, str]:
+    """``packages`` and the ROS package ``source`` sits in (the nearest package.xml above it, by
+    its <name>), as ROS finds a package's own files: a ``package://`` or ``$(find)`` of it needs
+    no ``--package-path``.  A path given for that name wins."""
+    path = find_package_xml(source)
+    if path is None:
+        return packages
+    try:
+        name = (ET.parse(path).getroot().findtext("name") or "").strip()
+    except (OSError, ET.ParseError):
+        return packages
+    if not name or name in packages:
+        return packages
+    return {**packages, name: str(path.parent.absolute())}
+
+
 def _text(el) -> str:
     return re.sub(r"\s+", " ", "".join(el.itertext())).strip()
 

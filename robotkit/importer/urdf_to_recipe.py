@@ -121,7 +121,8 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         warnings.append(f"robot name '{robot_name}' is not a valid recipe name; using '{fixed}'")
         robot_name = fixed
 
-    # global materials (first definition of a name wins, as in urdfdom)
+    # global materials (first definition of a name wins, as in urdfdom; a definition inside a link's
+    # visual joins them for the name-only references of the links after it)
     global_materials: dict[str, ET.Element] = {}
     for el in et_children:
         if _local(el.tag) == "material" and el.get("name") and el.get("name") not in global_materials:
@@ -135,6 +136,8 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         name = vis_mat.get("name") or ""
         rgba = _rgba(vis_mat, f"link '{link}': material '{name}'", problems, warnings)
         texture = vis_mat.find("texture")
+        if (rgba is not None or texture is not None) and name:  # urdfdom: a link's definition serves later links
+            global_materials.setdefault(name, vis_mat)
         if rgba is None and name in global_materials:
             g = global_materials[name]
             rgba = _rgba(g, f"material '{name}'", problems, warnings)
@@ -748,16 +751,14 @@ def _verbatim(node, drop: set[str], root) -> str | None:
                    for c in node.childNodes):
             return None
     # namespace prefixes declared on <robot> (e.g. xmlns:xacro) that the element uses
-    used = set(re.findall(r"</?([A-Za-z_][\w.\-]*):", node.toxml())) | {
+    used = set(re.findall(r"</?([A-Za-z_][\w.\-]*):", _xml(node))) | {
         a.split(":")[0] for a in _all_attr_names(node) if ":" in a and not a.startswith("xmlns")}
     for prefix in sorted(used):
         decl = f"xmlns:{prefix}"
         if root.hasAttribute(decl) and not node.hasAttribute(decl):
             node.setAttribute(decl, root.getAttribute(decl))
-    if _unformatted(node):  # xacro drops the whitespace between elements: indent for reading
-        text = node.toprettyxml(indent="  ").strip()
-    else:
-        text = node.toxml()
+    text = _xml(node, "" if _unformatted(node) else None)  # xacro drops the whitespace between elements:
+    # indent for reading
     lines = [line.rstrip() for line in text.split("\n")]
     rest = [line for line in lines[1:] if line.strip()]
     if rest:
@@ -766,6 +767,32 @@ def _verbatim(node, drop: set[str], root) -> str | None:
     text = "\n".join(lines)
     ET.fromstring(text)  # well-formed (the schema checks it too)
     return text
+
+
+def _xml(node, indent: str | None = None) -> str:
+    """The XML text of a minidom node, attributes in document order; with ``indent``, one element a
+    line (for elements holding elements only).  minidom's own writer is not used: importing xacro
+    replaces it for the whole process (sorted attributes, whitespace dropped), so the recipe
+    would depend on whether a xacro file was read before."""
+    def esc(text: str) -> str:
+        return text.replace("&", "&amp;").replace("<", "&lt;").replace('"', "&quot;").replace(">", "&gt;")
+
+    if node.nodeType == node.TEXT_NODE:
+        return esc(node.data)
+    if node.nodeType == node.COMMENT_NODE:
+        return f"<!--{node.data}-->"
+    if node.nodeType == node.CDATA_SECTION_NODE:
+        return f"<![CDATA[{node.data}]]>"
+    if node.nodeType != node.ELEMENT_NODE:
+        return ""
+    head = node.tagName + "".join(f' {a.name}="{esc(a.value)}"' for a in node.attributes.values())
+    kids = list(node.childNodes)
+    if not kids:
+        return f"<{head}/>"
+    if indent is None or (len(kids) == 1 and kids[0].nodeType == node.TEXT_NODE):
+        return f"<{head}>" + "".join(_xml(k) for k in kids) + f"</{node.tagName}>"
+    inner = [_xml(k, indent + "  ") for k in kids if not (k.nodeType == k.TEXT_NODE and not k.data.strip())]
+    return f"<{head}>\n" + "".join(f"{indent}  {x}\n" for x in inner) + f"{indent}</{node.tagName}>"
 
 
 def _unformatted(node) -> bool:

@@ -461,6 +461,10 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
             xacro.init_stacks(None)
     # the document without xacro's banner comments
     root = doc.documentElement
+    for el in [root, *root.getElementsByTagName("*")]:  # xacro:attribute leaves its value a number, on which
+        for attr in el.attributes.values():  # xacro's writer fails; every other attribute is str() of its value
+            if not isinstance(attr.value, str):
+                attr.value = str(attr.value)
     text = '<?xml version="1.0"?>\n' + root.toxml() + "\n"
     warnings = [f"{_show(path)}: xacro: {line.strip()}" for line in stderr.getvalue().splitlines()
                 if line.strip() and not line.startswith(" ") and "when processing file" not in line]

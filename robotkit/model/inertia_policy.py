@@ -104,7 +104,12 @@ def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
     a, b, c = new
     excess = c - (a + b)
     if excess > c * TRIANGLE_TOL:
-        new = np.array([a + excess / 3, b + excess / 3, c - excess / 3])
+        # a third of the excess each way; principal axes off the link's axes add TRIANGLE_TOL: a
+        # tensor exactly on the boundary comes back from that rotation a rounding short of it,
+        # which MuJoCo refuses (Romeo's arms)
+        margin = 0.0 if np.allclose(np.abs(vecs), np.round(np.abs(vecs)), rtol=0, atol=1e-12) else TRIANGLE_TOL
+        d = (excess + c * margin) / (3 + margin)
+        new = np.array([a + d, b + d, c - d])
         changes.append(f"principal moments {_moments((a, b, c))} moved to {_moments(new)} "
                        "to meet the triangle inequality")
     if not changes:

@@ -366,6 +366,13 @@ class Robot:
                             "to load it and Gazebo drops it with everything below it; give it an inertial "
                             f"(links.{j.child}.inertial: {{mass: ...}}, or geometry and a density)",
                             ("urdf", "sdf", "mjcf")))
+        for link in self.links:  # libsdformat weighs a welded link with the links welded below it only
+            up = next((j for j in self.joints if j.child == link.name), None)
+            moves = next((j for j in self.joints if j.parent == link.name and j.type in moving), None)
+            if up is not None and up.type == "fixed" and moves is not None and not self.body_mass(link.name) > 0:
+                out.append((link.name, f"link '{link.name}' has no mass, nor the links welded below it, and joint "
+                            f"'{moves.name}' moves below it: Gazebo's URDF conversion drops everything that moves "
+                            f"below it; give links.{link.name} an inertial", ("urdf",)))
         root = self.root
         if (root != "world" and self.link(root).inertial is None and self.anchor() is None
                 and any(j.parent == root for j in self.joints)):

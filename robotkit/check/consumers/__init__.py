@@ -12,6 +12,7 @@ URDF, so its view is compared with the description lumped the same way.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import math
 from dataclasses import dataclass, field
@@ -71,6 +72,52 @@ class Build:
     mjcf: Path | None
     base: str = "fixed"  # fixed | free: how the root sits (Pinocchio, PyBullet)
     package_paths: dict[str, str] = field(default_factory=dict)
+    foreign: bool = False  # a URDF as its author wrote it (check on an original), not a build's
+
+
+def listed(names) -> str:
+    """The first three names quoted, and how many more (each once): for a note on many links."""
+    names = [f"'{n}'" for n in dict.fromkeys(names)]
+    return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+
+
+@contextlib.contextmanager
+def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
+    """A foreign URDF as a program that knows no ROS packages reads it: a copy whose mesh URIs are
+    file paths (``package://`` through ``build.package_paths`` or the package folder the URDF
+    sits in, relative paths from the URDF's folder).  With ``formats``, each mesh of another
+    format is given as OBJ (in metres, DAE units applied).  Yields (the copy, the meshes so
+    converted); a build's own URDF is yielded as it is."""
+    if not build.foreign:
+        yield build.urdf, []
+        return
+    import tempfile
+
+    from lxml import etree
+
+    from robotkit.check.lints import resolve_uri
+    from robotkit.mesh.export import obj_bytes
+    from robotkit.mesh.io import load_mesh
+
+    tree = etree.parse(str(build.urdf), etree.XMLParser(resolve_entities=False, no_network=True))
+    for el in tree.getroot().iter():  # a line after each element: PyBullet loses characters of long lines
+        el.tail = (el.tail or "") + "\n"  # (measured with 3.2.7: a xacro expansion on one line of 9 kB fails)
+    converted = []
+    with tempfile.TemporaryDirectory(prefix="robotkit-consumer-") as tmp:
+        for k, mesh in enumerate(tree.getroot().iter("mesh")):
+            uri = mesh.get("filename") or ""
+            path = resolve_uri(uri, build.urdf.parent, build.package_paths)
+            if path is None or not path.is_file():
+                continue  # the program says what it cannot find
+            if formats is not None and path.suffix.lower() not in formats:
+                obj = Path(tmp) / f"{k}_{path.stem}.obj"
+                obj.write_bytes(obj_bytes(load_mesh(str(path))))
+                converted.append(uri)
+                path = obj
+            mesh.set("filename", str(path.absolute()))
+        copy = Path(tmp) / build.urdf.name
+        tree.write(str(copy), xml_declaration=True, encoding="utf-8")
+        yield copy, converted
 
 
 def read(consumer: str, build: Build) -> View:

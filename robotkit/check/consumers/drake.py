@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, Unreadable, View
+from robotkit.check.consumers import Missing, Refused, Unreadable, View, listed, with_mesh_paths
 
 
 def _load(build, path) -> View:
@@ -68,8 +68,25 @@ def _unnamed(path) -> bool:
     return False
 
 
+DRAKE_MESHES = (".obj", ".vtk", ".gltf")
+
+
 def from_urdf(build) -> View:
-    return _load(build, build.urdf)
+    if not build.foreign:
+        return _load(build, build.urdf)
+    from robotkit.emit.urdf import typed_transmissions
+
+    with with_mesh_paths(build, DRAKE_MESHES) as (urdf, converted):
+        text, typed = typed_transmissions(urdf.read_text(encoding="utf-8"))
+        urdf.write_text(text, encoding="utf-8")
+        view = _load(build, urdf)
+    if typed:  # ros2_control's form: the robot is fine, Drake needs what a build writes
+        view.notes.append(f"reads a <transmission> only with a <type>: {listed(n for n, _ in typed)} given to it "
+                          "with the class of their <plugin> here (a build writes it)")
+    if converted:  # the robot is fine; Drake needs the conversion a build makes
+        view.notes.append(f"reads meshes only as OBJ, VTK or glTF: {listed(converted)} given to it as OBJ here "
+                          "(a build converts them)")
+    return view
 
 
 def from_sdf(build) -> View:

@@ -27,7 +27,11 @@ def _parsed(path) -> str:
 def _view(text: str, source: str, lumped: bool) -> View:
     from robotkit.check.kinematics import read_sdf_text
 
-    model = read_sdf_text(text, source)
+    try:
+        model = read_sdf_text(text, source)
+    except ValueError as exc:  # libsdformat wrote a model it cannot load (a URDF planar joint drops)
+        raise Refused(f"libsdformat's reading is not a model it can load: {str(exc).removeprefix(source + ': ')}") \
+            from None
 
     def poses(q: dict[str, float]):
         # model.sdf renames a joint named like a link (robotkit.emit.sdf.joint_names)

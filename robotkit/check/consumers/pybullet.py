@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View
+from robotkit.check.consumers import Missing, Refused, View, listed, with_mesh_paths
 
 
 MAX_LINKS = 128
@@ -31,6 +31,16 @@ def _quiet():
                 os.close(fd)
 
 
+DEFAULT_MASS = 1.0  # what PyBullet gives a link without <inertial>
+
+
+def _without_inertial(urdf) -> set[str]:
+    from lxml import etree
+
+    root = etree.parse(str(urdf), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+    return {el.get("name") for el in root.iter("link") if el.find("inertial") is None}
+
+
 def _T(pos, orn) -> np.ndarray:
     import pybullet as p
 
@@ -40,42 +50,13 @@ def _T(pos, orn) -> np.ndarray:
     return T
 
 
-@contextlib.contextmanager
-def _located(build):
-    """The URDF as a PyBullet user loads a ROS package's: PyBullet knows no package paths, so
-    ``package://PKG/`` of the packages given (``--package-path``) becomes their folder, in a
-    temporary copy (relative mesh paths made absolute)."""
-    import re
-    import tempfile
-
-    text = build.urdf.read_text(encoding="utf-8") if build.package_paths else ""
-    if not any(f"package://{pkg}/" in text for pkg in build.package_paths):
-        yield build.urdf
-        return
-
-    def located(m: re.Match) -> str:
-        uri = m.group(2)
-        pkg = re.match(r"package://([^/]+)/(.*)", uri)
-        if pkg and pkg.group(1) in build.package_paths:
-            uri = os.path.join(os.path.abspath(build.package_paths[pkg.group(1)]), pkg.group(2))
-        elif "://" not in uri and not os.path.isabs(uri):
-            uri = os.path.join(os.path.abspath(build.urdf.parent), uri)
-        return m.group(1) + uri + m.group(3)
-
-    with tempfile.TemporaryDirectory(prefix="robotkit-pybullet-") as tmp:
-        copy = os.path.join(tmp, build.urdf.name)
-        with open(copy, "w", encoding="utf-8") as f:
-            f.write(re.sub(r'(\bfilename=")([^"]*)(")', located, text))
-        yield copy
-
-
 def from_urdf(build) -> View:
     try:
         with _quiet():
             import pybullet as p
     except ImportError:
         raise Missing("PyBullet is not installed (pip install pybullet)") from None
-    with _quiet(), _located(build) as urdf:
+    with _quiet(), with_mesh_paths(build) as (urdf, _):  # PyBullet knows no ROS packages
         client = p.connect(p.DIRECT)
         try:
             # loaded free, so the base keeps its mass from the file (a fixed base is reported massless)
@@ -96,6 +77,13 @@ def from_urdf(build) -> View:
     masses = {base: p.getDynamicsInfo(body, -1, physicsClientId=client)[0]}
     masses.update({info[i][12].decode(): p.getDynamicsInfo(body, i, physicsClientId=client)[0] for i in range(n)})
     local = p.getDynamicsInfo(body, -1, physicsClientId=client)
+    notes = []
+    defaulted = sorted(n for n in _without_inertial(build.urdf) if masses.get(n) == DEFAULT_MASS)
+    if defaulted:  # URDF's frames (no <inertial>, massless to urdfdom): PyBullet's own default, not the robot's
+        notes.append(f"gives each link without <inertial> {DEFAULT_MASS:g} kg: {listed(defaulted)} "
+                     f"({len(defaulted) * DEFAULT_MASS:g} kg more than the description; a build writes a token "
+                     "mass that PyBullet keeps)")
+        masses.update({n: 0.0 for n in defaulted})
 
     def poses(q: dict[str, float]) -> dict[str, np.ndarray]:
         for i in range(n):
@@ -109,4 +97,4 @@ def from_urdf(build) -> View:
             out[info[i][12].decode()] = _T(s[4], s[5])
         return out
 
-    return View(masses, poses, pose_tol=PRECISION)
+    return View(masses, poses, pose_tol=PRECISION, notes=notes)
