@@ -336,29 +336,23 @@ def test_defaults_change_no_value(corpus, name, tmp_path, monkeypatch):
 
 DEFECTS = {  # every error `robotkit check` names on each original; why each is real is said beside it
     # inertia-box: tensors that do not fit the parts (the fingers' is a 3 cm rod along y; the wrist
-    # links' moments are a twelfth of their geometry's); PyBullet gives its links without <inertial> 1 kg
+    # links' moments are a twelfth of their geometry's); PyBullet's 1 kg for its links without
+    # <inertial> (frames to urdfdom) is a warning: its default, not the robot's
     "kinova_j2n6s300": {
         "inertia-box": ["j2n6s300_link_4", "j2n6s300_link_5", "j2n6s300_link_6", "j2n6s300_link_finger_1",
                         "j2n6s300_link_finger_tip_1", "j2n6s300_link_finger_2", "j2n6s300_link_finger_tip_2",
-                        "j2n6s300_link_finger_3", "j2n6s300_link_finger_tip_3"],
-        "consumer": ["PyBullet (URDF): total mass 6.784574 kg, the description's is 4.784574 kg",
-                     "PyBullet (URDF): link 'j2n6s300_end_effector' weighs 1 kg (its default for a link without "
-                     "<inertial>), the description says 0 kg",
-                     "PyBullet (URDF): link 'root' weighs 1 kg (its default for a link without <inertial>), the "
-                     "description says 0 kg"]},
+                        "j2n6s300_link_finger_3", "j2n6s300_link_finger_tip_3"]},
     # the calf rotors' transverse moments exceed their axial one: a disc's are half of it
     "aliengo": {
-        "inertia-box": ["FR_calf_rotor", "FL_calf_rotor", "RR_calf_rotor", "RL_calf_rotor"],
-        "consumer": ["PyBullet (URDF): total mass 25.937 kg, the description's is 24.937 kg",
-                     "PyBullet (URDF): link 'base' weighs 1 kg (its default for a link without <inertial>), the "
-                     "description says 0 kg"]},
+        "inertia-box": ["FR_calf_rotor", "FL_calf_rotor", "RR_calf_rotor", "RL_calf_rotor"]},
     # no <inertial> anywhere and effort 0 on every joint (ROS-Industrial's kinematics-only files)
     "motoman_sda10f": {
         "joint-limits": [f"arm_{side}_joint_{j}" for side in ("left", "right")
                          for j in ("1_s", "2_l", "3_e", "4_u", "5_r", "6_b", "7_t")],
+        # torso_base_link: massless, welded above the torso joint (libsdformat drops what moves below it)
         "massless-moving": ["torso_link_b1", "torso_link_b2"] + [f"arm_{side}_link_{j}" for side in ("left", "right")
                                                                  for j in ("1_s", "2_l", "3_e", "4_u", "5_r", "6_b",
-                                                                           "7_t")],
+                                                                           "7_t")] + ["torso_base_link"],
         "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"]},
     "fanuc_m10ia": {
         "joint-limits": [f"joint_{i}" for i in range(1, 7)],
@@ -366,25 +360,19 @@ DEFECTS = {  # every error `robotkit check` names on each original; why each is 
         "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"]},
     # the gripper links' tensor is a placeholder (the same moments on every axis: a 7.75 cm cube)
     "open_manipulator_x": {
-        "inertia-box": ["gripper_left_link", "gripper_right_link"],
-        "consumer": ["PyBullet (URDF): total mass 1.594057319 kg, the description's is 0.594057319 kg",
-                     "PyBullet (URDF): link 'end_effector_link' weighs 1 kg (its default for a link without "
-                     "<inertial>), the description says 0 kg"]},
+        "inertia-box": ["gripper_left_link", "gripper_right_link"]},
     "shadow_hand": {
-        "inertia": ["rh_fftip", "rh_mftip", "rh_rftip", "rh_lftip", "rh_thtip"],  # zero tensors
-        "consumer": ["PyBullet (URDF): total mass 5.794 kg, the description's is 3.794 kg",
-                     "PyBullet (URDF): link 'rh_imu' weighs 1 kg (its default for a link without <inertial>), the "
-                     "description says 0 kg",
-                     "PyBullet (URDF): link 'rh_manipulator' weighs 1 kg (its default for a link without "
-                     "<inertial>), the description says 0 kg"]},
+        "inertia": ["rh_fftip", "rh_mftip", "rh_rftip", "rh_lftip", "rh_thtip"]},  # zero tensors
     # the sonars' tensor is a placeholder cube; the antennas' has a negative moment
     "pmb2": {
         "inertia-box": ["base_sonar_03_link", "base_sonar_02_link", "base_sonar_01_link", "base_cover_link"],
         "inertia": ["base_antenna_left_link", "base_antenna_right_link"]},
-    # PyBullet's static base (mass 0), which Gazebo drops with everything below it
+    # PyBullet's static base (mass 0), which Gazebo drops with everything below it and Drake gives 1 kg
     "kuka_iiwa_bullet": {
         "mass": ["lbr_iiwa_link_0"],
-        "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"]},
+        "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)",
+                     "Drake (URDF): total mass 18.5 kg, the description's is 17.5 kg",
+                     "Drake (URDF): link 'lbr_iiwa_link_0' weighs 1 kg, the description says 0 kg"]},
     # hand-typed chassis tensor; the camera's 10 mg with a 0.78 m cube's tensor
     "racecar_bullet": {"inertia-box": ["chassis", "zed_camera_link"], "implied-density": ["zed_camera_link"]},
     # PyBullet's own dialect: <capsule>, massless links between the three joints of a ball joint, no name
@@ -416,11 +404,11 @@ def test_check_names_the_real_defects_of_each_original(name):
 
 def test_check_passes_a_clean_original():
     """The turret bot's URDF (a ROS package beside the corpus) has no defect: exit 0, with
-    Drake's own limit (no STL collision meshes) as a warning."""
+    Drake's own limit (meshes only as OBJ, VTK or glTF: given to it converted) as a warning."""
     turret = ROBOTS_DIR.parent / "turret_bot"
     proc = run_cli("check", turret / "urdf" / "turret_bot.urdf", "--package-path", f"turret_bot={turret}")
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert proc.stdout.splitlines()[-1] == f"{turret / 'urdf' / 'turret_bot.urdf'}: 0 errors, 2 warnings"
-    assert "  warning: Drake (URDF) refuses the robot: MakeConvexHull only applies to .obj, .vtk, and .gltf meshes; " \
-           f"unsupported extension '.stl' for geometry data: {turret / 'meshes' / 'base.stl'}. [consumer]" \
-           in proc.stdout.splitlines()
+    assert "  warning: Drake (URDF): reads meshes only as OBJ, VTK or glTF: 'package://turret_bot/meshes/base.stl', " \
+           "'package://turret_bot/meshes/slider.stl', 'package://turret_bot/meshes/rotor.stl' given to it as OBJ here " \
+           "(a build converts them) [consumer]" in proc.stdout.splitlines()

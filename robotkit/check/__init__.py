@@ -89,11 +89,10 @@ def urdf_tree(path: Path) -> tuple[dict[str, int], list[Finding]]:
     """(subject -> line of each ``<link>`` and ``<joint>``, findings on the kinematic tree)."""
     from lxml import etree
 
+    from robotkit.check.consumers import parse_urdf
+
     try:
-        data = path.read_bytes()
-        # urdfdom (TinyXML2) reads any declared version (PyBullet's humanoid says "0.0"); libxml2 only 1.x
-        data = re.sub(rb'^(\s*<\?xml\s+version\s*=\s*["\'])(?!1\.)[^"\']*', rb"\g<1>1.0", data)
-        root = etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True))
+        root = parse_urdf(path).getroot()
     except (etree.XMLSyntaxError, OSError) as exc:
         raise RobotkitError(Problem(f"not well-formed XML: {exc}", file=str(path))) from None
     lines = {f"{e.tag} '{e.get('name')}'": e.sourceline for e in root if e.tag in ("link", "joint")}

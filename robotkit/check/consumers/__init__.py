@@ -81,6 +81,18 @@ def listed(names) -> str:
     return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
 
 
+def parse_urdf(path):
+    """A URDF's lxml tree, read as urdfdom (TinyXML2) reads it: any declared XML version (PyBullet's
+    humanoid says "0.0"; libxml2 takes only 1.x).  Raises lxml's XMLSyntaxError or OSError."""
+    import re
+
+    from lxml import etree
+
+    data = Path(path).read_bytes()
+    data = re.sub(rb'^(\s*<\?xml\s+version\s*=\s*["\'])(?!1\.)[^"\']*', rb"\g<1>1.0", data)
+    return etree.ElementTree(etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True)))
+
+
 @contextlib.contextmanager
 def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
     """A foreign URDF as a program that knows no ROS packages reads it: a copy whose mesh URIs are
@@ -93,13 +105,11 @@ def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
         return
     import tempfile
 
-    from lxml import etree
-
     from robotkit.check.lints import resolve_uri
     from robotkit.mesh.export import obj_bytes
     from robotkit.mesh.io import load_mesh
 
-    tree = etree.parse(str(build.urdf), etree.XMLParser(resolve_entities=False, no_network=True))
+    tree = parse_urdf(build.urdf)
     for el in tree.getroot().iter():  # a line after each element: PyBullet loses characters of long lines
         el.tail = (el.tail or "") + "\n"  # (measured with 3.2.7: a xacro expansion on one line of 9 kB fails)
     converted = []
