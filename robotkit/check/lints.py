@@ -100,7 +100,7 @@ def _origin(el) -> np.ndarray:
 
 def resolve_uri(uri: str, base: Path, package_paths: dict[str, str]) -> Path | None:
     if uri.startswith("package://") or uri.startswith("model://"):
-        pkg, _, rest = uri.split("://", 1)[1].partition("/")
+        pkg, _, rest = uri.split("://", 1)[1].lstrip("/").partition("/")
         if pkg in package_paths:
             return Path(package_paths[pkg]) / rest
         for parent in [base, *base.parents][:4]:  # the URDF inside its own package (pkg/urdf/x.urdf)

@@ -13,7 +13,8 @@ The policies:
   radius :data:`MIN_RADIUS` at the link's mass, or :data:`RELATIVE_FLOOR` of the largest
   moment when that is smaller), then the triangle inequality restored by moving
   the largest moment down and the other two up by a third of the excess each (the least
-  change in the Frobenius norm).  The principal axes are kept.
+  change in the Frobenius norm), plus a third of :data:`TRIANGLE_TOL` of the largest so that
+  the sum of the two ends strictly above it whatever the rounding.  The principal axes are kept.
 - ``recompute``: from the link's geometry, keeping the given mass (a recipe's
   ``inertial: {mass: M}`` does the same; ``robotkit import --recompute-inertials`` for every link).
 - ``estimate``: the link's bounding primitive (robotkit.mesh.inertia.bounding_primitive) as a
@@ -104,7 +105,10 @@ def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
     a, b, c = new
     excess = c - (a + b)
     if excess > c * TRIANGLE_TOL:
-        new = np.array([a + excess / 3, b + excess / 3, c - excess / 3])
+        # a + b ends TRIANGLE_TOL * c above c, not on it: equality rounds either way in float
+        # (0.00366..7 + 0.00366..7 < 0.00733..4), and MuJoCo refuses a + b < c by any amount
+        move = (excess + c * TRIANGLE_TOL) / 3
+        new = np.array([a + move, b + move, c - move])
         changes.append(f"principal moments {_moments((a, b, c))} moved to {_moments(new)} "
                        "to meet the triangle inequality")
     if not changes:
