@@ -465,6 +465,25 @@ def lint_massless_moving(links: list[LinkFacts], joints: list[JointFacts]) -> li
                                f"moves (joint '{j.name}') but has no mass: MuJoCo refuses to load the robot and "
                                "Gazebo drops the link with everything below it",
                                "give it an <inertial>; robotkit import computes one from its geometry"))
+    # libsdformat drops a link without mass inside the tree with everything below it, even when
+    # it is welded to a link with mass (iCub's l_hip_3, between the hip and the leg)
+    flagged = {j.child for j in joints if j.type in MOVING}
+    roots = {j.parent for j in joints} - {j.child for j in joints}
+
+    def carries(name: str, seen: frozenset = frozenset()) -> str | None:
+        for j in joints:
+            if j.parent == name and j.child not in seen and (
+                    j.type in MOVING or mass.get(j.child, 0.0) > 0 or carries(j.child, seen | {name})):
+                return j.name
+        return None
+
+    for link in links:
+        below = None if link.name in flagged | roots or mass[link.name] > 0 else carries(link.name)
+        if below:
+            out.append(Finding("error", "massless-parent", f"link '{link.name}'",
+                               f"has no mass and joint '{below}' below it: Gazebo's URDF conversion drops the "
+                               "link with everything below it, even welded to a link with mass",
+                               "give it an <inertial>; robotkit import gives it a point mass"))
     return out
 
 

@@ -110,8 +110,9 @@ def _has_mass(link: dict) -> bool:
 
 
 def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
-    """A link the build refuses or SDF misreads for having no mass (it moves, or it is a root
-    with moving joints below it and no mass welded to it) gets one: computed from its geometry at the
+    """A link the build refuses or SDF misreads for having no mass (it moves, it is a root
+    with moving joints below it and no mass welded to it, or it has moving joints or mass below
+    it: libsdformat drops such a link with its subtree) gets one: computed from its geometry at the
     recipe's density, or a point mass when it has none.  Each is recorded in ``out.repairs``."""
     moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
     children: dict[str, list[dict]] = {}
@@ -140,6 +141,21 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
                                            "it a link, which Gazebo and Drake give 1 kg without an inertial")
     child_links = {j["child"] for j in joints.values()}
     roots = [n for n in links if n not in child_links]
+
+    def carries(name: str, seen: frozenset = frozenset()) -> str | None:
+        """The first joint below ``name`` that moves or holds mass (libsdformat drops it)."""
+        for jname, j in joints.items():
+            if j["parent"] != name or j["child"] in seen or j["child"] not in links:
+                continue
+            if j["type"] in moving or _has_mass(links[j["child"]]) or carries(j["child"], seen | {name}):
+                return jname
+        return None
+
+    for name in sorted(child_links - set(roots)):  # a massless link inside the tree: iCub's l_hip_3
+        below = carries(name) if name in links and not _has_mass(links[name]) else None
+        if below:
+            refused.setdefault(name, f"no mass in the original, with joint '{below}' below it: Gazebo's URDF "
+                                     "conversion drops it and everything below it, even welded to a link with mass")
     for root in roots:
         below = children.get(root, [])
         if root != "world" and below and not body_mass(root):

@@ -11,7 +11,7 @@ The policies:
 - ``repair``: the smallest change that makes it physical: the mass raised to a floor when it
   is not positive; the tensor's principal moments raised to a floor (that of a solid sphere of
   radius :data:`MIN_RADIUS` at the link's mass, or :data:`RELATIVE_FLOOR` of the largest
-  moment when that is smaller), then the triangle inequality restored by moving
+  moment when that is smaller, never below :data:`MIN_MOMENT`), then the triangle inequality restored by moving
   the largest moment down and the other two up by a third of the excess each (the least
   change in the Frobenius norm), plus a third of :data:`TRIANGLE_TOL` of the largest so that
   the sum of the two ends strictly above it whatever the rounding.  The principal axes are kept.
@@ -80,10 +80,18 @@ class Repaired:
     """What was changed, one phrase each (empty: nothing was wrong)."""
 
 
+MIN_MOMENT = 1e-13
+"""No repair leaves a principal moment below this (kg m^2): MuJoCo refuses a tensor whose least
+eigenvalue is under 1e-14 (its mjEPS), and ten times that survives its eigen-decomposition's
+rounding.  A tensor whose largest moment is a thousand times smaller is rounding noise (iCub's
+1.4e-20 product of inertia) and is floored as a zero one."""
+
+
 def moment_floor(mass: float, largest: float = 0.0) -> float:
     """The smallest principal moment a repair leaves (see the module docstring)."""
     sphere = 0.4 * mass * MIN_RADIUS ** 2
-    return min(sphere, RELATIVE_FLOOR * largest) if largest > 0 else sphere
+    relative = RELATIVE_FLOOR * largest
+    return max(min(sphere, relative) if relative >= MIN_MOMENT else sphere, MIN_MOMENT)
 
 
 def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
