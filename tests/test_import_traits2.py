@@ -134,3 +134,126 @@ def test_check_on_the_original_reads_the_meshes_and_names_the_refusals(built):
         ("consumer", "robot 'traits2'", f"Drake (URDF) refuses the robot: {source}:6: error: URI "
                                         "'package:///tpkg/meshes/body.stl' refers to unknown package ''")]
     assert [f for f in found if f.check in ("mesh-file", "consumers")] == []
+
+
+# ---------------------------------------------------------------- iCub and Go1
+
+URDF_ICUB = textwrap.dedent("""\
+    <?xml version="1.0"?>
+    <robot name="traits2b">
+      <link name="base_link">
+        <inertial><mass value="2"/><inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial>
+        <visual><geometry><mesh filename="package://tpkg/meshes/dense.stl"/></geometry></visual>
+      </link>
+      <link name="hip">
+        <inertial><mass value="0.2675"/><inertia ixx="0" ixy="0" ixz="1.35525e-20" iyy="0" iyz="0" izz="0"/></inertial>
+      </link>
+      <link name="ft_frame">
+        <inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+      </link>
+      <link name="leg">
+        <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+      </link>
+      <link name="imu">
+        <inertial><mass value="1e-6"/><inertia ixx="1e-12" ixy="0" ixz="0" iyy="1e-12" iyz="0" izz="1e-12"/></inertial>
+      </link>
+      <joint name="imu_joint" type="fixed"><parent link="base_link"/><child link="imu"/></joint>
+      <joint name="hip_pitch" type="revolute">
+        <parent link="base_link"/><child link="hip"/><axis xyz="0 1 0"/>
+        <limit lower="-1" upper="1" effort="5" velocity="1"/>
+      </joint>
+      <joint name="ft_sensor" type="fixed">
+        <parent link="hip"/><child link="ft_frame"/><origin xyz="0 0 -0.05"/>
+      </joint>
+      <joint name="hip_yaw" type="revolute">
+        <parent link="ft_frame"/><child link="leg"/><origin xyz="0 0 -0.05"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="5" velocity="1"/>
+      </joint>
+    </robot>
+    """)
+
+
+@pytest.fixture(scope="module")
+def built_icub(tmp_path_factory):
+    """A rounding-noise tensor (iCub's ankle: one product of inertia of 1.4e-20), a massless
+    frame between a moving link and the moving leg below it (iCub's l_hip_3, which libsdformat
+    drops with the leg, unless its point mass is above the 1e-6 kg of iCub's lightest link), and a binary STL of 204,800 triangles (Go1's trunk has 351,394)."""
+    import trimesh
+
+    mujoco()
+    root = tmp_path_factory.mktemp("traits2b")
+    (root / "tpkg" / "meshes").mkdir(parents=True)
+    (root / "tpkg" / "urdf").mkdir()
+    sphere = trimesh.creation.icosphere(subdivisions=6, radius=0.1)  # 81,920 triangles
+    dense = trimesh.util.concatenate([sphere.copy().apply_translation([0.25 * i, 0, 0]) for i in range(3)])
+    assert len(dense.faces) == 245760
+    dense.export(root / "tpkg" / "meshes" / "dense.stl")
+    source = root / "tpkg" / "urdf" / "traits2b.urdf"
+    source.write_text(URDF_ICUB, encoding="utf-8")
+    packages = {"tpkg": str(root / "tpkg")}
+    result = import_file(source, root / "recipe" / "robot.yaml", packages, {})
+    out = build([result.recipe_path], root / "build")
+    assert not out.errors, out.errors
+    return source, packages, result, root / "build" / result.robot
+
+
+def test_a_rounding_noise_tensor_is_floored_as_a_zero_one():
+    # the least moment a repair leaves is never below what MuJoCo takes (1e-14)
+    fixed = ip.repair(0.2675, np.array([[0, 0, 1.35525e-20], [0, 0, 0], [1.35525e-20, 0, 0]]), 1.0)
+    assert fixed.changes == ("principal moments -1.35525e-20, 0, 1.35525e-20 raised to at least 1.07e-07 kg m^2",)
+    assert np.linalg.eigvalsh(fixed.inertia).min() > 1e-7
+    assert ip.moment_floor(1e-9) == ip.MIN_MOMENT == 1e-13  # 0.4 * 1e-9 kg * (1 mm)^2 is 4e-16
+
+
+def test_the_icub_traits_build_and_every_consumer_loads_them(built_icub):
+    source, _, result, robot_dir = built_icub
+    urdf = robot_dir / "urdf" / "traits2b.urdf"
+    check_urdf(urdf)
+    assert result.repairs == {
+        "hip": "the original's inertia is not positive definite (principal moments -1.35525e-20, 0, 1.35525e-20): "
+               "repaired (principal moments -1.35525e-20, 0, 1.35525e-20 raised to at least 1.07e-07 kg m^2)",
+        "ft_frame": "no mass in the original, with joint 'hip_yaw' below it: Gazebo's URDF conversion drops it and "
+                    "everything below it, even welded to a link with mass; it has no geometry: a point mass of "
+                    "1.0e-05 kg (ten times the 1e-06 kg up to which libsdformat drops a link) with the smallest "
+                    "inertia a repair leaves"}
+    stated = robot_dir.parent / "stated.urdf"
+    stated.write_text(_with_stated_repairs(source, urdf, result.repairs), encoding="utf-8")
+    want = read_urdf(stated)
+    want.links["ft_frame"] = read_urdf(urdf).links["ft_frame"]  # the stated point mass
+    assert compare(want, read_urdf(urdf), 1e-9, configs=5) == []
+    mjcf = (robot_dir / "mjcf" / "traits2b.xml").read_text(encoding="utf-8")
+    assert 'file="mjcf/dense.obj"' in mjcf  # MuJoCo's STL reader takes at most 200,000 triangles
+    findings, summary = consumer_findings(Build("traits2b", robot_dir, urdf, robot_dir / "model.sdf",
+                                                robot_dir / "mjcf" / "traits2b.xml"), configs=3)
+    assert [str(f) for f in findings if f.severity == "error"] == []
+    assert all(s["loaded"] for s in summary.values()), summary
+
+
+def test_check_names_the_massless_link_gazebo_drops(built_icub):
+    from robotkit.check import check
+
+    source, packages, _, _ = built_icub
+    found = [(f.check, f.subject, f.message) for f in check(str(source), package_paths=packages)
+             if f.severity == "error"]
+    assert found == [
+        ("inertia", "link 'hip'", "inertia is not positive definite (principal moments -1.355e-20, 0, 1.355e-20)"),
+        ("massless-parent", "link 'ft_frame'", "has no mass and joint 'hip_yaw' below it: Gazebo's URDF "
+         "conversion drops the link with everything below it, even welded to a link with mass")]
+
+
+def test_check_names_the_leg_gazebo_drops_when_mujoco_reads_the_original(tmp_path):
+    """Without the ankle's tensor, MuJoCo reads the original and the consumers are compared."""
+    from robotkit.check import check
+
+    source = tmp_path / "frame.urdf"
+    source.write_text(URDF_ICUB.replace('ixz="1.35525e-20"', 'ixz="0"').replace('ixx="0" ixy="0" ixz="0" iyy="0" '
+                      'iyz="0" izz="0"/></inertial>\n  </link>\n  <link name="ft_frame">', 'ixx="0.001" ixy="0" '
+                      'ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>\n  </link>\n  <link name="ft_frame">')
+                      .replace('<visual><geometry><mesh filename="package://tpkg/meshes/dense.stl"/></geometry>'
+                               '</visual>', ''), encoding="utf-8")
+    found = [(f.check, f.message) for f in check(str(source)) if f.severity == "error"]
+    assert found == [
+        ("massless-parent", "has no mass and joint 'hip_yaw' below it: Gazebo's URDF conversion drops the link "
+                            "with everything below it, even welded to a link with mass"),
+        ("consumer", "Gazebo (URDF): total mass 2.267501 kg, the description's is 3.267501 kg"),
+        ("consumer", "Gazebo (URDF): link 'leg' (1 kg) is missing")]

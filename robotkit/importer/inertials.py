@@ -109,6 +109,10 @@ def _has_mass(link: dict) -> bool:
     return isinstance(spec, dict) or (spec is None and bool(link.get("visual")))
 
 
+POINT_MASS_FLOOR = 1e-5
+"""kg: the least point mass import gives a link without one (libsdformat drops a link of 1e-6 kg)."""
+
+
 def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
     """A link the build refuses or SDF misreads for having no mass (it moves, it is a root
     with moving joints below it and no mass welded to it, or it has moving joints or mass below
@@ -172,6 +176,10 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
                                      "drops it and everything below it")
     given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
     point = 1e-3 * min(given) if given else 1e-3
+    # libsdformat reads a mass up to 1e-6 kg as none and drops the link (iCub weighs a link 1e-6 kg)
+    why_point = "a thousandth of the lightest link" if point >= POINT_MASS_FLOOR else \
+        "ten times the 1e-06 kg up to which libsdformat drops a link"
+    point = max(point, POINT_MASS_FLOOR)
     for name, why in refused.items():
         link = links[name]
         if link.get("visual"):
@@ -183,8 +191,8 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
         else:
             floor = inertia_policy.moment_floor(point)
             link["inertial"] = {"mass": point, "inertia": {"ixx": floor, "iyy": floor, "izz": floor}}
-            out.repairs[name] = (f"{why}; it has no geometry: a point mass of {fmt(point)} kg (a thousandth of the "
-                                 f"lightest link) with the smallest inertia a repair leaves")
+            out.repairs[name] = (f"{why}; it has no geometry: a point mass of {fmt(point)} kg ({why_point}) "
+                                 "with the smallest inertia a repair leaves")
 
 
 def _tensor(t: dict):
