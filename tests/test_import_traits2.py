@@ -257,3 +257,70 @@ def test_check_names_the_leg_gazebo_drops_when_mujoco_reads_the_original(tmp_pat
                             "with everything below it, even welded to a link with mass"),
         ("consumer", "Gazebo (URDF): total mass 2.267501 kg, the description's is 3.267501 kg"),
         ("consumer", "Gazebo (URDF): link 'leg' (1 kg) is missing")]
+
+
+# ---------------------------------------------------------------- Jackal
+
+XACRO_JACKAL = textwrap.dedent("""\
+    <?xml version="1.0"?>
+    <robot name="rover" xmlns:xacro="http://www.ros.org/wiki/xacro">
+      <xacro:arg name="extras" default="extras.urdf"/>
+      <xacro:macro name="wheel" params="prefix *joint_pose">
+        <link name="${prefix}_wheel_link">
+          <inertial><mass value="0.5"/><inertia ixx="0.0013" ixy="0" ixz="0" iyy="0.0024" iyz="0" izz="0.0013"/></inertial>
+          <collision><geometry><cylinder radius="0.1" length="0.04"/></geometry></collision>
+        </link>
+        <joint name="${prefix}_wheel_joint" type="continuous">
+          <parent link="chassis"/><child link="${prefix}_wheel_link"/>
+          <xacro:insert_block name="joint_pose"/><axis xyz="0 1 0"/>
+        </joint>
+        <transmission name="${prefix}_wheel_trans">
+          <type>transmission_interface/SimpleTransmission</type>
+          <joint name="${prefix}_wheel"><hardwareInterface>VelocityJointInterface</hardwareInterface></joint>
+          <actuator name="${prefix}_actuator"><mechanicalReduction>1</mechanicalReduction></actuator>
+        </transmission>
+      </xacro:macro>
+      <link name="chassis">
+        <inertial><mass value="16"/><inertia ixx="0.3" ixy="0" ixz="0" iyy="0.4" iyz="0" izz="0.45"/></inertial>
+      </link>
+      <xacro:wheel prefix="left"><origin xyz="0 0.19 0"/></xacro:wheel>
+      <xacro:wheel prefix="right"><origin xyz="0 -0.19 0"/></xacro:wheel>
+      <transmission name="spare_trans">
+        <type>transmission_interface/SimpleTransmission</type>
+        <joint name="left_wheel_joint"><hardwareInterface>VelocityJointInterface</hardwareInterface></joint>
+        <actuator name="spare_actuator"><mechanicalReduction>1</mechanicalReduction></actuator>
+      </transmission>
+      <xacro:include filename="$(arg extras)"/>
+      <xacro:include filename="$(optenv ROVER_URDF_EXTRAS extras.urdf)"/>
+    </robot>
+    """)
+
+
+def test_a_transmission_naming_no_joint_is_left_out_and_stated(tmp_path):
+    """The Jackal's wheel transmissions name joint 'front_left_wheel' where the joint is
+    'front_left_wheel_joint' (and it includes a placeholder file twice, by $(arg) and by
+    $(optenv), whose <robot> holds a stray character): Drake refuses such a URDF, so import
+    leaves those transmissions out, says so in the recipe, and check names them."""
+    from robotkit.check import check
+
+    (tmp_path / "extras.urdf").write_text("<robot>\n  <!-- placeholder -->\ne</robot>\n", encoding="utf-8")
+    source = tmp_path / "rover.urdf.xacro"
+    source.write_text(XACRO_JACKAL, encoding="utf-8")
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    assert result.left_out == [
+        f"transmission '{side}_wheel_trans' is left out: it names joint '{side}_wheel', which the robot does not "
+        "have (Drake refuses the URDF, ros_control the transmission)" for side in ("left", "right")]
+    assert result.extras == ['<transmission name="spare_trans">']
+    recipe = result.recipe_path.read_text(encoding="utf-8")
+    assert "# transmission 'left_wheel_trans' is left out: it names joint 'left_wheel', which the robot does\n" \
+           "# not have (Drake refuses the URDF, ros_control the transmission)\n" in recipe
+    out = build([result.recipe_path], tmp_path / "build")
+    assert not out.errors, out.errors
+    robot_dir = tmp_path / "build" / "rover"
+    findings, summary = consumer_findings(Build("rover", robot_dir, robot_dir / "urdf" / "rover.urdf",
+                                                robot_dir / "model.sdf", robot_dir / "mjcf" / "rover.xml"), configs=3)
+    assert [str(f) for f in findings if f.severity == "error"] == []
+    assert all(s["loaded"] for s in summary.values()), summary
+    found = [(f.subject, f.message) for f in check(str(source)) if f.check == "transmission"]
+    assert found == [(f"transmission '{side}_wheel_trans'", f"names joint '{side}_wheel', which the robot does not "
+                      "have: Drake refuses the URDF and ros_control the transmission") for side in ("left", "right")]

@@ -239,6 +239,14 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
         joints.append(JointFacts(el.get("name"), el.get("type"), num("lower"), num("upper"), num("effort"),
                                  num("velocity"), mimic.get("joint") if mimic is not None else None,
                                  ends["parent"], ends["child"]))
+    names = {j.name for j in joints}
+    for el in root.findall("transmission"):  # the Jackal's name 'front_left_wheel' for 'front_left_wheel_joint'
+        for j in el.findall("joint"):
+            if j.get("name") not in names:
+                problems.append(Finding("error", "transmission", f"transmission '{el.get('name')}'",
+                                        f"names joint '{j.get('name')}', which the robot does not have: Drake "
+                                        "refuses the URDF and ros_control the transmission",
+                                        "name one of the robot's joints; robotkit import leaves it out"))
     return links, joints, problems
 
 
@@ -477,8 +485,13 @@ def lint_massless_moving(links: list[LinkFacts], joints: list[JointFacts]) -> li
                 return j.name
         return None
 
+    massless_roots = [r for r in roots if not body_mass(r) > 0]  # the whole robot hangs on them: Gazebo reads none
+    welded_to_them, todo = set(), massless_roots
+    while todo:
+        welded_to_them |= set(todo)
+        todo = [c for n in todo for c in fixed_below.get(n, []) if c not in welded_to_them]
     for link in links:
-        below = None if link.name in flagged | roots or mass[link.name] > 0 else carries(link.name)
+        below = None if link.name in flagged | welded_to_them or body_mass(link.name) > 0 else carries(link.name)
         if below:
             out.append(Finding("error", "massless-parent", f"link '{link.name}'",
                                f"has no mass and joint '{below}' below it: Gazebo's URDF conversion drops the "

@@ -145,21 +145,6 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
                                            "it a link, which Gazebo and Drake give 1 kg without an inertial")
     child_links = {j["child"] for j in joints.values()}
     roots = [n for n in links if n not in child_links]
-
-    def carries(name: str, seen: frozenset = frozenset()) -> str | None:
-        """The first joint below ``name`` that moves or holds mass (libsdformat drops it)."""
-        for jname, j in joints.items():
-            if j["parent"] != name or j["child"] in seen or j["child"] not in links:
-                continue
-            if j["type"] in moving or _has_mass(links[j["child"]]) or carries(j["child"], seen | {name}):
-                return jname
-        return None
-
-    for name in sorted(child_links - set(roots)):  # a massless link inside the tree: iCub's l_hip_3
-        below = carries(name) if name in links and not _has_mass(links[name]) else None
-        if below:
-            refused.setdefault(name, f"no mass in the original, with joint '{below}' below it: Gazebo's URDF "
-                                     "conversion drops it and everything below it, even welded to a link with mass")
     for root in roots:
         below = children.get(root, [])
         if root != "world" and below and not body_mass(root):
@@ -174,6 +159,21 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
             refused.setdefault(root, "no mass in the original (nor on the links welded to it), and it is (or is "
                                      "welded to) the root with moving joints below it: Gazebo's URDF conversion "
                                      "drops it and everything below it")
+
+    def carries(name: str, seen: frozenset = frozenset()) -> str | None:
+        """The first joint below ``name`` that moves or holds mass (libsdformat drops it)."""
+        for jname, j in joints.items():
+            if j["parent"] != name or j["child"] in seen or j["child"] not in links:
+                continue
+            if j["type"] in moving or _has_mass(links[j["child"]]) or carries(j["child"], seen | {name}):
+                return jname
+        return None
+
+    for name in sorted(child_links - set(roots)):  # a massless link inside the tree: iCub's l_hip_3
+        below = carries(name) if name in links and not body_mass(name) else None
+        if below:
+            refused.setdefault(name, f"no mass in the original, with joint '{below}' below it: Gazebo's URDF "
+                                     "conversion drops it and everything below it, even welded to a link with mass")
     given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
     point = 1e-3 * min(given) if given else 1e-3
     # libsdformat reads a mass up to 1e-6 kg as none and drops the link (iCub weighs a link 1e-6 kg)

@@ -56,6 +56,7 @@ class Converted:
     extras: list[str] = field(default_factory=list)  # a short label per verbatim element
     repairs: dict[str, str] = field(default_factory=dict)  # link -> what was wrong and what the recipe does
     joint_notes: dict[str, str] = field(default_factory=dict)  # joint -> what the recipe changes from the original
+    left_out: list[str] = field(default_factory=list)  # elements of the original the recipe leaves out, and why
 
 
 
@@ -308,6 +309,14 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
             pes = el.find("preserveFixedJoint")
             if pes is not None and (pes.text or "").strip().lower() in ("true", "1"):
                 drop.add("preserveFixedJoint")  # robotkit writes it for every fixed joint
+        missing = [j.get("name") for j in el.findall("joint") if j.get("name") not in joints] \
+            if tag == "transmission" else []
+        if missing:  # the Jackal's transmissions name joint 'front_left_wheel' for 'front_left_wheel_joint'
+            note = (f"transmission '{el.get('name')}' is left out: it names joint '{missing[0]}', which the robot "
+                    "does not have (Drake refuses the URDF, ros_control the transmission)")
+            out.left_out.append(note)
+            warnings.append(note)
+            continue
         xml_text = _verbatim(dom_children[idx], drop, dom.documentElement)
         if xml_text is None:
             continue
