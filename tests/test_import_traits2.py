@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import re
 import textwrap
 from pathlib import Path
 
@@ -324,3 +325,62 @@ def test_a_transmission_naming_no_joint_is_left_out_and_stated(tmp_path):
     found = [(f.subject, f.message) for f in check(str(source)) if f.check == "transmission"]
     assert found == [(f"transmission '{side}_wheel_trans'", f"names joint '{side}_wheel', which the robot does not "
                       "have: Drake refuses the URDF and ros_control the transmission") for side in ("left", "right")]
+
+
+# ---------------------------------------------------------------- Alex (example-robot-data)
+
+URDF_ALEX = textwrap.dedent("""\
+    <?xml version="1.0"?>
+    <robot name="hand">
+      <link name="palm">
+        <inertial><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>
+      </link>
+      <link name="L1">
+        <inertial><mass value="0.01"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial>
+      </link>
+      <link name="L2">
+        <inertial><mass value="0.01"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial>
+      </link>
+      <joint name="Left_index_q1" type="revolute">
+        <parent link="palm"/><child link="L1"/><axis xyz="0 0 1"/>
+        <limit lower="0" upper="2" effort="1" velocity="1"/>
+      </joint>
+      <joint name="Left_index_q2" type="revolute">
+        <parent link="L1"/><child link="L2"/><origin xyz="0.04 0 0"/><axis xyz="0 0 1"/>
+        <limit lower="0" upper="2.6" effort="1" velocity="1"/>
+        <mimic joint = "index_q1" multiplier =  "1.05851325" offset = "0.72349796"/>
+      </joint>
+    </robot>
+    """)
+
+
+def test_a_mimic_of_a_joint_the_robot_lacks_is_dropped_and_stated(tmp_path):
+    """Alex's hands mimic 'index_q1' where the joint is 'Left_index_q1': check_urdf accepts it,
+    Drake refuses it.  Import drops the mimic (the joint moves on its own, stated above it),
+    the build loads everywhere, and check names the mimic."""
+    from robotkit.check import check
+
+    mujoco()
+    source = tmp_path / "hand.urdf"
+    source.write_text(URDF_ALEX, encoding="utf-8")
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    note = ("mimicked joint 'index_q1' in the original, which the robot does not have (Drake refuses such a URDF): "
+            "the mimic is dropped and the joint moves on its own")
+    assert result.joint_notes == {"Left_index_q2": note}
+    assert " ".join(line.strip(" #") for line in result.recipe_path.read_text(encoding="utf-8").splitlines()
+                    if line.startswith("  # ")) == note
+    out = build([result.recipe_path], tmp_path / "build")
+    assert not out.errors, out.errors
+    robot_dir = tmp_path / "build" / "hand"
+    urdf = robot_dir / "urdf" / "hand.urdf"
+    check_urdf(urdf)
+    stated = tmp_path / "stated.urdf"  # the original without the mimic
+    stated.write_text(re.sub(r"<mimic[^>]*/>", "", URDF_ALEX), encoding="utf-8")
+    assert compare(read_urdf(stated), read_urdf(urdf), 1e-9, configs=5) == []
+    findings, summary = consumer_findings(Build("hand", robot_dir, urdf, robot_dir / "model.sdf",
+                                                robot_dir / "mjcf" / "hand.xml"), configs=3)
+    assert [str(f) for f in findings if f.severity == "error"] == []
+    assert all(s["loaded"] for s in summary.values()), summary
+    found = [(f.check, f.subject, f.message) for f in check(str(source)) if f.check == "mimic-missing"]
+    assert found == [("mimic-missing", "joint 'Left_index_q2'", "mimics joint 'index_q1', which the robot does not "
+                      "have: Drake refuses the URDF")]

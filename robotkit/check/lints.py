@@ -513,6 +513,10 @@ def lint_joints(joints: list[JointFacts]) -> list[Finding]:
                                    "a joint with zero effort cannot be driven"))
             if j.velocity is not None and j.velocity <= 0:
                 out.append(Finding("error", "joint-limits", s, f"velocity limit {j.velocity:g} is not positive"))
+        if j.mimic is not None and j.mimic not in by_name:  # check_urdf accepts it (Alex's hands)
+            out.append(Finding("error", "mimic-missing", s, f"mimics joint '{j.mimic}', which the robot does not "
+                               "have: Drake refuses the URDF", "name one of the robot's joints; robotkit import "
+                               "drops the mimic"))
         seen = [j.name]
         node = j
         while node.mimic is not None and node.mimic in by_name:

@@ -282,14 +282,17 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
             warnings.append(f"joint '{name}': {note}")
     for name, joint in joints.items():
         mimic = joint.get("mimic")
-        if mimic and mimic["joint"] not in joints:
-            problems.add(f"joint '{name}': mimics joint '{mimic['joint']}', which is not defined")
+        if mimic and mimic["joint"] not in joints:  # check_urdf accepts it (Alex's hands: 'index_q1')
+            note = (f"mimicked joint '{mimic['joint']}' in the original, which the robot does not have (Drake "
+                    "refuses such a URDF): the mimic is dropped and the joint moves on its own")
         elif mimic and joints[mimic["joint"]]["type"] == "fixed":
             note = (f"mimicked fixed joint '{mimic['joint']}' in the original: a fixed joint has no position to "
                     "follow, so the mimic is dropped and the joint moves on its own")
-            del joint["mimic"]
-            out.joint_notes[name] = note
-            warnings.append(f"joint '{name}': {note}")
+        else:
+            continue
+        del joint["mimic"]
+        out.joint_notes[name] = "; ".join(filter(None, (out.joint_notes.get(name), note)))
+        warnings.append(f"joint '{name}': {note}")
 
     # ---- everything else: gazebo blocks (partly mapped), transmissions, ... verbatim
     extras: list[str] = []
