@@ -11,10 +11,11 @@ The policies:
 - ``repair``: the smallest change that makes it physical: the mass raised to a floor when it
   is not positive; the tensor's principal moments raised to a floor (that of a solid sphere of
   radius :data:`MIN_RADIUS` at the link's mass, or :data:`RELATIVE_FLOOR` of the largest
-  moment when that is smaller, never below :data:`MIN_MOMENT`), then the triangle inequality restored by moving
-  the largest moment down and the other two up by a third of the excess each (the least
-  change in the Frobenius norm), plus a third of :data:`TRIANGLE_TOL` of the largest so that
-  the sum of the two ends strictly above it whatever the rounding.  The principal axes are kept.
+  moment when that is smaller, never below :data:`MIN_MOMENT`), then the triangle inequality
+  restored by moving the largest moment down and the other two up by a third of the excess
+  each (the least change in the Frobenius norm), plus a third of :data:`TRIANGLE_TOL` of the
+  largest, so that the sum of the two ends above it whatever the rounding.  The principal axes
+  are kept.
 - ``recompute``: from the link's geometry, keeping the given mass (a recipe's
   ``inertial: {mass: M}`` does the same; ``robotkit import --recompute-inertials`` for every link).
 - ``estimate``: the link's bounding primitive (robotkit.mesh.inertia.bounding_primitive) as a
@@ -83,8 +84,8 @@ class Repaired:
 MIN_MOMENT = 1e-13
 """No repair leaves a principal moment below this (kg m^2): MuJoCo refuses a tensor whose least
 eigenvalue is under 1e-14 (its mjEPS), and ten times that survives its eigen-decomposition's
-rounding.  A tensor whose largest moment is a thousand times smaller is rounding noise (iCub's
-1.4e-20 product of inertia) and is floored as a zero one."""
+rounding.  A tensor a thousandth of whose largest moment is below it is rounding noise (iCub's
+1.4e-20 product of inertia) and gets the floor of a zero one, the sphere's."""
 
 
 def moment_floor(mass: float, largest: float = 0.0) -> float:
