@@ -384,3 +384,56 @@ def test_a_mimic_of_a_joint_the_robot_lacks_is_dropped_and_stated(tmp_path):
     found = [(f.check, f.subject, f.message) for f in check(str(source)) if f.check == "mimic-missing"]
     assert found == [("mimic-missing", "joint 'Left_index_q2'", "mimics joint 'index_q1', which the robot does not "
                       "have: Drake refuses the URDF")]
+
+
+# ---------------------------------------------------------------- Talos (example-robot-data)
+
+URDF_TALOS = textwrap.dedent("""\
+    <?xml version="1.0"?>
+    <robot name="head">
+      <link name="rgbd_link">
+        <inertial><mass value="0.2"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>
+      </link>
+      <link name="rgbd_depth_frame">
+        <inertial><mass value="0"/><origin xyz="0 0 0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+      </link>
+      <link name="rgbd_depth_optical_frame">
+        <inertial><mass value="0"/><origin xyz="0 0 0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+      </link>
+      <joint name="rgbd_depth_joint" type="fixed">
+        <parent link="rgbd_link"/><child link="rgbd_depth_frame"/><origin xyz="0 0.0375 0"/>
+      </joint>
+      <joint name="rgbd_depth_optical_joint" type="fixed">
+        <parent link="rgbd_depth_frame"/><child link="rgbd_depth_optical_frame"/><origin rpy="-1.5708 0 -1.5708"/>
+      </joint>
+    </robot>
+    """)
+
+
+def test_frames_with_inertials_of_mass_0_welded_together(tmp_path):
+    """Talos's camera frames each carry an <inertial> of mass 0, one welded to the next: Gazebo
+    refuses the original ("Pose values must be finite"); the build, whose frames carry no
+    inertial, loads everywhere, and check names the pair."""
+    from robotkit.check import check
+
+    mujoco()
+    source = tmp_path / "head.urdf"
+    source.write_text(URDF_TALOS, encoding="utf-8")
+    found = [(f.check, f.subject, f.message) for f in check(str(source)) if f.severity == "error"]
+    assert found == [
+        ("zero-mass-welded", "link 'rgbd_depth_optical_frame'", "has an <inertial> of mass 0 and is welded (joint "
+         "'rgbd_depth_optical_joint') to 'rgbd_depth_frame', which has one too: libsdformat lumps them into a "
+         "centre of mass of 0/0 and Gazebo refuses the robot (\"Pose values must be finite\")"),
+        ("consumer", "robot 'head'", "Gazebo (URDF) refuses the robot: Error [Param.cc:576] Pose values must be "
+                                     "finite.")]
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    assert result.repairs == {} and result.joint_notes == {}
+    out = build([result.recipe_path], tmp_path / "build")
+    assert not out.errors, out.errors
+    robot_dir = tmp_path / "build" / "head"
+    urdf = robot_dir / "urdf" / "head.urdf"
+    assert compare(read_urdf(source), read_urdf(urdf), 1e-9, configs=2) == []
+    findings, summary = consumer_findings(Build("head", robot_dir, urdf, robot_dir / "model.sdf",
+                                                robot_dir / "mjcf" / "head.xml"), configs=2)
+    assert [str(f) for f in findings if f.severity == "error"] == []
+    assert all(s["loaded"] for s in summary.values()), summary

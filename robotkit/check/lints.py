@@ -53,6 +53,7 @@ class LinkFacts:
     inertia: np.ndarray | None = None  # about com, link axes
     geoms: list[GeomFacts] = field(default_factory=list)
     unread: set[str] = field(default_factory=set)  # roles with a shape that could not be read (PyBullet's capsule)
+    zero_inertial: bool = False  # an explicit <inertial> of mass 0 and no inertia (read as a frame)
 
     def role(self, role: str) -> list[GeomFacts]:
         return [g for g in self.geoms if g.role == role]
@@ -219,6 +220,7 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
             facts.com, facts.inertia = T[:3, 3], R @ I @ R.T
             if 0 <= facts.mass < NEGLIGIBLE and not I.any():  # an explicitly massless link (a frame)
                 facts.mass = facts.com = facts.inertia = None
+                facts.zero_inertial = m is not None and float(m.get("value")) == 0
         for role in ("visual", "collision"):
             for g in el.findall(role):
                 gf = _geom_facts(g, role, path.parent, package_paths, subject, problems, cache)
@@ -485,6 +487,14 @@ def lint_massless_moving(links: list[LinkFacts], joints: list[JointFacts]) -> li
                 return j.name
         return None
 
+    zero = {link.name for link in links if link.zero_inertial}
+    for j in joints:  # libsdformat lumps the two into a centre of mass of 0 / 0 (Talos's camera frames)
+        if j.type == "fixed" and j.child in zero and j.parent in zero:
+            out.append(Finding("error", "zero-mass-welded", f"link '{j.child}'",
+                               f"has an <inertial> of mass 0 and is welded (joint '{j.name}') to '{j.parent}', "
+                               "which has one too: libsdformat lumps them into a centre of mass of 0/0 and Gazebo "
+                               "refuses the robot (\"Pose values must be finite\")",
+                               "leave the <inertial> out of a frame; robotkit's build writes none"))
     massless_roots = [r for r in roots if not body_mass(r) > 0]  # the whole robot hangs on them: Gazebo reads none
     welded_to_them, todo = set(), massless_roots
     while todo:
