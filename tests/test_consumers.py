@@ -240,11 +240,11 @@ def test_public_robot_imported_built_and_loaded_everywhere(tmp_path, name, entry
     assert smoke_test(b.dir / "mjcf" / "scene.xml") == []
     if name == "aliengo":
         # the trunk's texture travels with its DAE; calf.dae is in inches (<unit meter="0.0254">):
-        # MuJoCo's STL copy is in metres, as RViz and Gazebo show the DAE
+        # MuJoCo's OBJ copy is in metres, as RViz and Gazebo show the DAE
         assert (b.dir / "meshes" / "visual" / "trunk_uv_base_final.png").is_file()
         import trimesh
 
-        calf = trimesh.load(b.dir / "meshes" / "mjcf" / "calf.stl")
+        calf = trimesh.load(b.dir / "meshes" / "mjcf" / "calf.obj")
         assert 0.3 < max(calf.extents) < 0.35, calf.extents
 
 

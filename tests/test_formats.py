@@ -195,8 +195,8 @@ def test_dae_visuals_are_converted_for_mujoco(tmp_path, assets):
     result = build([recipe], tmp_path / "out")
     robot = tmp_path / "out" / "dae"
     assert (robot / "meshes" / "visual" / "wrist3.dae").read_bytes() == (tmp_path / "wrist3.dae").read_bytes()
-    assert (robot / "meshes" / "mjcf" / "wrist3.stl").is_file()
-    assert ("dae: MJCF: mesh 'wrist3.dae': MuJoCo reads no DAE; converted to meshes/mjcf/wrist3.stl (the file's "
+    assert (robot / "meshes" / "mjcf" / "wrist3.obj").is_file()
+    assert ("dae: MJCF: mesh 'wrist3.dae': MuJoCo reads no DAE; converted to meshes/mjcf/wrist3.obj (the file's "
             "own colours and textures are dropped, the recipe's material is used)") in result.warnings
     mujoco().MjModel.from_xml_path(str(robot / "mjcf" / "scene.xml"))
     assert_equivalent(robot, configs=5)

@@ -239,7 +239,8 @@ def test_import_inertia_policy(tmp_path, policy):
     assert not built.errors
     links = read_urdf(tmp_path / "build" / "vendor" / "urdf" / "vendor.urdf").links
     box = 2.0 / 12 * np.diag([0.2 ** 2 + 0.4 ** 2, 0.1 ** 2 + 0.4 ** 2, 0.1 ** 2 + 0.2 ** 2])
-    want = np.diag([0.02, 0.02, 0.04]) if policy == "repair" else box  # a box is its own bounding primitive
+    repaired = np.diag([0.02, 0.02, 0.04]) + np.diag([1, 1, -1]) * 0.05e-9 / 3  # a + b 1e-9 of c above c
+    want = repaired if policy == "repair" else box  # a box is its own bounding primitive
     assert np.allclose(links["arm"].inertia, want, rtol=1e-12, atol=1e-15)
     assert np.allclose(links["arm"].com, [0, 0, 0] if policy == "repair" else [0, 0, 0.2], rtol=0, atol=1e-12)
     assert links["arm"].mass == 2.0 and links["base"].mass == 1.0

@@ -19,10 +19,14 @@ def test_a_physical_tensor_is_kept():
     assert fixed.changes == () and (fixed.inertia == I).all() and fixed.mass == 2.0
 
 
+REPAIRED_ARM = np.diag([0.02, 0.02, 0.04]) + np.diag([1, 1, -1]) * 0.05 * ip.TRIANGLE_TOL / 3
+"""0.01, 0.01, 0.05 repaired: a + b ends TRIANGLE_TOL of c above c, not on it."""
+
+
 def test_the_triangle_inequality_is_met_with_the_least_change():
     # excess 0.05 - 0.02 = 0.03: a third of it off the largest moment, a third onto each other one
     fixed = ip.repair(1.0, np.diag([0.01, 0.01, 0.05]), 1.0)
-    assert np.allclose(fixed.inertia, np.diag([0.02, 0.02, 0.04]), rtol=0, atol=1e-15)
+    assert np.allclose(fixed.inertia, REPAIRED_ARM, rtol=0, atol=1e-15)
     assert fixed.changes == ("principal moments 0.01, 0.01, 0.05 moved to 0.02, 0.02, 0.04 to meet the "
                              "triangle inequality",)
     assert ip.defects(1.0, fixed.inertia) == []
@@ -74,7 +78,7 @@ def test_the_recipe_chooses_the_policy(tmp_path):
         recipe = write_recipe(tmp_path, RECIPE.format(policy=policy, link_policy=link_policy), name)
         (_, robot), = load_robots([recipe])
         arm = robot.link("arm").inertial
-        assert np.allclose(arm.tensor(), np.diag([0.02, 0.02, 0.04]), rtol=0, atol=1e-15), name
+        assert np.allclose(arm.tensor(), REPAIRED_ARM, rtol=0, atol=1e-15), name
     # a link may keep what the recipe would repair
     mixed = write_recipe(tmp_path, RECIPE.format(policy="inertia_policy: repair", link_policy=", policy: keep"),
                          "mixed.yaml")
@@ -178,7 +182,7 @@ def test_a_link_policy_overrides_the_recipe_policy(tmp_path):
     """recipe-wide recompute; the arm asks to repair its tensor, the ball to keep its physical one."""
     recipe = _policies(tmp_path, "inertia_policy: recompute", arm=", policy: repair", ball=", policy: keep")
     got = _built_inertials(recipe, tmp_path / "out")
-    assert np.allclose(got["arm"][2], np.diag([0.02, 0.02, 0.04]), rtol=0, atol=1e-15)  # the repair
+    assert np.allclose(got["arm"][2], REPAIRED_ARM, rtol=0, atol=1e-15)  # the repair
     assert np.allclose(got["arm"][1], [0.5, 0, 0], rtol=0, atol=0)  # the given centre of mass kept
     assert np.allclose(got["ball"][2], np.eye(3) * 0.01, rtol=0, atol=0)  # kept as given
     # the rod recomputed from its (64-section) cylinder mesh at 0.5 kg: trimesh's mass properties agree

@@ -225,7 +225,9 @@ def _pose(el) -> tuple[np.ndarray, str | None]:
 
 
 def read_sdf_text(text: str, source: str) -> KModel:
-    root = ET.fromstring(text)
+    # libsdformat prints namespaced elements (<ignition::corrected_offsets>, the PR2's Gazebo 1
+    # <sensor:contact>) without their namespace declaration, which no XML parser accepts
+    root = ET.fromstring(re.sub(r"(</?|\s)(\w+)::?(?=\w)", r"\1\2__", text))
     model = root.find("model")
     frames: dict[str, tuple[np.ndarray, str]] = {}  # name -> (pose, relative_to)
     link_els = {lk.get("name"): lk for lk in model.findall("link")}
@@ -327,9 +329,7 @@ def read_urdf_via_libsdformat(path) -> KModel:
     proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
     if proc.returncode != 0 or "<sdf" not in proc.stdout:
         raise RuntimeError(f"ign sdf -p {path} failed: {proc.stderr.strip() or proc.stdout.strip()}")
-    # libsdformat prints namespaced elements (<ignition::corrected_offsets>) without their namespace
-    text = re.sub(r"<(/?)(\w+)::", r"<\1\2__", proc.stdout)
-    return read_sdf_text(text, f"URDF {path} (libsdformat)")
+    return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)")
 
 
 def lump(model: KModel) -> KModel:

@@ -53,6 +53,7 @@ class LinkFacts:
     inertia: np.ndarray | None = None  # about com, link axes
     geoms: list[GeomFacts] = field(default_factory=list)
     unread: set[str] = field(default_factory=set)  # roles with a shape that could not be read (PyBullet's capsule)
+    zero_inertial: bool = False  # an explicit <inertial> of mass 0 and no inertia (read as a frame)
 
     def role(self, role: str) -> list[GeomFacts]:
         return [g for g in self.geoms if g.role == role]
@@ -100,7 +101,7 @@ def _origin(el) -> np.ndarray:
 
 def resolve_uri(uri: str, base: Path, package_paths: dict[str, str]) -> Path | None:
     if uri.startswith("package://") or uri.startswith("model://"):
-        pkg, _, rest = uri.split("://", 1)[1].partition("/")
+        pkg, _, rest = uri.split("://", 1)[1].lstrip("/").partition("/")
         if pkg in package_paths:
             return Path(package_paths[pkg]) / rest
         for parent in [base, *base.parents][:4]:  # the URDF inside its own package (pkg/urdf/x.urdf)
@@ -219,6 +220,7 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
             facts.com, facts.inertia = T[:3, 3], R @ I @ R.T
             if 0 <= facts.mass < NEGLIGIBLE and not I.any():  # an explicitly massless link (a frame)
                 facts.mass = facts.com = facts.inertia = None
+                facts.zero_inertial = m is not None and float(m.get("value")) == 0
         for role in ("visual", "collision"):
             for g in el.findall(role):
                 gf = _geom_facts(g, role, path.parent, package_paths, subject, problems, cache)
@@ -239,6 +241,14 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
         joints.append(JointFacts(el.get("name"), el.get("type"), num("lower"), num("upper"), num("effort"),
                                  num("velocity"), mimic.get("joint") if mimic is not None else None,
                                  ends["parent"], ends["child"]))
+    names = {j.name for j in joints}
+    for el in root.findall("transmission"):  # the Jackal's name 'front_left_wheel' for 'front_left_wheel_joint'
+        for j in el.findall("joint"):
+            if j.get("name") not in names:
+                problems.append(Finding("error", "transmission", f"transmission '{el.get('name')}'",
+                                        f"names joint '{j.get('name')}', which the robot does not have: Drake "
+                                        "refuses the URDF and ros_control the transmission",
+                                        "name one of the robot's joints; robotkit import leaves it out"))
     return links, joints, problems
 
 
@@ -466,14 +476,48 @@ def lint_massless_moving(links: list[LinkFacts], joints: list[JointFacts]) -> li
                                "Gazebo drops the link with everything below it",
                                "give it an <inertial>; robotkit import computes one from its geometry"))
     welded = {j.child for j in joints if j.type == "fixed"}
+    welded_flagged = set()
     for name in sorted(welded & set(mass)):  # libsdformat weighs a welded link with the links welded below it only
         moves = next((j for j in joints if j.parent == name and j.type in MOVING), None)
         if moves is not None and name not in given and not body_mass(name) > 0:
+            welded_flagged.add(name)
             out.append(Finding("error", "massless-moving", f"link '{name}'",
                                f"joint '{moves.name}' moves below it but it has no mass, nor the links welded "
                                "below it: Gazebo's URDF conversion drops everything that moves below it, though "
                                "it is welded to a link with mass",
                                "give it an <inertial>; robotkit import computes one from its geometry"))
+    # libsdformat drops a link without mass inside the tree with everything below it, even when
+    # it is welded to a link with mass (iCub's l_hip_3, between the hip and the leg)
+    flagged = {j.child for j in joints if j.type in MOVING} | welded_flagged
+    roots = {j.parent for j in joints} - {j.child for j in joints}
+
+    def carries(name: str, seen: frozenset = frozenset()) -> str | None:
+        for j in joints:
+            if j.parent == name and j.child not in seen and (
+                    j.type in MOVING or mass.get(j.child, 0.0) > 0 or carries(j.child, seen | {name})):
+                return j.name
+        return None
+
+    zero = {link.name for link in links if link.zero_inertial}
+    for j in joints:  # libsdformat lumps the two into a centre of mass of 0 / 0 (Talos's camera frames)
+        if j.type == "fixed" and j.child in zero and j.parent in zero:
+            out.append(Finding("error", "zero-mass-welded", f"link '{j.child}'",
+                               f"has an <inertial> of mass 0 and is welded (joint '{j.name}') to '{j.parent}', "
+                               "which has one too: libsdformat lumps them into a centre of mass of 0/0 and Gazebo "
+                               "refuses the robot (\"Pose values must be finite\")",
+                               "leave the <inertial> out of a frame; robotkit's build writes none"))
+    massless_roots = [r for r in roots if not body_mass(r) > 0]  # the whole robot hangs on them: Gazebo reads none
+    welded_to_them, todo = set(), massless_roots
+    while todo:
+        welded_to_them |= set(todo)
+        todo = [c for n in todo for c in fixed_below.get(n, []) if c not in welded_to_them]
+    for link in links:
+        below = None if link.name in flagged | welded_to_them or body_mass(link.name) > 0 else carries(link.name)
+        if below:
+            out.append(Finding("error", "massless-parent", f"link '{link.name}'",
+                               f"has no mass and joint '{below}' below it: Gazebo's URDF conversion drops the "
+                               "link with everything below it, even welded to a link with mass",
+                               "give it an <inertial>; robotkit import gives it a point mass"))
     return out
 
 
@@ -490,6 +534,10 @@ def lint_joints(joints: list[JointFacts]) -> list[Finding]:
                                    "a joint with zero effort cannot be driven"))
             if j.velocity is not None and j.velocity <= 0:
                 out.append(Finding("error", "joint-limits", s, f"velocity limit {j.velocity:g} is not positive"))
+        if j.mimic is not None and j.mimic not in by_name:  # check_urdf accepts it (Alex's hands)
+            out.append(Finding("error", "mimic-missing", s, f"mimics joint '{j.mimic}', which the robot does not "
+                               "have: Drake refuses the URDF", "name one of the robot's joints; robotkit import "
+                               "drops the mimic"))
         seen = [j.name]
         node = j
         while node.mimic is not None and node.mimic in by_name:

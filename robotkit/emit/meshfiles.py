@@ -3,7 +3,8 @@
 Shared by the emitters (URDF, SDF, MJCF) and the tasks that write the files:
 
 - visual geometry references the copied (or processed) visual file, except in MJCF, which
-  reads no COLLADA and only binary STL: a DAE or an ASCII STL becomes ``meshes/mjcf/<stem>.stl``;
+  reads no COLLADA, only binary STL and at most 200,000 triangles in an STL: a DAE becomes
+  ``meshes/mjcf/<stem>.obj``, an ASCII STL ``meshes/mjcf/<stem>.stl``, a larger binary STL OBJ;
 - collision geometry references an OBJ in every format: Drake takes convex meshes only as
   OBJ, VTK or glTF; MuJoCo, Gazebo and RViz read OBJ too.  Collision pieces are written as OBJ
   by their task; any other mesh used for collision is converted to ``meshes/collision/<stem>.obj``.
@@ -35,12 +36,34 @@ def is_ascii_stl(path: str) -> bool:
     return head.lstrip()[:5].lower() == b"solid"
 
 
+MJCF_STL_FACES = 200000
+"""MuJoCo's STL reader takes at most this many triangles (its OBJ reader has no such limit)."""
+
+
+def binary_stl_faces(path: str) -> int:
+    """The triangle count a binary STL's header announces (0 when unreadable)."""
+    import struct
+
+    try:
+        with open(path, "rb") as f:
+            head = f.read(84)
+    except OSError:
+        return 0
+    return struct.unpack("<I", head[80:84])[0] if len(head) == 84 else 0
+
+
 def visual_file(mesh, fmt: str) -> str:
-    """Path below ``meshes/`` of the file a visual geom of format ``fmt`` references."""
+    """Path below ``meshes/`` of the file a visual geom of format ``fmt`` references: for MJCF, a
+    DAE becomes OBJ (Go1's trunk has 351,394 triangles, past what MuJoCo's STL reader takes),
+    an ASCII STL binary STL, and a binary STL with too many triangles OBJ."""
     stem, ext = os.path.splitext(mesh.file_name)
-    if fmt == "mjcf" and (ext.lower() not in MJCF_VISUAL_EXT
-                          or ext.lower() == ".stl" and not mesh.processed and is_ascii_stl(mesh.source)):
-        return f"mjcf/{stem}.stl"
+    if fmt == "mjcf" and ext.lower() not in MJCF_VISUAL_EXT:
+        return f"mjcf/{stem}.obj"
+    if fmt == "mjcf" and ext.lower() == ".stl" and not mesh.processed:
+        if is_ascii_stl(mesh.source):
+            return f"mjcf/{stem}.stl"
+        if binary_stl_faces(mesh.source) > MJCF_STL_FACES:
+            return f"mjcf/{stem}.obj"
     return mesh.path
 
 

@@ -38,6 +38,8 @@ class ImportResult:
     """Per link whose inertial the recipe changes from the original: what was wrong and what it does."""
     joint_notes: dict[str, str] = field(default_factory=dict)
     """Per joint the recipe changes from the original (a mimic of a fixed joint, lower == upper)."""
+    left_out: list[str] = field(default_factory=list)
+    """Elements of the original the recipe leaves out, and why (each in the recipe's header too)."""
 
 
 def is_xacro(path: Path, text: str) -> bool:
@@ -158,6 +160,9 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     else:
         header.append("inertials as given in the original (explicit); those no real body has: "
                       f"{inertia_policy} (--inertia-policy)")
+    from robotkit.importer.recipe_writer import _wrap
+
+    header += [line for note in conv.left_out for line in _wrap(note)]
     text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
@@ -181,7 +186,8 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     from robotkit.importer.inertials import _report_recomputed
 
     result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
-                          repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes))
+                          repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes),
+                          left_out=list(conv.left_out))
     if recompute_inertials:
         _report_recomputed(out, conv, result)
     return result

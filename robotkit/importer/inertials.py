@@ -119,9 +119,14 @@ def _welded_below(name: str, children: dict[str, list[dict]]) -> list[str]:
     return welded
 
 
+POINT_MASS_FLOOR = 1e-5
+"""kg: the least point mass import gives a link without one (libsdformat drops a link of 1e-6 kg)."""
+
+
 def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
-    """A link the build refuses or SDF misreads for having no mass (it moves, or it is a root
-    with moving joints below it and no mass welded to it) gets one: computed from its geometry at the
+    """A link the build refuses or SDF misreads for having no mass (it moves, it is a root
+    with moving joints below it and no mass welded to it, or it has moving joints or mass below
+    it: libsdformat drops such a link with its subtree) gets one: computed from its geometry at the
     recipe's density, or a point mass when it has none.  Each is recorded in ``out.repairs``."""
     moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
     children: dict[str, list[dict]] = {}
@@ -166,8 +171,31 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
             refused.setdefault(bearer(name), f"no mass in the original (nor on the links welded below it), and "
                                              f"joint '{jname}' moves below it: Gazebo's URDF conversion drops "
                                              "everything that moves below it, though it is welded to a link with mass")
+
+    named = {id(j): n for n, j in joints.items()}
+
+    def carries(name: str, seen: frozenset = frozenset()) -> str | None:
+        """The first joint below ``name`` that moves or holds mass (libsdformat drops it)."""
+        for j in children.get(name, []):
+            if j["child"] in seen or j["child"] not in links:
+                continue
+            if j["type"] in moving or _has_mass(links[j["child"]]) or carries(j["child"], seen | {name}):
+                return named[id(j)]
+        return None
+
+    for name in sorted(set(parent_joint) & set(links)):  # a massless link inside the tree: iCub's l_hip_3
+        if body_mass(name) or any(n in refused for n in _welded_below(name, children)):
+            continue
+        below = carries(name)
+        if below:
+            refused.setdefault(name, f"no mass in the original, with joint '{below}' below it: Gazebo's URDF "
+                                     "conversion drops it and everything below it, even welded to a link with mass")
     given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
     point = 1e-3 * min(given) if given else 1e-3
+    # libsdformat reads a mass up to 1e-6 kg as none and drops the link (iCub weighs a link 1e-6 kg)
+    why_point = "a thousandth of the lightest link" if point >= POINT_MASS_FLOOR else \
+        "ten times the 1e-06 kg up to which libsdformat drops a link"
+    point = max(point, POINT_MASS_FLOOR)
     for name, why in refused.items():
         link = links[name]
         if link.get("visual"):
@@ -179,8 +207,8 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
         else:
             floor = inertia_policy.moment_floor(point)
             link["inertial"] = {"mass": point, "inertia": {"ixx": floor, "iyy": floor, "izz": floor}}
-            out.repairs[name] = (f"{why}; it has no geometry: a point mass of {fmt(point)} kg (a thousandth of the "
-                                 f"lightest link) with the smallest inertia a repair leaves")
+            out.repairs[name] = (f"{why}; it has no geometry: a point mass of {fmt(point)} kg ({why_point}) "
+                                 "with the smallest inertia a repair leaves")
 
 
 def _tensor(t: dict):

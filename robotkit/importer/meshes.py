@@ -36,7 +36,7 @@ class MeshResolver:
     def locate(self, uri: str, link: str, problems: _Problems) -> str | None:
         """Absolute path of the file ``uri`` names, or None with a problem."""
         path = None
-        m = re.match(r"^(package|model)://([^/]+)/(.+)$", uri)
+        m = re.match(r"^(package|model):///?([^/]+)/(.+)$", uri)  # package:///PKG/: Pinocchio's reading
         if m:
             pkg, rest = m.group(2), m.group(3)
             if pkg not in self.packages:
@@ -69,7 +69,7 @@ class MeshResolver:
             return path
         if path in self._dest_of:
             return self._dest_of[path]
-        m = re.match(r"^(package|model)://(.+)$", uri)
+        m = re.match(r"^(package|model):///?(.+)$", uri)
         rel = m.group(2) if m else os.path.basename(path)
         dest = os.path.normpath(os.path.join(self.recipe_dir, "meshes", rel))
         stem, ext = os.path.splitext(dest)

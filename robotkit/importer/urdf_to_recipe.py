@@ -56,6 +56,7 @@ class Converted:
     extras: list[str] = field(default_factory=list)  # a short label per verbatim element
     repairs: dict[str, str] = field(default_factory=dict)  # link -> what was wrong and what the recipe does
     joint_notes: dict[str, str] = field(default_factory=dict)  # joint -> what the recipe changes from the original
+    left_out: list[str] = field(default_factory=list)  # elements of the original the recipe leaves out, and why
 
 
 
@@ -284,14 +285,17 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
             warnings.append(f"joint '{name}': {note}")
     for name, joint in joints.items():
         mimic = joint.get("mimic")
-        if mimic and mimic["joint"] not in joints:
-            problems.add(f"joint '{name}': mimics joint '{mimic['joint']}', which is not defined")
+        if mimic and mimic["joint"] not in joints:  # check_urdf accepts it (Alex's hands: 'index_q1')
+            note = (f"mimicked joint '{mimic['joint']}' in the original, which the robot does not have (Drake "
+                    "refuses such a URDF): the mimic is dropped and the joint moves on its own")
         elif mimic and joints[mimic["joint"]]["type"] == "fixed":
             note = (f"mimicked fixed joint '{mimic['joint']}' in the original: a fixed joint has no position to "
                     "follow, so the mimic is dropped and the joint moves on its own")
-            del joint["mimic"]
-            out.joint_notes[name] = note
-            warnings.append(f"joint '{name}': {note}")
+        else:
+            continue
+        del joint["mimic"]
+        out.joint_notes[name] = "; ".join(filter(None, (out.joint_notes.get(name), note)))
+        warnings.append(f"joint '{name}': {note}")
 
     # ---- everything else: gazebo blocks (partly mapped), transmissions, ... verbatim
     extras: list[str] = []
@@ -311,6 +315,14 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
             pes = el.find("preserveFixedJoint")
             if pes is not None and (pes.text or "").strip().lower() in ("true", "1"):
                 drop.add("preserveFixedJoint")  # robotkit writes it for every fixed joint
+        missing = [j.get("name") for j in el.findall("joint") if j.get("name") not in joints] \
+            if tag == "transmission" else []
+        if missing:  # the Jackal's transmissions name joint 'front_left_wheel' for 'front_left_wheel_joint'
+            note = (f"transmission '{el.get('name')}' is left out: it names joint '{missing[0]}', which the robot "
+                    "does not have (Drake refuses the URDF, ros_control the transmission)")
+            out.left_out.append(note)
+            warnings.append(note)
+            continue
         xml_text = _verbatim(dom_children[idx], drop, dom.documentElement)
         if xml_text is None:
             continue

@@ -11,9 +11,11 @@ The policies:
 - ``repair``: the smallest change that makes it physical: the mass raised to a floor when it
   is not positive; the tensor's principal moments raised to a floor (that of a solid sphere of
   radius :data:`MIN_RADIUS` at the link's mass, or :data:`RELATIVE_FLOOR` of the largest
-  moment when that is smaller), then the triangle inequality restored by moving
-  the largest moment down and the other two up by a third of the excess each (the least
-  change in the Frobenius norm).  The principal axes are kept.
+  moment when that is smaller, never below :data:`MIN_MOMENT`), then the triangle inequality
+  restored by moving the largest moment down and the other two up by a third of the excess
+  each (the least change in the Frobenius norm), plus a third of :data:`TRIANGLE_TOL` of the
+  largest, so that the sum of the two ends above it whatever the rounding.  The principal axes
+  are kept.
 - ``recompute``: from the link's geometry, keeping the given mass (a recipe's
   ``inertial: {mass: M}`` does the same; ``robotkit import --recompute-inertials`` for every link).
 - ``estimate``: the link's bounding primitive (robotkit.mesh.inertia.bounding_primitive) as a
@@ -79,10 +81,18 @@ class Repaired:
     """What was changed, one phrase each (empty: nothing was wrong)."""
 
 
+MIN_MOMENT = 1e-13
+"""No repair leaves a principal moment below this (kg m^2): MuJoCo refuses a tensor whose least
+eigenvalue is under 1e-14 (its mjEPS), and ten times that survives its eigen-decomposition's
+rounding.  A tensor a thousandth of whose largest moment is below it is rounding noise (iCub's
+1.4e-20 product of inertia) and gets the floor of a zero one, the sphere's."""
+
+
 def moment_floor(mass: float, largest: float = 0.0) -> float:
     """The smallest principal moment a repair leaves (see the module docstring)."""
     sphere = 0.4 * mass * MIN_RADIUS ** 2
-    return min(sphere, RELATIVE_FLOOR * largest) if largest > 0 else sphere
+    relative = RELATIVE_FLOOR * largest
+    return max(min(sphere, relative) if relative >= MIN_MOMENT else sphere, MIN_MOMENT)
 
 
 def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
@@ -104,12 +114,10 @@ def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
     a, b, c = new
     excess = c - (a + b)
     if excess > c * TRIANGLE_TOL:
-        # a third of the excess each way; principal axes off the link's axes add TRIANGLE_TOL: a
-        # tensor exactly on the boundary comes back from that rotation a rounding short of it,
-        # which MuJoCo refuses (Romeo's arms)
-        margin = 0.0 if np.allclose(np.abs(vecs), np.round(np.abs(vecs)), rtol=0, atol=1e-12) else TRIANGLE_TOL
-        d = (excess + c * margin) / (3 + margin)
-        new = np.array([a + d, b + d, c - d])
+        # a + b ends TRIANGLE_TOL * c above c, not on it: equality rounds either way in float
+        # (0.00366..7 + 0.00366..7 < 0.00733..4), and MuJoCo refuses a + b < c by any amount
+        move = (excess + c * TRIANGLE_TOL) / 3
+        new = np.array([a + move, b + move, c - move])
         changes.append(f"principal moments {_moments((a, b, c))} moved to {_moments(new)} "
                        "to meet the triangle inequality")
     if not changes:
