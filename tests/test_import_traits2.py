@@ -121,7 +121,7 @@ def test_every_consumer_reads_gazebo1_namespaced_blocks(built):
 
 def test_check_on_the_original_reads_the_meshes_and_names_the_refusals(built):
     """The mesh is read (the box's inertia is compared with the given one), the consumers stage
-    runs whatever libsdformat prints, and the errors are the robot's two real defects."""
+    runs whatever libsdformat prints, and the errors are the robot's real defects (its package:/// URIs, once per geometry, and the tensor)."""
     from robotkit.check import check
 
     source, packages, _, _ = built
@@ -130,10 +130,14 @@ def test_check_on_the_original_reads_the_meshes_and_names_the_refusals(built):
         ("link 'base_link'", "the equivalent inertia box (0.245 x 0.245 x 0.245 m) is 2.45x larger than the "
                              "geometry's at uniform density (0.3 x 0.2 x 0.1 m)")]
     assert [(f.check, f.subject, f.message) for f in found if f.severity == "error"] == [
+        ("mesh-uri", "link 'base_link'", "visual mesh 'package:///tpkg/meshes/body.stl' names no package "
+                                         "('package:///' leaves the package name empty): ROS's resource retriever, "
+                                         "RViz, Drake and PyBullet cannot find it"),
+        ("mesh-uri", "link 'base_link'", "collision mesh 'package:///tpkg/meshes/body.stl' names no package "
+                                         "('package:///' leaves the package name empty): ROS's resource retriever, "
+                                         "RViz, Drake and PyBullet cannot find it"),
         ("triangle-inequality", "link 'mount'", "principal moments 0.001, 0.001, 0.01 violate the triangle "
-                                                "inequality (I1 + I2 >= I3): no real body has them"),
-        ("consumer", "robot 'traits2'", f"Drake (URDF) refuses the robot: {source}:6: error: URI "
-                                        "'package:///tpkg/meshes/body.stl' refers to unknown package ''")]
+                                                "inequality (I1 + I2 >= I3): no real body has them")]
     assert [f for f in found if f.check in ("mesh-file", "consumers")] == []
 
 
@@ -213,8 +217,9 @@ def test_the_icub_traits_build_and_every_consumer_loads_them(built_icub):
     assert result.repairs == {
         "hip": "the original's inertia is not positive definite (principal moments -1.35525e-20, 0, 1.35525e-20): "
                "repaired (principal moments -1.35525e-20, 0, 1.35525e-20 raised to at least 1.07e-07 kg m^2)",
-        "ft_frame": "no mass in the original, with joint 'hip_yaw' below it: Gazebo's URDF conversion drops it and "
-                    "everything below it, even welded to a link with mass; it has no geometry: a point mass of "
+        "ft_frame": "no mass in the original (nor on the links welded below it), and joint 'hip_yaw' moves below "
+                    "it: Gazebo's URDF conversion drops everything that moves below it, though it is welded to a "
+                    "link with mass; it has no geometry: a point mass of "
                     "1.0e-05 kg (ten times the 1e-06 kg up to which libsdformat drops a link) with the smallest "
                     "inertia a repair leaves"}
     stated = robot_dir.parent / "stated.urdf"
@@ -238,8 +243,9 @@ def test_check_names_the_massless_link_gazebo_drops(built_icub):
              if f.severity == "error"]
     assert found == [
         ("inertia", "link 'hip'", "inertia is not positive definite (principal moments -1.355e-20, 0, 1.355e-20)"),
-        ("massless-parent", "link 'ft_frame'", "has no mass and joint 'hip_yaw' below it: Gazebo's URDF "
-         "conversion drops the link with everything below it, even welded to a link with mass")]
+        ("massless-moving", "link 'ft_frame'", "joint 'hip_yaw' moves below it but it has no mass, nor the links "
+         "welded below it: Gazebo's URDF conversion drops everything that moves below it, though it is welded to a "
+         "link with mass")]
 
 
 def test_check_names_the_leg_gazebo_drops_when_mujoco_reads_the_original(tmp_path):
@@ -254,8 +260,9 @@ def test_check_names_the_leg_gazebo_drops_when_mujoco_reads_the_original(tmp_pat
                                '</visual>', ''), encoding="utf-8")
     found = [(f.check, f.message) for f in check(str(source)) if f.severity == "error"]
     assert found == [
-        ("massless-parent", "has no mass and joint 'hip_yaw' below it: Gazebo's URDF conversion drops the link "
-                            "with everything below it, even welded to a link with mass"),
+        ("massless-moving", "joint 'hip_yaw' moves below it but it has no mass, nor the links welded below it: "
+                            "Gazebo's URDF conversion drops everything that moves below it, though it is welded to "
+                            "a link with mass"),
         ("consumer", "Gazebo (URDF): total mass 2.267501 kg, the description's is 3.267501 kg"),
         ("consumer", "Gazebo (URDF): link 'leg' (1 kg) is missing")]
 

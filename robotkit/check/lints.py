@@ -144,6 +144,11 @@ def _geom_facts(el, role: str, base: Path, package_paths: dict[str, str], subjec
         props = mi.sphere_props(r)
     elif kind == "mesh":
         uri = shape.get("filename", "")
+        if uri.startswith("package:///"):  # read by robotkit (and the consumers here) as package://PKG/
+            problems.append(Finding("error", "mesh-uri", subject,
+                                    f"{role} mesh '{uri}' names no package ('package:///' leaves the package name "
+                                    "empty): ROS's resource retriever, RViz, Drake and PyBullet cannot find it",
+                                    "write package://PKG/...; robotkit import reads it so"))
         path = resolve_uri(uri, base, package_paths)
         name = os.path.basename(uri)
         if path is None or not path.is_file():
