@@ -118,8 +118,11 @@ def yaml_limits(text: str) -> tuple[str, int] | None:
             if open_nodes[-1][0] > MAX_NODES or sum(f[0] for f in open_nodes) > MAX_NODES:
                 return (f"aliases expand to more than {MAX_NODES:,} values (an alias bomb?)",
                         event.start_mark.line + 1)
-    except yaml.YAMLError:
-        return None
+    except yaml.YAMLError as exc:  # libyaml 0.2.5 as PyYAML 6.0.4 ships it stops deep nesting itself,
+        mark = getattr(exc, "problem_mark", None)  # scanning ahead of the events
+        if "maximum nesting depth" in str(getattr(exc, "problem", "")) and mark is not None:
+            return f"nested deeper than {MAX_DEPTH} levels", mark.line + 1
+        return None  # syntax errors are the composer's to report
     return None
 
 
