@@ -537,6 +537,20 @@ def test_invalid_yaml_and_not_a_mapping(tmp_path, monkeypatch):
         "(image, resolution, origin, negate, occupied_thresh, free_thresh, mode)"]
 
 
+
+def test_deep_nesting_and_alias_bombs_are_refused_before_composing(tmp_path, monkeypatch):
+    """PyYAML's composer recurses once per level (5,000 brackets: RecursionError) and expands
+    aliases in full: the map YAML gets the recipe's limits first."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "deep.yaml").write_text("image: m.pgm\nresolution: " + "[" * 5000 + "]" * 5000 + "\n")
+    assert errors(tmp_path / "deep.yaml") == ["deep.yaml:2: nested deeper than 64 levels"]
+    lines = ["image: m.pgm", "a: &a [" + ", ".join(["1"] * 10) + "]"]
+    for prev, name in zip("abcde", "bcdef"):
+        lines.append(f"{name}: &{name} [" + ", ".join([f"*{prev}"] * 10) + "]")
+    lines.append("g: [" + ", ".join(["*f"] * 10) + "]")
+    (tmp_path / "bomb.yaml").write_text("\n".join(lines) + "\n")
+    assert errors(tmp_path / "bomb.yaml") == ["bomb.yaml:7: aliases expand to more than 1,000,000 values (an alias bomb?)"]
+
 def test_empty_map(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     img = np.full((10, 12), 254, dtype=np.uint8)

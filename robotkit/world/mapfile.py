@@ -148,6 +148,12 @@ def _read_yaml(yaml_path: Path, problems: list[Problem]):
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         problems.append(Problem(f"cannot read file: {reason}", file=file))
         return None, {}
+    from robotkit.recipe.load import yaml_limits
+
+    limit = yaml_limits(text)  # nesting and alias bombs, before the (recursive) composer sees them
+    if limit is not None:
+        problems.append(Problem(limit[0], file=file, line=limit[1]))
+        return None, {}
     try:
         node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.YAMLError as exc:
