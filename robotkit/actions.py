@@ -207,8 +207,6 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
         mesh, info["repair"] = run_repair(mesh)
     kind, value = decimate
     if kind == "none":  # only mirrored (load_mesh flipped the faces of a mirroring scale)
-        from robotkit.mesh.export import stl_bytes
-
         write_if_changed(target, stl_bytes(mesh))
         write_if_changed(report, dump_json(_plain(info)))
         return

@@ -4,7 +4,6 @@ round-trips, and a comment above each link or joint the import changed from the 
 
 from __future__ import annotations
 
-import math
 import posixpath
 import re
 from collections import Counter

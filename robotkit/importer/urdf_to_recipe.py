@@ -36,9 +36,9 @@ from robotkit.importer.meshes import MeshResolver, MeshUse
 from robotkit.importer.names import _material_name, _name_hint, _valid_frame_name, _valid_name
 from robotkit.importer.parsing import _Problems, _float, _floats, _fmt_list, _local, _origin, _origin_dict
 from robotkit.importer.recipe_writer import dump_recipe, fmt  # noqa: F401  (the import's writer)
-from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.errors import Problem, RobotkitError
 from robotkit.emit.urdf import MASSLESS
-from robotkit.recipe.schema import FRAME_NAME_RE, MIN_MASS, NAME_RE, UNITS, _g
+from robotkit.recipe.schema import MIN_MASS, UNITS, _g
 
 GREY = [0.5, 0.5, 0.5, 1.0]
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
