@@ -4,12 +4,13 @@ then MeshLib) against meshlib called plainly, meshoptimizer alone, fast-simplifi
 use), on every visual mesh of the examples (recipes/meshes) and of the robots in
 ../shared/assets.
 
-Per mesh, in a child process of its own (pymeshlab crashes on some inputs): load it once
+Per mesh and tool, in a child process of its own (pymeshlab crashes on some inputs): load it once
 (robotkit.mesh.io.load_mesh: metres, coincident vertices merged), decimate it with every
-tool to the same target (a fraction of its faces), take the best of ``--repeat`` runs per
-tool, interleaved, for wall time (``time.perf_counter``) and CPU time (``time.process_time``:
+tool to the same target (a fraction of its faces), take the best of ``--repeat`` runs for wall time (``time.perf_counter``) and CPU time (``time.process_time``:
 every thread of the process, so a threaded library is not flattered on a shared machine),
-and measure the result independently of robotkit's code:
+and measure the result independently of robotkit's code.  Each tool runs in a process of its
+own, so that no library's idle worker threads (MeshLib's TBB pool spins for a while after its
+work) count in another tool's CPU time:
 
 - faces: the result's face count against the target (within 2 %?);
 - closed: closed before -> closed after (every edge used twice in opposite directions);
@@ -212,32 +213,18 @@ def main() -> int:
             continue
         if n < args.min_faces:
             continue
-        row = None
-        todo = list(tools)
-        for _attempt in range(len(tools)):
+        row = {"mesh": path, "faces": n, "target": max(4, round(args.keep * n)), "closed": None, "tools": {}}
+        for name in tools:  # one process per tool: a crash (pymeshlab's) is that tool's result, and
+            # no library's idle worker threads (MeshLib's TBB pool spins after its work) run on
+            # into another tool's CPU time
             proc = subprocess.run([sys.executable, __file__, "--one", path, "--keep", str(args.keep),
                                    "--repeat", str(args.repeat), "--samples", str(args.samples),
-                                   "--tools", ",".join(todo)], capture_output=True, text=True, timeout=900)
+                                   "--tools", name], capture_output=True, text=True, timeout=900)
             if proc.returncode == 0:
                 got = json.loads(proc.stdout.strip().splitlines()[-1])
-                row = got if row is None else {**row, "tools": {**row["tools"], **got["tools"]}}
-                break
-            # a tool crashed the process (pymeshlab does): find it by running the tools one by one
-            crashed = None
-            for name in todo:
-                p = subprocess.run([sys.executable, __file__, "--one", path, "--keep", str(args.keep),
-                                    "--repeat", "1", "--samples", "10", "--tools", name],
-                                   capture_output=True, text=True, timeout=900)
-                if p.returncode != 0:
-                    crashed = name
-                    break
-            if crashed is None:
-                break
-            todo.remove(crashed)
-            row = row or {"mesh": path, "faces": n, "target": max(4, round(args.keep * n)), "closed": None, "tools": {}}
-            row["tools"][crashed] = {"error": f"crashed (exit {p.returncode})"}
-        if row is None:
-            continue
+                row = {**got, "tools": {**row["tools"], **got["tools"]}}
+            else:
+                row["tools"][name] = {"error": f"crashed (exit {proc.returncode})"}
         row["tools"] = {t: row["tools"].get(t, {"error": "not run"}) for t in tools}
         rows.append(row)
         cells = []
@@ -265,7 +252,7 @@ def summary(rows, tools):
         kept = sum(r["tools"][t]["closed"] for r in closed_in)
         print(f"  {t:20} ran {len(ok):3}; within 2 % of the target {within:3}; closed kept closed "
               f"{kept}/{len(closed_in)}")
-    both = [r for r in rows if all("error" not in r["tools"][t] for t in ("robotkit", "meshlib"))]
+    both = [r for r in rows if all("error" not in r["tools"].get(t, {"error": 1}) for t in ("robotkit", "meshlib"))]
     if both:
         h = np.array([r["tools"]["robotkit"]["hausdorff"] / max(r["tools"]["meshlib"]["hausdorff"], 1e-300)
                       for r in both])

@@ -220,7 +220,7 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
         out, rep = run_decimate(mesh, target_faces=target_faces)
         return out, rep
 
-    out, rep = _cache().get_or_compute("decimate/3", {"faces": target_faces, **library(), "samples": 4000,
+    out, rep = _cache().get_or_compute("decimate/4", {"faces": target_faces, **library(), "samples": 4000,
                                                       "seed": 0, "report": True}, [mesh], compute)
     info["decimate"] = rep
     from robotkit.mesh.export import stl_bytes
@@ -297,7 +297,7 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
             raise ValueError(f"decimation target {faces} faces is above the mesh's {len(mesh.faces)} faces")
         from robotkit.mesh.decimate import decimate, library
 
-        op, args, make = "collision-decimate/3", {"faces": faces, **library(), "seed": 0}, \
+        op, args, make = "collision-decimate/4", {"faces": faces, **library(), "seed": 0}, \
             (lambda: [decimate(mesh, target_faces=faces, samples=0)[0]])
     elif kind == "hull":
         from robotkit.mesh.hull import convex_hull
@@ -312,8 +312,8 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
                     preprocess=c["preprocess"], preprocess_resolution=c["preprocess_resolution"], seed=c["seed"],
                     max_hull_vertices=strategy["max_vertices"], mcts_iterations=c["mcts_iterations"],
                     input_faces=INPUT_FACES)  # in the cache key: the effective parameters
-        op, make = "collision-coacd/3", (lambda: decompose(mesh, **args))  # /2: bodies joined (coacd_input)
-        # /3: its large inputs decimated with the meshoptimizer first pass
+        op, make = "collision-coacd/4", (lambda: decompose(mesh, **args))  # /2: bodies joined (coacd_input)
+        # /3: its large inputs decimated with the meshoptimizer first pass; /4: first pass with locks
     pieces, info = cache.get_or_compute(op, {**args, "fidelity_samples": 4000}, [mesh], with_report(make))
     return list(pieces) if isinstance(pieces, (list, tuple)) else [pieces], info["fidelity"]
 

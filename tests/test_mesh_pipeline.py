@@ -292,21 +292,67 @@ def test_decimate_reaches_the_target_and_keeps_closed_meshes_closed_on_real_mesh
     meshes = [(rel, load_mesh(str(REPO / rel))) for rel in REAL_VISUALS]
     meshes = [(rel, m) for rel, m in meshes if len(m.faces) >= 1000]
     assert len(meshes) == 11
-    misses, first_pass = [], set()
+    misses, rounds = [], {}
     for rel, mesh in meshes:
         out, report = decimate(mesh, ratio=keep, samples=0)
         target = report["target_faces"]
         assert report["faces_after"] == len(out.faces) and report["library"] == "meshlib"
         assert report["prepass_library"] == "meshoptimizer"
-        first_pass.add(report["prepass"] is not None)
+        rounds[rel] = report["prepass_rounds"], report["prepass_locked"], report["prepass"]
         if abs(len(out.faces) - target) > 0.02 * target or (report["is_volume_before"]
                                                             and not report["is_volume_after"]):
             misses.append((rel, target, len(out.faces), report["is_volume_before"], report["is_volume_after"]))
     assert misses == []
-    # both ways are taken: meshoptimizer's first pass (the UR5's parts) and MeshLib alone, where
-    # the first pass would have left duplicate faces (the lidar) or the input has edges of three
-    # faces (the TurtleBot3's base)
-    assert first_pass == {True, False}
+    # the first pass is taken everywhere: at once on the UR5's parts, after locking the vertices
+    # round its duplicate faces on the lidar, and with the vertices of its own edges of three
+    # faces locked from the start on the TurtleBot3's base
+    assert all(factor in (2.0, 4.0) for _, _, factor in rounds.values())
+    assert rounds["recipes/meshes/ur5/visual/forearm.dae"][:2] == (1, 0)
+    assert rounds["recipes/meshes/turtlebot3/lds.stl"][0] > 1
+    assert rounds["recipes/meshes/turtlebot3/burger_base.stl"][1] > 0
+
+
+def test_first_pass_locks_the_vertices_round_meshoptimizers_defects():
+    """meshoptimizer alone leaves duplicate faces and edges of three faces on the TurtleBot3's
+    lidar (thin walls); with the vertices round them locked it gives a closed surface, which
+    MeshLib then takes to the target, closed."""
+    from robotkit.mesh.decimate import CLOSED, _defective_faces, _edge_census, _prepass, _simplify
+    from robotkit.mesh.io import load_mesh
+
+    mesh = load_mesh(str(REPO / "recipes/meshes/turtlebot3/lds.stl"))
+    V = np.asarray(mesh.vertices)
+    Vf = np.ascontiguousarray((V - V.mean(axis=0)) * (1000.0 / np.linalg.norm(np.ptp(V, axis=0))), dtype=np.float32)
+    F = np.asarray(mesh.faces)
+    assert _edge_census(F, len(V)) == CLOSED
+    indices = np.ascontiguousarray(F, dtype=np.uint32).ravel()
+    alone = _simplify(indices, Vf, 3 * 2688, np.zeros(len(V), np.uint8))
+    assert _edge_census(alone, len(V))[0] and _defective_faces(alone, len(V), closed=True).sum() > 0
+    faces, details = _prepass(Vf, F, 1344, closed=True)
+    assert details["prepass"] in (2.0, 4.0) and details["prepass_rounds"] > 1 and details["prepass_locked"] > 0
+    assert _edge_census(faces, len(V)) == CLOSED and len(faces) < 0.7 * len(F)
+    out, report = decimate(mesh, target_faces=1344, samples=0)
+    assert report["is_volume_after"] and 1317 <= report["faces_after"] <= 1344
+
+
+def test_meshlib_runs_on_the_calling_thread_alone():
+    """MeshLib's TBB pool is limited to one thread once robotkit has called it (a build already
+    runs one process per core, and TBB's idle workers spin); trimesh's embreex brings a TBB of
+    its own, so the one in MeshLib's folder is the one limited and checked."""
+    import ctypes
+
+    from robotkit.mesh.decimate import _meshlib_single_threaded
+
+    decimate(trimesh.creation.icosphere(subdivisions=2), target_faces=100, samples=0)
+    with open("/proc/self/maps") as maps:
+        paths = sorted({ln.split()[-1] for ln in maps if "/libtbb" in ln and "malloc" not in ln})
+    meshlib_tbb = [p for p in paths if "meshlib" in Path(p).parent.name]
+    assert len(meshlib_tbb) == 1 and _meshlib_single_threaded() == 1
+    active = ctypes.CDLL(meshlib_tbb[0])._ZN3tbb6detail2r127global_control_active_valueEi
+    active.restype, active.argtypes = ctypes.c_size_t, [ctypes.c_int]
+    assert active(0) == 1
+    threads = len(os.listdir("/proc/self/task"))
+    decimate(trimesh.creation.icosphere(subdivisions=4), target_faces=500, samples=0)
+    assert len(os.listdir("/proc/self/task")) <= threads  # no TBB worker started
 
 
 @pytest.mark.parametrize("first_pass", [False, True])
@@ -317,7 +363,7 @@ def test_decimate_fills_missing_triangles_that_stop_it_above_the_target(monkeypa
     import robotkit.mesh.decimate as decimate_module
 
     if not first_pass:
-        monkeypatch.setattr(decimate_module, "PREPASS_FACTORS", ())
+        monkeypatch.setattr(decimate_module, "PREPASS_LIMIT", 0.0)
     sphere = trimesh.creation.icosphere(subdivisions=4)  # 5,120 faces
     # 40 faces no two of which share a vertex: 40 holes of three edges
     taken, used = [], set()
@@ -361,13 +407,32 @@ def test_edge_census_against_trimesh():
     assert _edge_census(F, 8) == (False, False, 0) and _edge_census(F[1:], 8)[2] == 3
     assert _edge_census(cases["an edge of three faces"], 9)[:2] == (True, True)
     # two faces back to back pass the edge test (each edge twice, in opposite directions),
-    # and MeshLib would make a hole of them: the first pass is refused for repeated corners
-    from robotkit.mesh.decimate import _repeated_faces
+    # and MeshLib would make a hole of them: the first pass's check flags repeated corners too
+    from robotkit.mesh.decimate import _defective_faces
 
     pillow = np.vstack([F, [[8, 9, 10], [10, 9, 8]]])
     assert _edge_census(pillow, 11) == (False, False, 0)
-    assert _repeated_faces(pillow) and _repeated_faces(cases["a flipped duplicate"])
-    assert not _repeated_faces(F) and not _repeated_faces(np.array([[0, 1, 2], [0, 1, 3], [1, 2, 3]]))
+    assert _defective_faces(pillow, 11, closed=True).nonzero()[0].tolist() == [12, 13]
+    # per face, against trimesh's edge counts: the faces on an edge of three faces, on a directed
+    # edge used twice, on a border (closed input), degenerate, or with another face's corners
+    for name, faces in {**cases, "pillow": pillow}.items():
+        m = trimesh.Trimesh(np.vstack([V, np.eye(3) + 5.0]), faces, process=False)
+        und, inv, cnt = np.unique(m.edges_sorted, axis=0, return_inverse=True, return_counts=True)
+        _, dinv, dcnt = np.unique(m.edges, axis=0, return_inverse=True, return_counts=True)
+        slot = (cnt[inv.ravel()] != 2) | (dcnt[dinv.ravel()] > 1)
+        expect = slot.reshape(-1, 3).any(axis=1) | (faces[:, 0] == faces[:, 1])
+        _, rinv, rcnt = np.unique(np.sort(faces, axis=1), axis=0, return_inverse=True, return_counts=True)
+        expect |= rcnt[rinv.ravel()] > 1
+        got = _defective_faces(faces, 11, closed=True)
+        assert got.tolist() == expect.tolist(), name
+        # an edge defect between two allowed vertices is not counted
+        allowed = np.zeros(11, bool)
+        assert _defective_faces(faces, 11, closed=True, allowed=allowed).tolist() == expect.tolist(), name
+    fin = cases["an edge of three faces"]
+    allowed = np.zeros(11, bool)
+    allowed[F[0, :2]] = True
+    assert _defective_faces(fin, 11, closed=False).sum() == 3
+    assert _defective_faces(fin, 11, closed=False, allowed=allowed).sum() == 0
 
 
 def test_closed_volume_agrees_with_trimesh():
