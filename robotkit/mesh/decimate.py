@@ -142,13 +142,14 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
     F = np.asarray(mesh.faces, dtype=np.int64)
     census = _edge_census(F, len(V))
-    vol_in = _closed_volume(V, F, census)
+    lo, hi = (V.min(axis=0), V.max(axis=0)) if len(V) else (np.zeros(3), np.zeros(3))
+    centre = 0.5 * (lo + hi)
+    vol_in = _closed_volume(V, F, census, centre)
     details = {**_NO_PREPASS, "fast_stage": None, "holes_filled": 0}
     if target >= n:
         out = trimesh.Trimesh(V.copy(), F.copy(), process=False)
     else:
-        centre = 0.5 * (V.min(axis=0) + V.max(axis=0))
-        diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+        diag = float(np.linalg.norm(hi - lo)) or 1.0
         k = NORMALISED_DIAGONAL / diag
         degenerate = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
         if degenerate.any():  # MeshLib drops them: the UR5's meshes are closed without them
@@ -157,7 +158,9 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
         closed = vol_in is not None or census == CLOSED  # CLOSED and no volume: inside out
         v, f, details = _decimate_core((V - centre) * k, F, target, closed, defective=census[0])
         out = trimesh.Trimesh(v / k + centre, f, process=False)  # MeshLib packs: every vertex is used
-    vol_out = closed_volume(out)
+    F_out = np.asarray(out.faces, dtype=np.int64)
+    V_out = np.asarray(out.vertices, dtype=np.float64)
+    vol_out = _closed_volume(V_out, F_out, _edge_census(F_out, len(V_out)), centre)
     report = {
         **library(),
         "faces_before": n, "faces_after": int(len(out.faces)), "target_faces": target,
@@ -493,11 +496,14 @@ def closed_volume(mesh) -> float | None:
     return _closed_volume(V, F, _edge_census(F, len(V)))
 
 
-def _closed_volume(V: np.ndarray, F: np.ndarray, census: tuple) -> float | None:
-    """:func:`closed_volume` of (V, F) whose :func:`_edge_census` is ``census``."""
+def _closed_volume(V: np.ndarray, F: np.ndarray, census: tuple, ref: np.ndarray | None = None) -> float | None:
+    """:func:`closed_volume` of (V, F) whose :func:`_edge_census` is ``census``; the signed
+    tetrahedra are taken from ``ref`` (default: the bounding-box centre), near the mesh for
+    precision."""
     if census != CLOSED or len(F) < 4 or not np.isfinite(V).all():
         return None
-    ref = 0.5 * (V.min(axis=0) + V.max(axis=0))
+    if ref is None:
+        ref = 0.5 * (V.min(axis=0) + V.max(axis=0))
     Vt = np.ascontiguousarray((V - ref).T)
     (ax, ay, az), (bx, by, bz), (cx, cy, cz) = ([np.take(Vt[k], F[:, j]) for k in range(3)] for j in range(3))
     volume = float((ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)).sum()) / 6.0
