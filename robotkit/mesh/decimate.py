@@ -25,7 +25,7 @@ more, to 4 times the target; where that fails too, or the first run leaves many 
 the work alone, first without moving vertices to 3 times the target, then with
 its optimal positions.  Where the pass is taken MeshLib has a fifth of the faces to collapse,
 2-4 times less time in all, and the Hausdorff distance was smaller in the median
-(0.8 of MeshLib alone's).  MeshLib checks every
+(0.85 of MeshLib alone's).  MeshLib checks every
 collapse (topology, flips), so a closed mesh stays closed.  Edge collapses keep
 holes: a mesh that lacks triangles of its tessellation (the KUKA iiwa's
 ``link_7`` lacks 37) stops far above a low target, so when MeshLib stops above
