@@ -230,10 +230,9 @@ def _prepass(Vf: np.ndarray, F: np.ndarray, target: int, closed: bool,
     goes to MeshLib unchanged, with its fast stage (measured on the 93 meshes of
     benchmarks/bench_decimate.py: a run to 2 times the target and a second to 4 times were as
     fast over the sum as six runs, and as close; the TurtleBot3's tyres came out clean from the
-    second).  An input with
-    defects of its own (edges of three faces, a directed edge twice: the TurtleBot3's base)
-    has their vertices locked from the start, and those defects are not counted against the
-    result.  The result indexes the input's vertices (MeshLib drops the unused ones).
+    second).  An input with defects of its own (edges of three faces, a directed edge twice:
+    the TurtleBot3's base) has their vertices locked from the start, and those defects are not
+    counted against the result.  The result indexes the input's vertices (MeshLib drops the unused ones).
 
     Returns (faces, details): ``prepass`` (the factor, None when the first pass was not
     used), ``prepass_rounds`` (meshoptimizer runs) and ``prepass_locked`` (vertices locked
