@@ -114,8 +114,10 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     than three edges).
 
     Report: :func:`library`, ``prepass`` (the multiple of the target meshoptimizer's
-    first pass went to, None when it was not used), ``holes_filled`` (missing triangles
-    filled), ``faces_before``, ``faces_after``, ``target_reached``, ``vertices_before``,
+    first pass went to, None when it was not used), ``prepass_rounds`` (meshoptimizer's
+    runs), ``prepass_locked`` (vertices it kept locked), ``fast_stage`` (the multiple of the
+    target MeshLib's fast stage went to, None when not used), ``holes_filled`` (missing
+    triangles filled), ``faces_before``, ``faces_after``, ``target_reached``, ``vertices_before``,
     ``vertices_after``, ``target_faces``, ``volume_before``, ``volume_after``,
     ``volume_change`` (relative, ``after/before - 1``; None unless both are
     closed volumes), ``is_volume_before``, ``is_volume_after``, and
@@ -174,12 +176,12 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     return out, report
 
 
-def _decimate_core(V: np.ndarray, F: np.ndarray, target: int, closed: bool, prepass: bool = True,
+def _decimate_core(V: np.ndarray, F: np.ndarray, target: int, closed: bool,
                    defective: bool = True) -> tuple[np.ndarray, np.ndarray, dict]:
     """Decimate (V, F), already normalised, to ``target`` faces: (float64 vertices, int64 faces, details).
 
-    A meshoptimizer pass first (:func:`_prepass`; not tried when ``prepass`` is false), then
-    MeshLib to the target; where the first pass gives up, MeshLib's own fast stage instead
+    A meshoptimizer pass first (:func:`_prepass`; ``defective``: whether the input may have
+    defects of its own, false when the caller's census found none), then MeshLib to the target; where the first pass gives up, MeshLib's own fast stage instead
     (``FAST_STAGE``, :func:`_meshlib_decimate`).  When MeshLib stops above the target and the
     input has missing triangles (holes of three edges, which edge collapses cannot remove), the
     same again on the input with those filled.  Details: ``prepass`` (the factor of the target
@@ -188,8 +190,8 @@ def _decimate_core(V: np.ndarray, F: np.ndarray, target: int, closed: bool, prep
     ``holes_filled``.
     """
     def run(Vf, F, defective):
-        first, details = _prepass(Vf, F, target, closed, defective) if prepass else (F, _NO_PREPASS)
-        fast = FAST_STAGE if prepass and details["prepass"] is None and FAST_STAGE * target < len(F) else None
+        first, details = _prepass(Vf, F, target, closed, defective)
+        fast = FAST_STAGE if details["prepass"] is None and FAST_STAGE * target < len(F) else None
         v, f = _meshlib_decimate(Vf, first, target, fast_stage=fast)
         return v, f, {**details, "fast_stage": fast}
 
