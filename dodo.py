@@ -1,6 +1,6 @@
 """`doit` in the repository root builds every recipe in recipes/ into build/.
 
-The tasks are the same ones `robotkit build recipes/*.yaml` runs (robotkit.tasks),
+The tasks are the same ones `robotkit build recipes/*.yaml` runs (robotkit.pipeline.tasks),
 with the same dependency database (build/.robotkit/doit.sqlite3), so the two
 commands share one incremental state.
 
@@ -14,9 +14,9 @@ from pathlib import Path
 
 from doit import get_var
 
-from robotkit.build import doit_config, to_doit
+from robotkit.pipeline.runner import doit_config, to_doit
 from robotkit.errors import RobotkitError
-from robotkit.tasks import all_tasks
+from robotkit.pipeline.tasks import all_tasks
 
 ROOT = Path(__file__).resolve().parent
 OUT = ROOT / "build"

@@ -20,7 +20,7 @@ sys.path.insert(0, str(REPO))
 
 
 def main() -> None:
-    from robotkit.build import build
+    from robotkit.pipeline.runner import build
     from robotkit.check.consumers import CONSUMERS, Build, read
 
     out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(tempfile.mkdtemp())

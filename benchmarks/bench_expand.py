@@ -41,7 +41,7 @@ parts:
 
 
 def recipe_text(pairs: int) -> str:
-    lines = [f"robot: centipede", "density: 800", "links:",
+    lines = ["robot: centipede", "density: 800", "links:",
              f"  body: {{visual: {{box: {{size: [{pairs * 0.08:.2f}, 0.1, 0.05]}}}}}}", PART.strip(), "instances:"]
     for i in range(pairs):
         x = f"{i * 8} cm"
@@ -66,7 +66,7 @@ def main() -> None:
     ap.add_argument("--legs", type=int, default=250)
     args = ap.parse_args()
     from robotkit.recipe.load import read_recipes
-    from robotkit.tasks import load_robots
+    from robotkit.model.load import load_robots
 
     tmp = Path(tempfile.mkdtemp(prefix="bench-expand-"))
     parts = tmp / "parts.yaml"

@@ -1,9 +1,12 @@
-"""Small file helpers shared by every stage: atomic, change-only writes."""
+"""Small helpers shared by every stage: atomic, change-only writes; environment variables set
+for the length of a ``with`` block."""
 
 from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -35,3 +38,19 @@ def write_if_changed(path: str | os.PathLike, data: bytes | str) -> bool:
             pass
         raise
     return True
+
+
+@contextmanager
+def environ(changes: Mapping[str, str]) -> Iterator[None]:
+    """Set environment variables inside the ``with`` block (worker processes started there
+    inherit them), then restore each one as it was, unset included."""
+    old = {name: os.environ.get(name) for name in changes}
+    os.environ.update(changes)
+    try:
+        yield
+    finally:
+        for name, value in old.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value

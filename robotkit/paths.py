@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.ioutil import environ
 
 ROOT_ENV = "ROBOTKIT_ROOT"
 """Extra read roots, separated by ``os.pathsep``: widening the project on purpose."""
@@ -117,14 +118,8 @@ def widened(folders):
     in the package paths the user declared."""
     old = os.environ.get(ROOT_ENV)
     extra = [os.path.abspath(os.fspath(f)) for f in folders]
-    os.environ[ROOT_ENV] = os.pathsep.join(dict.fromkeys(extra + [p for p in (old or "").split(os.pathsep) if p]))
-    try:
+    with environ({ROOT_ENV: os.pathsep.join(dict.fromkeys(extra + [p for p in (old or "").split(os.pathsep) if p]))}):
         yield
-    finally:
-        if old is None:
-            os.environ.pop(ROOT_ENV, None)
-        else:
-            os.environ[ROOT_ENV] = old
 
 
 def out_join(out_dir: str | os.PathLike, *parts: str, key: str | None = None) -> Path:

@@ -58,7 +58,7 @@ def read_roots(tmp_path_factory):
 @pytest.fixture(scope="session")
 def examples(tmp_path_factory) -> Path:
     """Every example recipe of recipes/ built once per session (tests that change a build copy it first)."""
-    from robotkit.build import build
+    from robotkit.pipeline.runner import build
 
     out = tmp_path_factory.mktemp("examples")
     result = build(sorted(RECIPES.glob("*.yaml")), out)

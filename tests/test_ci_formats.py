@@ -176,7 +176,7 @@ def test_a_missing_path_is_a_failing_case(tmp_path, junit_schema):
 
 def test_annotation_escapes_properties_and_message():
     from robotkit.check.findings import Finding
-    from robotkit.check.report import annotation
+    from robotkit.check.render import annotation
 
     f = Finding("warning", "mass,odd", "link 'a:b'", "50% off\nsecond line", file="dir,x/r:1.yaml", line=3)
     line = annotation(f)

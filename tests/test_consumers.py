@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from conftest import example_robots, run_cli, write_recipe
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from robotkit.check.consumers import CONSUMERS, Build, consumer_findings, read
 from robotkit.check.simulation import smoke_test
 from validators import IN_CI, ign_sdf_check, require

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.kinematics import compare, read_urdf
 from robotkit.importer import import_file
@@ -391,7 +391,7 @@ def test_check_names_the_real_defects_of_each_original(name):
     """`robotkit check` on each original (the xacro with its package paths, or the URDF): the
     errors are exactly the robot's real defects (a consumer's own limit, such as Drake reading
     no STL collision mesh, is a warning)."""
-    from robotkit.check import check
+    from robotkit.commands.check import check
 
     spec = CORPUS[name]
     found: dict[str, list[str]] = {}

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from conftest import GOLDEN, assert_golden, example_robots, run_cli, write_recipe
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from robotkit.check.equivalence import equivalence
 from robotkit.check.simulation import smoke_test
 from validators import check_urdf, ign_sdf_check, mujoco, require

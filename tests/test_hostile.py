@@ -53,20 +53,20 @@ def written(out: Path) -> list[str]:
 
 CASES = {
     "nan_inf_and_overflow": (
-        f"""
+        """
         robot: arm
         density: 1e308
         links:
-          base: {{visual: {{box: {{size: [1, 1, 1]}}, origin: {{xyz: [.nan, 0, 0]}}}}}}
+          base: {visual: {box: {size: [1, 1, 1]}, origin: {xyz: [.nan, 0, 0]}}}
           b2:
-            visual: {{sphere: {{radius: .inf}}}}
-            inertial: {{mass: .inf}}
+            visual: {sphere: {radius: .inf}}
+            inertial: {mass: .inf}
           b3:
-            visual: {{box: {{size: [1e-300, 1, 1]}}}}
-            inertial: {{mass: -.inf}}
+            visual: {box: {size: [1e-300, 1, 1]}}
+            inertial: {mass: -.inf}
         joints:
-          j: {{type: fixed, parent: base, child: b2}}
-          k: {{type: revolute, parent: base, child: b3, limit: {{lower: -1, upper: 1e400, effort: 1, velocity: 1}}}}
+          j: {type: fixed, parent: base, child: b2}
+          k: {type: revolute, parent: base, child: b3, limit: {lower: -1, upper: 1e400, effort: 1, velocity: 1}}
         """,
         ["robot.yaml:2: density: must be <= 100000",
          "robot.yaml:4: links.base.visual.origin.xyz[0]: must be a finite number (got nan)",
@@ -77,14 +77,14 @@ CASES = {
          "robot.yaml:13: joints.k.limit.upper: must be a finite number (got '1e400')"],
     ),
     "huge_integers_and_counts": (
-        f"""
+        """
         robot: arm
         links:
           base:
-            visual: {{box: {{size: [1, 1, 1]}}}}
-            collision: {{strategy: decompose, coacd: {{resolution: 1000000000000000000000000000000}}}}
+            visual: {box: {size: [1, 1, 1]}}
+            collision: {strategy: decompose, coacd: {resolution: 1000000000000000000000000000000}}
         sensors:
-          lidar: {{type: lidar, parent: base, lidar: {{samples: 100000000000}}, update_rate: 1e9}}
+          lidar: {type: lidar, parent: base, lidar: {samples: 100000000000}, update_rate: 1e9}
         """,
         ["robot.yaml:5: links.base.collision.coacd.resolution: must be <= 100000000",
          "robot.yaml:7: sensors.lidar.update_rate: must be <= 1e6",
@@ -343,7 +343,7 @@ def load(recipe: Path, cwd: Path, monkeypatch) -> tuple[int, str, str]:
     """What ``robotkit build`` answers before it runs a task (load, expand, validate, resolve),
     as the CLI prints it."""
     from robotkit.errors import RobotkitError
-    from robotkit.tasks import load_robots
+    from robotkit.model.load import load_robots
 
     monkeypatch.chdir(cwd)
     try:

@@ -9,7 +9,6 @@ exact error messages for missing packages and meshes.
 
 from __future__ import annotations
 
-import argparse
 import os
 import re
 import shutil
@@ -22,7 +21,7 @@ import numpy as np
 import pytest
 import yaml
 
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from robotkit.errors import RobotkitError
 from robotkit.importer import import_file
 from robotkit.importer.urdf_to_recipe import no_inertial_form
@@ -556,22 +555,20 @@ def test_acceptance_gripper_arm(tmp_path, gripper_arm):
 
 
 def test_cli_module(tmp_path, gripper_arm, capsys):
-    """robotkit/importer/cli.py as robotkit/cli.py will call it."""
-    from robotkit.importer import cli
+    """robotkit import through the command line's parser and robotkit/commands/import_.py."""
+    from robotkit.cli import main
 
     top, packages = gripper_arm
-    parser = argparse.ArgumentParser(prog="robotkit")
-    cli.add_parser(parser.add_subparsers(dest="command"))
     argv = ["import", str(top), "-o", str(tmp_path / "arm.yaml"), "--arg", "arm_length:=0.35",
             "--arg", "hand_mass:=0.25"]
     for name, folder in packages.items():
         argv += ["--package-path", f"{name}={folder}"]
-    assert cli.run(parser.parse_args(argv)) == 0
+    assert main(argv) == 0
     out, err = capsys.readouterr()
     assert "wrote" in out and "warning: " in err
     assert "xacro arguments: arm_length:=0.35 hand_mass:=0.25" in (tmp_path / "arm.yaml").read_text()
     with pytest.raises(SystemExit):
-        parser.parse_args(["import", str(top), "-o", "x.yaml", "--arg", "arm_length=0.35"])
+        main(["import", str(top), "-o", "x.yaml", "--arg", "arm_length=0.35"])
 
 
 def test_link_without_inertial_but_with_geometry(tmp_path):
@@ -627,9 +624,10 @@ def test_material_conflicts(tmp_path):
 
 def _finalized_robot(recipe: Path, out: Path):
     """The robot as the build's emitters see it (explicit inertials need no mesh facts)."""
-    from robotkit.actions import read_facts
+    from robotkit.pipeline.actions import read_facts
     from robotkit.model.resolve import finalize
-    from robotkit.tasks import STATE, load_robots
+    from robotkit.model.load import load_robots
+    from robotkit.pipeline.publish import STATE
 
     (_, robot), = load_robots([recipe])
     facts_dir = out / STATE / robot.name / "mesh"

@@ -32,7 +32,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.kinematics import compare, read_urdf
 from robotkit.importer import import_file

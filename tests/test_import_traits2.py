@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.kinematics import compare, read_urdf
 from robotkit.importer import import_file
@@ -122,7 +122,7 @@ def test_every_consumer_reads_gazebo1_namespaced_blocks(built):
 def test_check_on_the_original_reads_the_meshes_and_names_the_refusals(built):
     """The mesh is read (the box's inertia is compared with the given one), the consumers stage
     runs whatever libsdformat prints, and the errors are the robot's real defects (its package:/// URIs, once per geometry, and the tensor)."""
-    from robotkit.check import check
+    from robotkit.commands.check import check
 
     source, packages, _, _ = built
     found = check(str(source), package_paths=packages)
@@ -236,7 +236,7 @@ def test_the_icub_traits_build_and_every_consumer_loads_them(built_icub):
 
 
 def test_check_names_the_massless_link_gazebo_drops(built_icub):
-    from robotkit.check import check
+    from robotkit.commands.check import check
 
     source, packages, _, _ = built_icub
     found = [(f.check, f.subject, f.message) for f in check(str(source), package_paths=packages)
@@ -250,7 +250,7 @@ def test_check_names_the_massless_link_gazebo_drops(built_icub):
 
 def test_check_names_the_leg_gazebo_drops_when_mujoco_reads_the_original(tmp_path):
     """Without the ankle's tensor, MuJoCo reads the original and the consumers are compared."""
-    from robotkit.check import check
+    from robotkit.commands.check import check
 
     source = tmp_path / "frame.urdf"
     source.write_text(URDF_ICUB.replace('ixz="1.35525e-20"', 'ixz="0"').replace('ixx="0" ixy="0" ixz="0" iyy="0" '
@@ -309,7 +309,7 @@ def test_a_transmission_naming_no_joint_is_left_out_and_stated(tmp_path):
     'front_left_wheel_joint' (and it includes a placeholder file twice, by $(arg) and by
     $(optenv), whose <robot> holds a stray character): Drake refuses such a URDF, so import
     leaves those transmissions out, says so in the recipe, and check names them."""
-    from robotkit.check import check
+    from robotkit.commands.check import check
 
     (tmp_path / "extras.urdf").write_text("<robot>\n  <!-- placeholder -->\ne</robot>\n", encoding="utf-8")
     source = tmp_path / "rover.urdf.xacro"
@@ -365,7 +365,7 @@ def test_a_mimic_of_a_joint_the_robot_lacks_is_dropped_and_stated(tmp_path):
     """Alex's hands mimic 'index_q1' where the joint is 'Left_index_q1': check_urdf accepts it,
     Drake refuses it.  Import drops the mimic (the joint moves on its own, stated above it),
     the build loads everywhere, and check names the mimic."""
-    from robotkit.check import check
+    from robotkit.commands.check import check
 
     mujoco()
     source = tmp_path / "hand.urdf"
@@ -421,7 +421,7 @@ def test_frames_with_inertials_of_mass_0_welded_together(tmp_path):
     """Talos's camera frames each carry an <inertial> of mass 0, one welded to the next: Gazebo
     refuses the original ("Pose values must be finite"); the build, whose frames carry no
     inertial, loads everywhere, and check names the pair."""
-    from robotkit.check import check
+    from robotkit.commands.check import check
 
     mujoco()
     source = tmp_path / "head.urdf"

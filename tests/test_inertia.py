@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from robotkit.mesh.inertia import (box_props, combine, cylinder_props, mesh_mass_properties,
-                                   sphere_props)
+from robotkit.mesh.inertia import mesh_mass_properties
+from robotkit.model.massprops import box_props, combine, cylinder_props, sphere_props
 from robotkit.model.robot import rpy_matrix, matrix_rpy
 
 

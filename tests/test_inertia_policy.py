@@ -8,7 +8,7 @@ import pytest
 
 from robotkit.errors import RobotkitError
 from robotkit.model import inertia_policy as ip
-from robotkit.tasks import load_robots
+from robotkit.model.load import load_robots
 from tests.conftest import write_recipe
 
 
@@ -94,7 +94,7 @@ def _built_inertials(recipe, out):
     carry the same masses and tensors (robotkit.check.equivalence, at 1e-9)."""
     import xml.etree.ElementTree as ET
 
-    from robotkit.build import build
+    from robotkit.pipeline.runner import build
     from robotkit.check.equivalence import equivalence
     from tests.validators import mujoco, require
 
@@ -220,7 +220,7 @@ def test_estimate_needs_a_mass(tmp_path):
 def test_the_bounding_primitive_is_the_smallest_enclosure():
     import trimesh
 
-    from robotkit.mesh.inertia import bounding_primitive
+    from robotkit.model.massprops import bounding_primitive
 
     # a box along the axes: the box itself (exact), centred on it
     box = trimesh.creation.box([0.1, 0.2, 0.4])

@@ -24,7 +24,8 @@ from robotkit.mesh.decompose import decompose
 from robotkit.mesh.export import obj_bytes, stl_bytes
 from robotkit.mesh.fidelity import fidelity
 from robotkit.mesh.hull import canonical, convex_hull, convex_hull_report, from_manifold, to_manifold
-from robotkit.mesh.inertia import box_props, mesh_mass_properties
+from robotkit.mesh.inertia import mesh_mass_properties
+from robotkit.model.massprops import box_props
 from robotkit.mesh.primitives import Primitive, fit_box, fit_capsule, fit_cylinder, fit_sphere
 from robotkit.mesh.repair import repair
 from robotkit.mesh.transform import transform

@@ -1,4 +1,4 @@
-"""The no-op fast path (robotkit.stamp): a second build answers from the stamp without loading
+"""The no-op fast path (robotkit.pipeline.stamp): a second build answers from the stamp without loading
 anything, and every change to an input or an output falls through to the real build."""
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-import robotkit.build
-from robotkit import stamp
+import robotkit.pipeline.runner
+from robotkit.pipeline import stamp
 from robotkit.cli import main
 
 REPO = Path(__file__).resolve().parents[1]
@@ -42,17 +42,17 @@ def project(tmp_path, monkeypatch):
 
 
 class Calls:
-    """Counts real builds (robotkit.build.build) made by the CLI."""
+    """Counts real builds (robotkit.pipeline.runner.build) made by the CLI."""
 
     def __init__(self, monkeypatch):
         self.n = 0
-        real = robotkit.build.build
+        real = robotkit.pipeline.runner.build
 
         def counted(*a, **k):
             self.n += 1
             return real(*a, **k)
 
-        monkeypatch.setattr(robotkit.build, "build", counted)
+        monkeypatch.setattr(robotkit.pipeline.runner, "build", counted)
 
 
 def build(capsys) -> str:
@@ -99,7 +99,7 @@ def test_second_build_answers_from_the_stamp_and_changes_fall_through(project, c
          True),
         ("mesh", lambda: scale_mesh(project / "slider.stl"), True),
         ("template, touched only", lambda: bump(template), False),
-        # the staged file is published again (robotkit.publish): no task reruns
+        # the staged file is published again (robotkit.pipeline.publish): no task reruns
         ("output deleted", lambda: (project / "out" / "bot" / "urdf" / "bot.urdf").unlink(), False),
         # doit reruns a task for its inputs, not for an edited target: the real build decides
         ("output edited", lambda: bump(project / "out" / "bot" / "model.sdf", "<sdf/>\n"), False),

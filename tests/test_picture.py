@@ -13,7 +13,7 @@ import trimesh
 from PIL import Image
 
 from conftest import GOLDEN, RECIPES, assert_golden, run_cli, write_recipe
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 
 CHROMIUM_ARGS = ["--no-sandbox", "--headless", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run"]

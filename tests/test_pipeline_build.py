@@ -13,7 +13,7 @@ import pytest
 import trimesh
 
 from conftest import RECIPES, run_cli, tree_bytes, write_recipe
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from validators import check_urdf, ign_sdf_check, mujoco
 
 

@@ -1,4 +1,4 @@
-"""The progress line of long builds (robotkit.progress): on a terminal only, erased before anything else."""
+"""The progress line of long builds (robotkit.pipeline.progress): on a terminal only, erased before anything else."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import sys
 import threading
 
 from conftest import write_recipe
-from robotkit.progress import Progress
+from robotkit.pipeline.progress import Progress
 
 
 class Terminal(io.StringIO):

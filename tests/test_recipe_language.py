@@ -12,7 +12,7 @@ import trimesh
 import yaml
 
 from conftest import REPO, RECIPES, run_cli, write_recipe
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from robotkit.recipe.expand import units
 from robotkit.recipe.expand.expr import ExprError, evaluate
 from robotkit.check.kinematics import compare, read_urdf
@@ -554,7 +554,7 @@ def test_the_no_op_fast_path_sees_arguments_and_part_files(tmp_path):
 
 def test_doit_takes_arguments_for_the_recipes_that_declare_them(tmp_path):
     from robotkit.errors import RobotkitError
-    from robotkit.tasks import all_tasks
+    from robotkit.pipeline.tasks import all_tasks
 
     a = write_recipe(tmp_path, "robot: a\nargs: {size: 0.1}\nlinks: {base: {visual: {sphere: {radius: '${size}'}}}}\n",
                      name="a.yaml")

@@ -43,7 +43,7 @@ def _sourced(ws: Path, command: str, *argv: str) -> subprocess.CompletedProcess:
 
 @pytest.fixture(scope="session")
 def ros1_packages(tmp_path_factory) -> Path:
-    from robotkit.build import build
+    from robotkit.pipeline.runner import build
 
     out = tmp_path_factory.mktemp("ros1-build")
     # one process: a doit worker forked from the test process, which holds other libraries'

@@ -22,7 +22,7 @@ EXAMPLES = ["turret_bot", "lidar_mast", "rover", "turtlebot3_burger", "ur5"]
 
 @pytest.fixture(scope="session")
 def ros2_packages(tmp_path_factory) -> Path:
-    from robotkit.build import build
+    from robotkit.pipeline.runner import build
 
     out = tmp_path_factory.mktemp("ros2-build")
     # one process: a doit worker forked from the test process, which holds other libraries'
@@ -34,7 +34,7 @@ def ros2_packages(tmp_path_factory) -> Path:
 @pytest.fixture(scope="session")
 def ros1_small(tmp_path_factory) -> Path:
     """The ROS 1 packages of the examples that build in a second."""
-    from robotkit.build import build
+    from robotkit.pipeline.runner import build
 
     out = tmp_path_factory.mktemp("ros1-small")
     build([RECIPES / f"{name}.yaml" for name in ("turret_bot", "rover")], out, ros="ros1")
@@ -248,7 +248,7 @@ def test_bad_ros_input(tmp_path, extra, args, line):
 def test_rviz_view_fits_the_robot(tmp_path):
     """A 2 m cube raised 1 m: RViz looks at its centre from where its bounding sphere (radius
     sqrt(3)) fills 80 % of the 45-degree view: sqrt(3) / sin(22.5 deg) / 0.8 = 5.658 m."""
-    from robotkit.build import build
+    from robotkit.pipeline.runner import build
 
     recipe = write_recipe(tmp_path, "robot: cube\nlinks:\n  base: {visual: {box: {size: [2, 2, 2]}, "
                                     "origin: {xyz: [0, 0, 1]}}}\n")

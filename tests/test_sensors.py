@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from conftest import RECIPES, write_recipe
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from robotkit.check import kinematics as k
 from validators import check_urdf, ign_sdf_check, mujoco
 

@@ -12,7 +12,7 @@ import pytest
 import trimesh
 
 from conftest import GOLDEN, assert_golden, RECIPES, run_cli, tree_bytes
-from robotkit.build import build
+from robotkit.pipeline.runner import build
 from validators import check_urdf
 
 # REFERENCE_NUMBERS.md, "trimesh check" column (printed to 6 decimals): mass, com, (ixx, iyy, izz)

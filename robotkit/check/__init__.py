@@ -1,8 +1,9 @@
-"""`robotkit check`: validators, physics lints, cross-format equivalence and a simulation
-smoke test, folded into one list of findings and rendered for people, CI and editors.
+"""The check stages: validators, physics lints, cross-format equivalence, the consuming
+programs and a simulation smoke test, each folded into one list of findings.
 
-PATH may be a recipe (built first), a build folder (``OUT/<robot>`` or ``OUT``), or a URDF,
-SDF or MJCF file written anywhere (meshes resolved relative to it or via --package-path).
+One function per kind of input: a robotkit build folder, a URDF, a xacro file, an SDF or MJCF
+file written anywhere (meshes resolved relative to it or via package paths).  Which PATH is
+which, and building a recipe first, is ``robotkit.commands.check``'s job.
 """
 
 from __future__ import annotations
@@ -13,8 +14,8 @@ from pathlib import Path
 
 from robotkit.check.findings import Finding
 from robotkit.check.locate import locate
-from robotkit.check.report import render  # noqa: F401  (the CLI renders through here)
 from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
+from robotkit.emit.layout import robot_layout
 from robotkit.errors import Problem, RobotkitError
 
 
@@ -137,9 +138,8 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
     from robotkit.check.lints import lint, read_urdf_facts
     from robotkit.check.simulation import smoke_test
 
-    name = robot_dir.name
-    urdf, sdf = robot_dir / "urdf" / f"{name}.urdf", robot_dir / "model.sdf"
-    mjcf, scene = robot_dir / "mjcf" / f"{name}.xml", robot_dir / "mjcf" / "scene.xml"
+    layout = robot_layout(robot_dir)
+    name, urdf, sdf, mjcf, scene = layout.name, layout.urdf, layout.sdf, layout.mjcf, layout.scene
     for p in (urdf, sdf, mjcf, scene):
         if not p.is_file():
             raise RobotkitError(Problem(f"not a robotkit build folder: {p.relative_to(robot_dir)} is missing",
@@ -167,76 +167,15 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
     return findings
 
 
-def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
-    from robotkit.build import build
-    from robotkit.buildwarn import parse
-    from robotkit.recipe.load import load_recipes
-
-    located = []
-    result = build([path], out_dir, args=args, report=report)
-    warnings = [parse(w) for w in result.warning_lines]  # (file, line, key, text)
-    for i, loaded in enumerate(load_recipes(path, args)):  # one per variant
-        name = loaded.recipe.robot
-        others = [r for r in result.robots if r != name]
-        # a warning naming another variant's robot belongs to that one; the rest to the first
-        mine = [w for w in warnings if w[3].startswith(f"{name}:")
-                or (i == 0 and not any(w[3].startswith(f"{o}:") for o in others))]
-        located += _check_variant(loaded, mine, out_dir)
-    return located
-
-
-def _check_variant(loaded, warnings: list[tuple], out_dir: str) -> list[Finding]:
-    name = loaded.recipe.robot
-    build_findings = [Finding("warning", "build", key or f"robot '{name}'", text, file=file, line=line)
-                      for file, line, key, text in warnings]
-    findings = check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
-    marks = loaded.marks
-    located = []
-    for f in findings:
-        key = ("robot",)
-        if f.subject.startswith("link '"):
-            key = ("links", f.subject[6:-1])
-        elif f.subject.startswith("joint '"):
-            key = ("joints", f.subject[7:-1])
-        file, line = marks.locate(key)
-        located.append(replace(f, file=file, line=line))
-    return [f if f.file else replace(f, **dict(zip(("file", "line"), marks.locate(("robot",)))))
-            for f in build_findings] + located
-
-
-def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
-          args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
-    """``report``: a recipe's build also writes its picture report (as ``robotkit build`` does)."""
-    p = Path(path)
-    package_paths = package_paths or {}
-    if p.is_dir():
-        if (p / "model.sdf").is_file():
-            dirs = [p]
-        else:
-            dirs = sorted(d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
-        if not dirs:
-            raise RobotkitError(Problem("not a build folder (no <robot>/model.sdf below it)", file=path))
-        # a build folder's findings point at its URDF
-        return [f for d in dirs for f in locate(check_build_dir(d), d / "urdf" / f"{d.name}.urdf")]
-    if not p.is_file():
-        raise RobotkitError(Problem("no such file or folder", file=path))
-    suffix = p.suffix.lower()
-    if suffix in (".yaml", ".yml"):
-        return check_recipe(p, out_dir, args, report)
-    if suffix == ".urdf":
-        return check_urdf_file(p, package_paths)
-    if suffix == ".xacro":
-        return check_xacro_file(p, package_paths, args or {})
-    if suffix in (".sdf", ".world"):
-        return locate(validate_sdf(p) + _inertial_lints(p, "sdf"), p)
-    if suffix == ".xml":
-        return locate(validate_mjcf(p) or _inertial_lints(p, "mjcf"), p)
-    raise RobotkitError(Problem("unknown kind of file (expected a recipe .yaml, .urdf, .xacro, .sdf or MJCF .xml)",
-                                file=path))
+def check_model_file(path: Path, kind: str) -> list[Finding]:
+    """An SDF (``kind`` sdf) or MJCF (mjcf) file: its validator, then, for an MJCF the validator
+    accepts and for every SDF, the mass and inertia lints (their geometry is not measured yet)."""
+    if kind == "sdf":
+        return locate(validate_sdf(path) + _inertial_lints(path, kind), path)
+    return locate(validate_mjcf(path) or _inertial_lints(path, kind), path)
 
 
 def _inertial_lints(path: Path, kind: str) -> list[Finding]:
-    """Mass and inertia lints for SDF and MJCF files (their geometry is not measured yet)."""
     from robotkit.check.lints import LinkFacts, lint_link
     from robotkit.check import kinematics as k
 
@@ -258,42 +197,3 @@ def _inertial_lints(path: Path, kind: str) -> list[Finding]:
             continue
         out += lint_link(LinkFacts(link.name, link.mass, link.com, link.inertia))
     return out
-
-
-def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None) -> list[tuple[str, str]]:
-    """Every (check, subject) that a check of ``path`` ran, named as its findings name them, so
-    CI reports list what passed too: each validator on each file, the equivalence, consumer and
-    simulation stages on the robot, and the physics lints (``lints``) on each link and joint."""
-    from robotkit.check.locate import element_lines
-
-    p = Path(path)
-
-    def described(file: Path) -> list[tuple[str, str]]:
-        names = element_lines(file)
-        return [("lints", f"{'link' if tag in ('link', 'body') else 'joint'} '{name}'")
-                for (tag, name) in names if tag in ("link", "joint", "body")]
-
-    def folder(d: Path) -> list[tuple[str, str]]:
-        name, robot = d.name, f"robot '{d.name}'"
-        urdf = d / "urdf" / f"{name}.urdf"
-        files = [("check_urdf", urdf), ("ign sdf -k", d / "model.sdf"), ("mujoco", d / "mjcf" / f"{name}.xml"),
-                 ("mujoco", d / "mjcf" / "scene.xml")]
-        return ([(c, str(f)) for c, f in files] + [(c, robot) for c in ("equivalence", "consumer", "simulation")]
-                + described(urdf))
-
-    if p.is_dir():
-        dirs = [p] if (p / "model.sdf").is_file() else sorted(
-            d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
-        return [c for d in dirs for c in folder(d)]
-    suffix = p.suffix.lower()
-    if suffix in (".yaml", ".yml"):
-        from robotkit.recipe.load import load_recipes
-
-        return [c for loaded in load_recipes(p, args) for c in folder(Path(out_dir) / loaded.recipe.robot)]
-    if suffix == ".urdf":
-        return [("check_urdf", str(p)), ("consumer", f"robot '{p.stem}'")] + described(p)
-    if suffix == ".xacro":
-        return [("check_urdf", str(p)), ("consumer", f"robot '{p.name.removesuffix('.xacro').removesuffix('.urdf')}'")]
-    if suffix in (".sdf", ".world"):
-        return [("ign sdf -k", str(p))]
-    return [("mujoco", str(p))]

@@ -126,7 +126,7 @@ def _geom_facts(el, role: str, base: Path, package_paths: dict[str, str], subjec
     shape = g[0]
     T = _origin(el)
     kind = shape.tag
-    from robotkit.mesh import inertia as mi
+    from robotkit.model import massprops as mi
 
     props = None
     if kind == "box":
@@ -373,7 +373,7 @@ def _geometry_points(link: LinkFacts) -> np.ndarray | None:
 
 def _geometry_props(link: LinkFacts):
     """(volume, com, unit-density inertia) of the link's closed geometry, or None."""
-    from robotkit.mesh.inertia import combine
+    from robotkit.model.massprops import combine
 
     geoms = link.shape("visual") or link.shape("collision")
     if not geoms or any(g.inertia is None for g in geoms):

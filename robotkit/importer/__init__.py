@@ -223,7 +223,7 @@ def _check_resolves(recipe_file: Path, source: Path, lines: dict) -> None:
     are any)."""
     from dataclasses import replace
 
-    from robotkit.tasks import load_robots
+    from robotkit.model.load import load_robots
 
     try:
         load_robots([recipe_file])

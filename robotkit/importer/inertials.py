@@ -123,7 +123,7 @@ POINT_MASS_FLOOR = 1e-5
 """kg: the least point mass import gives a link without one (libsdformat drops a link of 1e-6 kg)."""
 
 
-def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out: "Converted") -> None:
+def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out) -> None:
     """A link the build refuses or SDF misreads for having no mass (it moves, it is a root
     with moving joints below it and no mass welded to it, or it has moving joints or mass below
     it: libsdformat drops such a link with its subtree) gets one: computed from its geometry at the
@@ -234,11 +234,11 @@ def _facts(mesh) -> dict:
             "bbox_min": [float(v) for v in bbox_min], "bbox_max": [float(v) for v in bbox_max]}
 
 
-def _report_recomputed(recipe_file: Path, conv, result: ImportResult) -> None:
+def _report_recomputed(recipe_file: Path, conv, result) -> None:
     import numpy as np
 
     from robotkit.model.resolve import finalize_link_inertial
-    from robotkit.tasks import load_robots
+    from robotkit.model.load import load_robots
 
     (_, robot), = load_robots([recipe_file])
     facts: dict[str, dict] = {}

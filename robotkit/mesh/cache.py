@@ -134,7 +134,10 @@ class Cache:
     """See the module docstring.  ``versions`` overrides :func:`library_versions` (tests)."""
 
     def __init__(self, root: str | os.PathLike | None = None, versions: dict | None = None, *,
-                 local: str | os.PathLike | None = None):
+                 local: str | os.PathLike | None = None, run: Callable[[Callable[[], object]], object] | None = None):
+        """``run(compute)`` computes a miss (the pipeline passes one that sends it to a Dask
+        cluster when one is configured); by default here, in this process."""
+        self.run = run or (lambda compute: compute())
         from robotkit.mesh.remote import is_url
 
         location = os.fspath(root) if root is not None else os.environ.get("ROBOTKIT_CACHE", "")
@@ -186,9 +189,7 @@ class Cache:
             if value is not None:
                 return value
             self.stats["misses"] += 1
-            from robotkit.distributed import run  # on a Dask cluster when one is configured
-
-            return self.put(key, run(compute), op=op, params=params)
+            return self.put(key, self.run(compute), op=op, params=params)
 
     def get(self, key: str):
         """The verified value stored under ``key``, or None (a corrupt entry is removed)."""

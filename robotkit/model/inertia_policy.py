@@ -18,7 +18,7 @@ The policies:
   are kept.
 - ``recompute``: from the link's geometry, keeping the given mass (a recipe's
   ``inertial: {mass: M}`` does the same; ``robotkit import --recompute-inertials`` for every link).
-- ``estimate``: the link's bounding primitive (robotkit.mesh.inertia.bounding_primitive) as a
+- ``estimate``: the link's bounding primitive (robotkit.model.massprops.bounding_primitive) as a
   uniform solid of the given mass.
 
 The build applies them in robotkit.model.resolve (recipe-wide ``inertia_policy``, per link

@@ -130,7 +130,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
             dec = (g.decimate or r.meshes.decimate) if role == "visual" else g.decimate
             dec = (("faces", dec.faces) if dec.faces is not None else ("ratio", dec.ratio)) if dec else None
             # a mirroring scale (a mirrored part): consumers render negative scales inside out, so
-            # the outputs get a mirrored copy in metres with its faces flipped (robotkit.actions)
+            # the outputs get a mirrored copy in metres with its faces flipped (robotkit.pipeline.actions)
             mirrored = scale[0] * scale[1] * scale[2] < 0
             if mirrored and dec is None:
                 dec = ("none", 0)
@@ -571,7 +571,7 @@ def _check_tree(link_names: list[str], joints: list[Joint], marks) -> list[Probl
 
 def geom_mass_props(geom: Geom, facts: dict) -> tuple[float, np.ndarray, np.ndarray]:
     """(volume, com, inertia at unit density) of a geometry in its link frame."""
-    from robotkit.mesh import inertia as mi
+    from robotkit.model import massprops as mi
 
     s = geom.shape
     if s.kind == "box":
@@ -598,7 +598,7 @@ def recenter_offset(geom: Geom, facts: dict) -> tuple[float, float, float]:
 
 def compute_inertial(link: Link, facts: dict) -> Inertial | None:
     """The link's inertial from its spec and the (recentered) source geometry."""
-    from robotkit.mesh.inertia import combine
+    from robotkit.model.massprops import combine
 
     spec = link.inertial_spec
     if spec.mode == "explicit":
@@ -615,10 +615,10 @@ def compute_inertial(link: Link, facts: dict) -> Inertial | None:
 
 
 def _estimate(link: Link, facts: dict) -> Inertial:
-    """The link's mass as its bounding primitive (robotkit.mesh.inertia.bounding_primitive) of
+    """The link's mass as its bounding primitive (robotkit.model.massprops.bounding_primitive) of
     its source geometry, in the link frame; a link of one primitive is its own.  A flat or thin
     primitive's tensor (a plate's, a rod's) gets the repair's floor."""
-    from robotkit.mesh.inertia import Bounding, bounding_primitive
+    from robotkit.model.massprops import Bounding, bounding_primitive
 
     geoms = link.source_geoms()
     s = geoms[0].shape

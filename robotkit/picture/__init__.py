@@ -1,69 +1,24 @@
-"""`robotkit report`: a picture report (report.html and its PNG pictures, one folder) of a
-recipe, a build folder, or a URDF/SDF/MJCF file; and `robotkit view`, the live viewer.
+"""The picture report (report.html and its PNG pictures, one folder) of a build folder, a URDF
+or an SDF/MJCF file; and the live viewer (``picture.viewer``).
 
-    what PATH is        (here)                      a build folder is the common case
     pictures            (robotkit.picture.render)   MuJoCo offscreen, from the MJCF
     tables              (robotkit.picture.page)     the check package's facts and lints, report.json
     the page            templates/report/report.html.j2
 
-A foreign URDF is imported into a recipe and built in a temporary folder (meshes of any
-format, DAE among them, become what MuJoCo reads), its table read from the file itself.
+What PATH is, and building a recipe or a foreign URDF for its pictures, is
+``robotkit.commands.report``'s job.
 """
 
 from __future__ import annotations
 
-import os
 import re
-import tempfile
 from pathlib import Path
 
+from robotkit.emit.layout import robot_layout
 from robotkit.errors import Problem, RobotkitError
 
 PAGE = "report.html"
 VERSION = 1  # bump when the pictures or the page change for the same build
-
-
-def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = None, build_out: str = "build",
-                 package_paths: dict[str, str] | None = None) -> Path:
-    """Write ``out_dir/report.html`` and its pictures for PATH; return the page's path."""
-    p = Path(path)
-    package_paths = package_paths or {}
-    if p.is_dir():
-        robot_dir = _robot_dir(p)
-        return report_build_dir(robot_dir, Path(out_dir) if out_dir else robot_dir / "report", str(p))
-    if not p.is_file():
-        raise RobotkitError(Problem("no such file or folder", file=str(path)))
-    suffix = p.suffix.lower()
-    if suffix in (".yaml", ".yml"):
-        from robotkit.build import build
-        from robotkit.recipe.load import load_recipe
-
-        loaded = load_recipe(p)
-        build([p], build_out, report=False)
-        robot_dir = Path(build_out) / loaded.recipe.robot
-        out = Path(out_dir) if out_dir else robot_dir / "report"
-        return report_build_dir(robot_dir, out, str(p), loaded.recipe.measured_mass)
-    if suffix == ".sdf" and (p.parent / "mjcf" / f"{p.parent.name}.xml").is_file():  # a build folder's SDF
-        return report_build_dir(p.parent, Path(out_dir) if out_dir else p.parent / "report", str(p))
-    out = Path(out_dir) if out_dir else p.parent / f"{p.stem}-report"
-    if suffix == ".urdf":
-        return report_urdf(p, out, package_paths)
-    if suffix in (".xml", ".sdf", ".world"):
-        return report_model_file(p, out, "sdf" if suffix != ".xml" else "mjcf")
-    raise RobotkitError(Problem("unknown kind of file (expected a recipe .yaml, .urdf, .sdf or MJCF .xml)",
-                                file=str(path)))
-
-
-def _robot_dir(p: Path) -> Path:
-    if (p / "model.sdf").is_file():
-        return p
-    dirs = sorted(d for d in p.iterdir() if (d / "model.sdf").is_file() and (d / "mjcf").is_dir())
-    if len(dirs) == 1:
-        return dirs[0]
-    if not dirs:
-        raise RobotkitError(Problem("not a build folder (no <robot>/model.sdf below it)", file=str(p)))
-    raise RobotkitError(Problem(f"holds {len(dirs)} robots ({', '.join(d.name for d in dirs)}); name one folder",
-                                file=str(p)))
 
 
 def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: float | None = None) -> Path:
@@ -72,43 +27,33 @@ def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: flo
     from robotkit.check.lints import lint, read_urdf_facts
     from robotkit.picture import page
 
-    name = robot_dir.name
-    urdf, mjcf = robot_dir / "urdf" / f"{name}.urdf", robot_dir / "mjcf" / f"{name}.xml"
+    layout = robot_layout(robot_dir)
+    name, urdf, mjcf = layout.name, layout.urdf, layout.mjcf
     for f in (urdf, mjcf):
         if not f.is_file():
             raise RobotkitError(Problem(f"not a robotkit build folder: {f.relative_to(robot_dir)} is missing",
                                         file=str(robot_dir)))
     links, joints, notes = read_urdf_facts(urdf, {name: str(robot_dir)})
     findings = notes + lint(links, joints, declared_mass)
-    losses, collision = page.read_losses(robot_dir / "report.json")
+    losses, collision = page.read_losses(layout.report_json)
     pictures = _pictures(mjcf, out, findings)
     return _write(out, name, source, pictures, links, joints, findings, losses, collision,
                   urdf.read_text(encoding="utf-8"))
 
 
-def report_urdf(urdf: Path, out: Path, package_paths: dict[str, str]) -> Path:
-    """A URDF written anywhere: its table from the file; its pictures from a build of its import."""
+def report_urdf(urdf: Path, out: Path, package_paths: dict[str, str], mjcf: Path | None,
+                notes: list[str]) -> Path:
+    """A URDF written anywhere: its table from the file; its pictures from ``mjcf`` (the MJCF of a
+    build of its import), none when that could not be built (``notes`` say why)."""
     from robotkit.check.lints import lint, read_urdf_facts
 
-    links, joints, notes = read_urdf_facts(urdf, package_paths)
-    findings = notes + lint(links, joints)
+    links, joints, lint_notes = read_urdf_facts(urdf, package_paths)
+    findings = lint_notes + lint(links, joints)
     text = urdf.read_text(encoding="utf-8")
     name = re.search(r"<robot[^>]*\bname=\"([^\"]+)\"", text)
     robot = name.group(1) if name else urdf.stem
-    extra: list[str] = []
-    with tempfile.TemporaryDirectory(prefix="robotkit-report-") as tmp:
-        try:
-            from robotkit.build import build
-            from robotkit.importer import import_file
-
-            result = import_file(str(urdf), Path(tmp) / "recipe.yaml", package_paths, {})
-            build([Path(tmp) / "recipe.yaml"], Path(tmp) / "build", report=False)
-            mjcf = Path(tmp) / "build" / result.robot / "mjcf" / f"{result.robot}.xml"
-            pictures = _pictures(mjcf, out, findings)
-        except RobotkitError as exc:
-            pictures = []
-            extra.append("No pictures: the URDF could not be built for MuJoCo: " + "; ".join(exc.lines()))
-    return _write(out, robot, str(urdf), pictures, links, joints, findings, {}, {}, text, extra)
+    pictures = _pictures(mjcf, out, findings) if mjcf is not None else []
+    return _write(out, robot, str(urdf), pictures, links, joints, findings, {}, {}, text, notes)
 
 
 def report_model_file(path: Path, out: Path, kind: str) -> Path:

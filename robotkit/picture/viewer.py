@@ -5,7 +5,7 @@ on top of it, one frame per link carries the overlays the report draws too: the 
 inertia box, the centre of mass, the link frame and joint axis, sensor frames and camera
 fields of view. A slider per joint moves it within its limits (yourdfpy moves mimic joints
 with their leader). A recipe and every file it reads (includes, meshes) are watched: on a
-save the recipe is rebuilt through the same build (robotkit.build) and the view updated in
+save the recipe is rebuilt through the same build (robotkit.pipeline.runner) and the view updated in
 place; a build error is shown in the page, and the last good robot stays on screen.
 """
 
@@ -16,12 +16,11 @@ import threading
 import time
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from functools import partial
 from pathlib import Path
 
 import numpy as np
 
-from robotkit.errors import Problem, RobotkitError
+from robotkit.errors import RobotkitError
 
 POLL = 0.3  # seconds between looks at the watched files
 CAMERA_TYPES = {"camera", "depth", "depth_camera", "rgbd_camera", "multicamera", "wideanglecamera"}
@@ -33,43 +32,6 @@ class Built:
     urdf: Path
     packages: dict[str, str]
     watch: list[Path] = field(default_factory=list)
-
-
-def resolve(path: Path, build_out: str) -> tuple[str, callable]:
-    """(kind, make) for PATH: ``make()`` (re)builds if needed and returns a :class:`Built`."""
-    if path.is_dir():
-        from robotkit.picture import _robot_dir
-
-        robot_dir = _robot_dir(path)
-        urdf = robot_dir / "urdf" / f"{robot_dir.name}.urdf"
-        return "build", lambda: Built(urdf, {robot_dir.name: str(robot_dir)}, [urdf])
-    if not path.is_file():
-        raise RobotkitError(Problem("no such file or folder", file=str(path)))
-    suffix = path.suffix.lower()
-    if suffix in (".yaml", ".yml"):
-        return "recipe", partial(_build_recipe, path, build_out)
-    if suffix == ".urdf":
-        return "urdf", lambda: Built(path, {}, [path])
-    raise RobotkitError(Problem("unknown kind of file (expected a recipe .yaml, a build folder or a .urdf)",
-                                file=str(path)))
-
-
-def _build_recipe(recipe: Path, build_out: str) -> Built:
-    from robotkit.build import build
-    from robotkit.tasks import load_robots
-
-    watch = [recipe]
-    try:
-        (loaded, robot), = load_robots([recipe])
-        watch = [Path(f) for f in loaded.files] + sorted({Path(m.source) for m in robot.meshes().values()})
-        result = build([recipe], build_out, report=False)
-        if result.errors:  # a bug in a task: shown like a user error, the viewer stays up
-            raise RobotkitError([Problem(f"internal error in task {name}: {msg}") for name, msg in result.errors])
-    except RobotkitError as exc:
-        exc.watch = watch  # still watched: fixing the recipe or a mesh rebuilds
-        raise
-    robot_dir = Path(build_out) / robot.name
-    return Built(robot_dir / "urdf" / f"{robot.name}.urdf", {robot.name: str(robot_dir)}, watch)
 
 
 def load_urdf(built: Built):
@@ -301,10 +263,10 @@ def _mtime(path: Path) -> float:
         return -1
 
 
-def serve(path: str, port: int = 8080, open_browser: bool = True, build_out: str = "build",
+def serve(label: str, kind: str, make, port: int = 8080, open_browser: bool = True,
           stop: threading.Event | None = None) -> int:
-    """Serve the viewer until interrupted (or ``stop`` is set)."""
-    kind, make = resolve(Path(path), build_out)
+    """Serve the viewer of ``make()`` (a :class:`Built`, rebuilt when what it watches changes)
+    until interrupted (or ``stop`` is set); ``kind`` is what PATH was (recipe, build, urdf)."""
     import viser
 
     server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
@@ -312,7 +274,7 @@ def serve(path: str, port: int = 8080, open_browser: bool = True, build_out: str
     viewer = Viewer(server, kind, make)
     viewer.reload()
     url = f"http://127.0.0.1:{server.get_port()}"
-    print(f"viewing {path} at {url} (Ctrl-C stops)", flush=True)
+    print(f"viewing {label} at {url} (Ctrl-C stops)", flush=True)
     if open_browser:
         import webbrowser
 

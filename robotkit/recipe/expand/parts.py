@@ -107,7 +107,7 @@ def _instance(name, spec, isrc: Source, scope, parts_env, ctx, flat, items, defa
             bad = True
     for key in ("part", "parent"):
         if not isinstance(spec.get(key), str):
-            ctx.report(isrc, (key,) if key in spec else (), f"required key is missing" if key not in spec
+            ctx.report(isrc, (key,) if key in spec else (), "required key is missing" if key not in spec
                        else f"must be a name (got {spec[key]!r})")
             bad = True
     mirror = spec.get("mirror")

@@ -5,10 +5,10 @@
                        from the mesh's size, and reported as such in the index
     one recipe each    OUT/.robotkit/catalogue/<name>.yaml: one link, the mesh as visual,
                        a collision strategy, density or the mass from the table
-    one build          robotkit.build over every recipe: the same doit tasks as any robot
+    one build          robotkit.pipeline.runner over every recipe: the same doit tasks as any robot
                        (repair, mass properties, collision decomposition, URDF, SDF, MJCF),
                        incremental, -j / --scheduler for the mesh work, and a failing object
-                       never stops the others; progress with the time left (robotkit.progress)
+                       never stops the others; progress with the time left (robotkit.pipeline.progress)
     index              OUT/catalogue.json and OUT/catalogue.csv: what was made, what failed and why
 
 A rerun builds only what is missing or changed (doit's record and the mesh cache); the
@@ -254,9 +254,9 @@ def catalogue(source: str | os.PathLike, out_dir: str | os.PathLike, *, density:
 
     result = None
     if recipes:
-        from robotkit.build import build
+        from robotkit.pipeline.runner import build
 
-        from robotkit.progress import Progress
+        from robotkit.pipeline.progress import Progress
 
         bar = Progress(progress, slow=float("inf"), eta=True, log_every=10.0, label="catalogue ")
         with paths.widened([base.resolve()]):  # the generated recipes read the meshes where they are
@@ -339,3 +339,28 @@ def _csv(index: dict) -> str:
             row.append("" if v is None else v)
         w.writerow(row)
     return buf.getvalue()
+
+
+def run(args) -> int:
+    import time
+
+    from robotkit.commands.build import cache_messages, scheduler
+
+    if args.jobs is not None and args.jobs < 1:
+        print("robotkit: error: -j must be at least 1", file=sys.stderr)
+        return 2
+    start = time.perf_counter()
+    with scheduler(args) as jobs, cache_messages():
+        made = catalogue(args.source, args.out, density=args.density, units=args.units, masses=args.masses,
+                         collision=args.collision, jobs=jobs)
+    index = made.index
+    for obj in index["objects"]:
+        if obj["status"] != "ok":
+            for line in obj["errors"] or ["failed"]:
+                print(f"{obj['source']}: {line}", file=sys.stderr)
+    guessed = sum(o["units_from"] == "guessed" for o in index["objects"])
+    out = os.path.relpath(os.path.abspath(args.out))
+    print(f"catalogue {out}: {index['ok']} objects made, {index['failed']} failed"
+          f"{f', units guessed for {guessed}' if guessed else ''} ({out}/catalogue.json; "
+          f"{len(made.ran)} tasks run, {len(made.uptodate)} up to date, {time.perf_counter() - start:.1f} s)")
+    return 1 if index["failed"] else 0

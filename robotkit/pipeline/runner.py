@@ -2,7 +2,7 @@
 
     load + validate each recipe   (robotkit.recipe.load)   all problems together, exit 2
     resolve to a Robot            (robotkit.model.resolve) tree checks, SI units
-    task dicts                    (robotkit.tasks)         file_dep, targets, config_changed
+    task dicts                    (robotkit.pipeline.tasks)         file_dep, targets, config_changed
     run them with doit            (here)                   incremental, -j N worker processes
 
 doit's own record (which tasks ran, which were up to date) is returned in a
@@ -38,11 +38,11 @@ class _Recorder:
     """A doit reporter that records instead of printing."""
 
     def __init__(self, result: BuildResult, echo=None, progress=None):
-        from robotkit.progress import Progress
+        from robotkit.pipeline.progress import Progress
 
         self.result = result
         self.echo = echo
-        # the progress line on a terminal (robotkit.progress); quiet with echo or no stream
+        # the progress line on a terminal (robotkit.pipeline.progress); quiet with echo or no stream
         if isinstance(progress, Progress):  # a caller's own (robotkit catalogue: time left, CI log lines)
             self.progress = progress
         else:
@@ -104,7 +104,7 @@ class _Recorder:
 
 
 def state_db(out_dir: Path) -> str:
-    from robotkit.tasks import STATE
+    from robotkit.pipeline.publish import STATE
 
     return str(out_dir / STATE / "doit.sqlite3")
 
@@ -139,24 +139,25 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
 
     ``keep_going`` returns the result with its ``failed`` tasks instead of raising, so that a
     batch (``robotkit catalogue``) builds every robot it can.  ``progress`` is a stream for the
-    progress line (:mod:`robotkit.progress`, terminals only) or a ``Progress`` of the caller's.
+    progress line (:mod:`robotkit.pipeline.progress`, terminals only) or a ``Progress`` of the caller's.
 
-    The stamp of the no-op fast path (:mod:`robotkit.stamp`) is removed first and written
+    The stamp of the no-op fast path (:mod:`robotkit.pipeline.stamp`) is removed first and written
     again when the build succeeds; ``stamp_options`` are the options it is kept under
-    (default :func:`robotkit.stamp.options` of the recipes and the output folder).
+    (default :func:`robotkit.pipeline.stamp.options` of the recipes and the output folder).
     """
     from doit.cmd_base import TaskLoader2
     from doit.doit_cmd import DoitMain
     from doit.task import dict_to_task
 
-    from robotkit import stamp
+    from robotkit.pipeline import stamp
 
     if stamp_options is None:  # a build without the report is another build than one with it
         stamp_options = stamp.options(recipes, out_dir, None if report else {"no_report": True})
     stamp.remove(out_dir, stamp_options)
 
-    from robotkit.buildwarn import build_warnings
-    from robotkit.tasks import load_robots, mesh_locations, robot_tasks
+    from robotkit.pipeline.buildwarn import build_warnings
+    from robotkit.model.load import load_robots, mesh_locations
+    from robotkit.pipeline.tasks import robot_tasks
 
     out = Path(out_dir).absolute()
     robots = load_robots(recipes, ros, args)  # raises before anything is written
@@ -212,11 +213,11 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
 
 
 def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder) -> list[str]:
-    """Publish each robot whose tasks all succeeded (robotkit.publish): a failed robot keeps its
+    """Publish each robot whose tasks all succeeded (robotkit.pipeline.publish): a failed robot keeps its
     previous complete output.  A file a consumer would refuse (exit 1: the MJCF of a chain too
     deep for MuJoCo) is left out of an otherwise complete output, as the build says.
     Returns the published files."""
-    from robotkit.publish import publish, staged_files
+    from robotkit.pipeline.publish import publish, staged_files
 
     if recorder.runtime_errors:
         return []
@@ -238,7 +239,7 @@ def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder
 
 def _input_stats(robots, tasks) -> dict:
     """Every file the build reads that no task writes, with its (size, mtime) now."""
-    from robotkit import stamp
+    from robotkit.pipeline import stamp
     from robotkit.emit.env import template_dirs
 
     targets = {str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])}

@@ -188,8 +188,9 @@ def world(map_yaml: str, out_dir: str, name: str, height: float, unknown_as_wall
 
 def _cache():
     from robotkit.mesh.cache import Cache
+    from robotkit.pipeline.distributed import run  # on a Dask cluster when one is configured
 
-    return Cache()
+    return Cache(run=run)
 
 
 @_user_errors_fail
@@ -319,8 +320,8 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
 
 
 def publish_outputs(out_dir: str, robot: str, tasks: list[dict]):
-    """``<robot>:publish`` (dodo.py): the robot's staged folders, published (robotkit.publish)."""
-    from robotkit.publish import publish, staged_files
+    """``<robot>:publish`` (dodo.py): the robot's staged folders, published (robotkit.pipeline.publish)."""
+    from robotkit.pipeline.publish import publish, staged_files
 
     publish(out_dir, robot, staged_files(tasks, out_dir))
 

@@ -49,13 +49,14 @@ def build_warnings(robots, out: Path) -> list[tuple[str, str]]:
     (``file:line: key: warning: text``) as the command line prints it.  The mesh tasks' own
     warnings come first (shown on every build, not only the one that ran them), then the losses
     and the lints."""
-    from robotkit.tasks import STATE, mesh_locations
+    from robotkit.model.load import mesh_locations
+    from robotkit.pipeline.publish import STATE
 
     places = [(loaded, robot, mesh_locations(loaded, robot), _mesh_facts(out / STATE / robot.name / "mesh", robot))
               for loaded, robot in robots]
     pairs = []
     for loaded, robot, where, facts in places:
-        for key, f in facts.items():  # recorded with their place (robotkit.actions.mesh_facts): placed anew
+        for key, f in facts.items():  # recorded with their place (robotkit.pipeline.actions.mesh_facts): placed anew
             pairs += [(w, warning_line(_PLACE.sub("", w, count=1), where.get(key))) for w in f.get("warnings", [])]
     for loaded, robot, where, facts in places:
         pairs += _losses(loaded, robot, out, where) + lints(loaded, robot, facts, where)
@@ -133,7 +134,6 @@ def lints(loaded, robot, facts: dict[str, dict], where: dict) -> list[tuple[str,
     def warn(text, place):
         out.append((text, warning_line(text, place)))
 
-    units = loaded.recipe.units
     for key, mesh in robot.meshes().items():
         f = facts.get(key)
         if not f or "bbox_min" not in f:

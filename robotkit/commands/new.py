@@ -71,3 +71,12 @@ def new(name: str, folder: str = ".") -> list[Path]:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)
     return list(files)
+
+
+def run(args) -> int:
+    import os
+
+    for path in new(args.name, args.dir):
+        print(os.path.relpath(path))
+    print(f"build it: robotkit build {os.path.relpath(os.path.join(args.dir, args.name + '.yaml'))}")
+    return 0

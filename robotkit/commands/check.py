@@ -1,0 +1,165 @@
+"""``robotkit check PATH...``: what each PATH is (:mod:`robotkit.commands.inputs`), a recipe
+built first (:mod:`robotkit.pipeline.runner`), then the check stages (:mod:`robotkit.check`) and
+the findings rendered for people, CI and editors.  Exit 0 clean, 1 problems, 2 bad input."""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+
+from robotkit.check import check_build_dir, check_model_file, check_urdf_file, check_xacro_file
+from robotkit.check.findings import Finding, input_findings
+from robotkit.check.locate import element_lines, locate
+from robotkit.check.render import job_summary, render
+from robotkit.commands.inputs import classify, package_paths
+from robotkit.emit.layout import RobotLayout, robot_layout
+from robotkit.errors import RobotkitError
+from robotkit.pipeline.buildwarn import parse
+from robotkit.pipeline.runner import build
+from robotkit.recipe.load import load_recipe, load_recipes
+
+
+def run(args) -> int:
+    packages = package_paths(args.package_path)
+    if packages is None:
+        return 2
+    if args.temp_out:
+        with tempfile.TemporaryDirectory(prefix="robotkit-check-") as out:
+            args.out = out
+            return _check_paths(args, packages)
+    return _check_paths(args, packages)
+
+
+def _check_paths(args, packages: dict[str, str]) -> int:
+    """Every PATH in turn; bad input (exit 2) is reported in the chosen format too, so a CI
+    report never comes out empty, and its lines go to stderr as always."""
+    findings, status, ran = [], 0, []
+    for path in args.paths:
+        try:  # github: the job summary points at the picture report, so a recipe's build writes it
+            findings += check(path, args.out, packages, args=dict(args.arg),
+                              report=args.format == "github" and not args.temp_out)
+            ran += cases(path, args.out, dict(args.arg))
+        except RobotkitError as exc:
+            for line in exc.lines():
+                print(line, file=sys.stderr)
+            findings += input_findings(exc.problems, path)
+            status = max(status, exc.exit_status)
+    _write_findings(args, findings, status, ran)
+    return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)
+
+
+def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[str, str]]) -> None:
+    source = " ".join(args.paths)
+    if args.format != "text" or not status:
+        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran))
+    elif any(f.check != "input" for f in findings):  # the paths that could be checked
+        sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on))
+    if args.junit:
+        Path(args.junit).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.junit).write_text(render(findings, "junit", source, args.fail_on, ran), encoding="utf-8")
+    if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
+        # a temporary build folder is gone when the summary is read: no report to point at
+        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, None if args.temp_out else args.out)
+
+
+def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
+          args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
+    """The findings on PATH.  ``report``: a recipe's build also writes its picture report (as
+    ``robotkit build`` does)."""
+    what = classify(path)
+    package_paths = package_paths or {}
+    if what.kind == "build":  # a build folder's findings point at its URDF
+        return [f for d in what.robots for f in locate(check_build_dir(d.root), d.urdf)]
+    if what.kind == "recipe":
+        return check_recipe(what.path, out_dir, args, report)
+    if what.kind == "urdf":
+        return check_urdf_file(what.path, package_paths)
+    if what.kind == "xacro":
+        return check_xacro_file(what.path, package_paths, args or {})
+    return check_model_file(what.path, what.kind)
+
+
+def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
+    """Build the recipe, then check each of its robots (one per variant), the build's warnings
+    and the findings placed on the recipe's lines."""
+    located = []
+    result = build([path], out_dir, args=args, report=report)
+    warnings = [parse(w) for w in result.warning_lines]  # (file, line, key, text)
+    for i, loaded in enumerate(load_recipes(path, args)):  # one per variant
+        name = loaded.recipe.robot
+        others = [r for r in result.robots if r != name]
+        # a warning naming another variant's robot belongs to that one; the rest to the first
+        mine = [w for w in warnings if w[3].startswith(f"{name}:")
+                or (i == 0 and not any(w[3].startswith(f"{o}:") for o in others))]
+        located += _check_variant(loaded, mine, out_dir)
+    return located
+
+
+def _check_variant(loaded, warnings: list[tuple], out_dir: str) -> list[Finding]:
+    name = loaded.recipe.robot
+    build_findings = [Finding("warning", "build", key or f"robot '{name}'", text, file=file, line=line)
+                      for file, line, key, text in warnings]
+    findings = check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
+    marks = loaded.marks
+    located = []
+    for f in findings:
+        key = ("robot",)
+        if f.subject.startswith("link '"):
+            key = ("links", f.subject[6:-1])
+        elif f.subject.startswith("joint '"):
+            key = ("joints", f.subject[7:-1])
+        file, line = marks.locate(key)
+        located.append(replace(f, file=file, line=line))
+    return [f if f.file else replace(f, **dict(zip(("file", "line"), marks.locate(("robot",)))))
+            for f in build_findings] + located
+
+
+def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None) -> list[tuple[str, str]]:
+    """Every (check, subject) that a check of ``path`` ran, named as its findings name them, so
+    CI reports list what passed too: each validator on each file, the equivalence, consumer and
+    simulation stages on the robot, and the physics lints (``lints``) on each link and joint."""
+    what = classify(path)
+    p = what.path
+    if what.kind == "build":
+        return [c for d in what.robots for c in _folder_cases(d)]
+    if what.kind == "recipe":
+        return [c for loaded in load_recipes(p, args) for c in _folder_cases(robot_layout(Path(out_dir) / loaded.recipe.robot))]
+    if what.kind == "urdf":
+        return [("check_urdf", str(p)), ("consumer", f"robot '{p.stem}'")] + _described(p)
+    if what.kind == "xacro":
+        return [("check_urdf", str(p)), ("consumer", f"robot '{p.name.removesuffix('.xacro').removesuffix('.urdf')}'")]
+    if what.kind == "sdf":
+        return [("ign sdf -k", str(p))]
+    return [("mujoco", str(p))]
+
+
+def _described(file: Path) -> list[tuple[str, str]]:
+    return [("lints", f"{'link' if tag in ('link', 'body') else 'joint'} '{name}'")
+            for (tag, name) in element_lines(file) if tag in ("link", "joint", "body")]
+
+
+def _folder_cases(d: RobotLayout) -> list[tuple[str, str]]:
+    robot = f"robot '{d.name}'"
+    files = [("check_urdf", d.urdf), ("ign sdf -k", d.sdf), ("mujoco", d.mjcf), ("mujoco", d.scene)]
+    return ([(c, str(f)) for c, f in files] + [(c, robot) for c in ("equivalence", "consumer", "simulation")]
+            + _described(d.urdf))
+
+
+def _job_summary(summary_file: str, findings, paths: list[str], out: str | None) -> None:
+    """Append the check's summary, pointing at the picture report, to GitHub's job summary."""
+    folders: list[RobotLayout] = []
+    for path in paths:
+        try:
+            what = classify(path)
+            if what.kind == "recipe" and out is not None:
+                folders.append(robot_layout(Path(out) / load_recipe(what.path).recipe.robot))
+            elif what.kind == "build":
+                folders += what.robots
+        except RobotkitError:
+            pass  # a recipe that does not load has no report; its findings say why
+    pages = [os.path.relpath(f.report_html) for f in folders if f.report_html.is_file()]
+    with open(summary_file, "a", encoding="utf-8") as f:
+        f.write(job_summary(findings, " ".join(paths), pages))

@@ -1,0 +1,64 @@
+"""``robotkit report PATH [-o DIR]``: the picture report of a recipe (built first), a build
+folder, a URDF (imported and built in a temporary folder for its pictures: meshes of any format,
+DAE among them, become what MuJoCo reads) or an SDF/MJCF file."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from pathlib import Path
+
+from robotkit.commands.inputs import classify, package_paths
+from robotkit.emit.layout import robot_layout
+from robotkit.errors import RobotkitError
+from robotkit.importer import import_file
+from robotkit.picture import report_build_dir, report_model_file, report_urdf
+from robotkit.pipeline.runner import build
+from robotkit.recipe.load import load_recipe
+
+KINDS = ("recipe", "build", "urdf", "sdf", "mjcf")
+
+
+def run(args) -> int:
+    packages = package_paths(args.package_path)
+    if packages is None:
+        return 2
+    start = time.perf_counter()
+    page = write_report(args.path, args.output, args.out, packages)
+    print(f"wrote {os.path.relpath(page)} ({time.perf_counter() - start:.2f} s)")
+    return 0
+
+
+def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = None, build_out: str = "build",
+                 package_paths: dict[str, str] | None = None) -> Path:
+    """Write ``out_dir/report.html`` and its pictures for PATH; return the page's path."""
+    what = classify(path, KINDS, "a recipe .yaml, .urdf, .sdf or MJCF .xml")
+    p = what.path
+    if what.kind == "build":
+        robot = what.one_robot()
+        return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p))
+    if what.kind == "recipe":
+        loaded = load_recipe(p)
+        build([p], build_out, report=False)
+        robot = robot_layout(Path(build_out) / loaded.recipe.robot)
+        return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
+                                loaded.recipe.measured_mass)
+    if what.kind == "sdf" and (robot := robot_layout(p.parent)).mjcf.is_file():  # a build folder's SDF
+        return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p))
+    out = Path(out_dir) if out_dir else p.parent / f"{p.stem}-report"
+    if what.kind == "urdf":
+        with tempfile.TemporaryDirectory(prefix="robotkit-report-") as tmp:
+            mjcf, notes = _built_mjcf(p, Path(tmp), package_paths or {})
+            return report_urdf(p, out, package_paths or {}, mjcf, notes)
+    return report_model_file(p, out, what.kind)
+
+
+def _built_mjcf(urdf: Path, tmp: Path, package_paths: dict[str, str]) -> tuple[Path | None, list[str]]:
+    """The MJCF of a build of the URDF's import in ``tmp``, or None and the reason."""
+    try:
+        result = import_file(str(urdf), tmp / "recipe.yaml", package_paths, {})
+        build([tmp / "recipe.yaml"], tmp / "build", report=False)
+    except RobotkitError as exc:
+        return None, ["No pictures: the URDF could not be built for MuJoCo: " + "; ".join(exc.lines())]
+    return robot_layout(tmp / "build" / result.robot).mjcf, []
