@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -7,6 +8,9 @@ import textwrap
 from pathlib import Path
 
 import pytest
+
+from robotkit.ioutil import environ
+from robotkit.paths import ROOT_ENV
 
 REPO = Path(__file__).resolve().parents[1]
 ASSETS = REPO.parent / "shared" / "assets"
@@ -25,16 +29,9 @@ def example_robots() -> list[str]:
 def mesh_cache(tmp_path_factory):
     """One mesh cache for the test session (builds in subprocesses inherit it): CoACD and
     friends run once per session, and the user's own cache is never touched."""
-    import os
-
     folder = tmp_path_factory.mktemp("robotkit-cache")
-    old = os.environ.get("ROBOTKIT_CACHE")
-    os.environ["ROBOTKIT_CACHE"] = str(folder)
-    yield folder
-    if old is None:
-        os.environ.pop("ROBOTKIT_CACHE", None)
-    else:
-        os.environ["ROBOTKIT_CACHE"] = old
+    with environ({"ROBOTKIT_CACHE": str(folder)}):
+        yield folder
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -42,17 +39,8 @@ def read_roots(tmp_path_factory):
     """Test recipes written to temporary folders read the example meshes, the shared assets and
     the packages other tests lay out beside them: widened on purpose, as a user would with
     ``--root`` (tests of the read rules unset it)."""
-    import os
-
-    from robotkit.paths import ROOT_ENV
-
-    old = os.environ.get(ROOT_ENV)
-    os.environ[ROOT_ENV] = os.pathsep.join([str(REPO), str(ASSETS), str(tmp_path_factory.getbasetemp())])
-    yield
-    if old is None:
-        os.environ.pop(ROOT_ENV, None)
-    else:
-        os.environ[ROOT_ENV] = old
+    with environ({ROOT_ENV: os.pathsep.join([str(REPO), str(ASSETS), str(tmp_path_factory.getbasetemp())])}):
+        yield
 
 
 @pytest.fixture(scope="session")
