@@ -89,7 +89,7 @@ def _floats(text: str | None, n: int, default: float = 0.0) -> list[float]:
 
 
 def _origin(el) -> np.ndarray:
-    from robotkit.model.robot import rpy_matrix
+    from robotkit.geometry import rpy_matrix
 
     T = np.eye(4)
     o = el.find("origin") if el is not None else None

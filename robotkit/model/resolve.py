@@ -23,8 +23,9 @@ from robotkit.errors import Problem, RecipeError
 from robotkit.model import inertia_policy
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
-    Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World, matrix_rpy, rpy_matrix,
+    Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World,
 )
+from robotkit.geometry import matrix_rpy
 from robotkit.recipe.load import LoadedRecipe
 from robotkit.recipe.schema import UNITS, Collision
 
@@ -699,7 +700,7 @@ def inertial_from_json(data) -> Inertial | None:
     return Inertial(data["mass"], tuple(data["com"]), tuple(data["inertia"]))
 
 
-__all__ = ["resolve", "finalize", "compute_inertial", "rpy_matrix"]
+__all__ = ["resolve", "finalize", "compute_inertial"]
 
 
 def finalize_link_inertial(link: Link, facts: dict) -> Inertial | None:
