@@ -26,6 +26,11 @@ def display_path(path: str | os.PathLike | None) -> str:
     return path if rel.startswith("..") else rel
 
 
+def short_number(x: float) -> str:
+    """A short number for messages: 1e-06 -> 1e-6, 10000.0 -> 10000."""
+    return f"{x:g}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
+
+
 @dataclass(frozen=True)
 class Problem:
     """One problem: ``file:line: key: message`` with the parts that are known."""

@@ -230,7 +230,7 @@ def random_recipe(rng: np.random.Generator, index: int) -> str:
         lines.append(f"    visual: {{{geom}, {origin}}}")
         if kind == "explicit":
             # a rotated, full (off-diagonal) tensor about an off-centre centre of mass
-            from robotkit.model.robot import rpy_matrix
+            from robotkit.geometry import rpy_matrix
 
             R = rpy_matrix(rng.uniform(-math.pi, math.pi, 3))
             principal = np.sort(rng.uniform(0.01, 0.1, 3))

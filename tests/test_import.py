@@ -530,7 +530,7 @@ def test_acceptance_gripper_arm(tmp_path, gripper_arm):
     data = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
     inertial = data["links"]["upper_arm"]["inertial"]
     assert inertial["com"] == [0.001, -0.002, 0.175] and inertial["mass"] == 1.2
-    from robotkit.model.robot import rpy_matrix
+    from robotkit.geometry import rpy_matrix
 
     R = rpy_matrix((0.3, -0.2, 0.7))
     I0 = np.array([[0.015, 0.0001, -0.00005], [0.0001, 0.0148, 0.00002], [-0.00005, 0.00002, 0.0009]])

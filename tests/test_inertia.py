@@ -10,7 +10,7 @@ import trimesh
 
 from robotkit.mesh.inertia import mesh_mass_properties
 from robotkit.model.massprops import box_props, combine, cylinder_props, sphere_props
-from robotkit.model.robot import rpy_matrix, matrix_rpy
+from robotkit.geometry import matrix_rpy, rpy_matrix
 
 
 def props(mesh):

@@ -29,7 +29,7 @@ from robotkit.model.massprops import box_props
 from robotkit.mesh.primitives import Primitive, fit_box, fit_capsule, fit_cylinder, fit_sphere
 from robotkit.mesh.repair import repair
 from robotkit.mesh.transform import transform
-from robotkit.model.robot import rpy_matrix
+from robotkit.geometry import rpy_matrix
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -936,7 +936,7 @@ def test_stl_bytes_are_reproducible_across_processes():
     assert data == stl_bytes(mesh.copy())
     assert len(data) == 84 + 50 * len(mesh.faces)
     code = ("import hashlib, numpy as np, trimesh, sys; sys.path.insert(0, %r);"
-            "from robotkit.mesh.export import stl_bytes; from robotkit.model.robot import rpy_matrix;"
+            "from robotkit.mesh.export import stl_bytes; from robotkit.geometry import rpy_matrix;"
             "m = trimesh.creation.icosphere(subdivisions=3, radius=0.1); T = np.eye(4);"
             "T[:3, :3] = rpy_matrix((0.3, -0.7, 1.2)); T[:3, 3] = (0.1, -0.2, 0.3); m.apply_transform(T);"
             "print(hashlib.sha256(stl_bytes(m)).hexdigest())") % str(REPO)

@@ -15,7 +15,7 @@ import trimesh
 from conftest import RECIPES, write_recipe
 from robotkit.pipeline.runner import build
 from robotkit.model.massprops import box_props, cylinder_props
-from robotkit.model.robot import rpy_matrix
+from robotkit.geometry import rpy_matrix
 from test_turret_bot import urdf_inertials
 from validators import check_urdf
 

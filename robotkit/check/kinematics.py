@@ -105,6 +105,7 @@ def axis_angle(axis, angle) -> np.ndarray:
                      [z * x * C - y * s, z * y * C + x * s, c + z * z * C]])
 
 
+# rpy_matrix and _quat_R are kept here on purpose, not taken from robotkit.geometry: an independent oracle.
 def rpy_matrix(r, p, y) -> np.ndarray:
     return axis_angle((0, 0, 1), y) @ axis_angle((0, 1, 0), p) @ axis_angle((1, 0, 0), r)
 

@@ -20,11 +20,10 @@ from robotkit.check.findings import Finding
 from robotkit.model import inertia_policy
 from robotkit.check.kinematics import NEGLIGIBLE
 from robotkit.errors import Problem, RobotkitError
+from robotkit.model.plausible import DENSITY_RANGE, PART_SIZE_RANGE
 
 # thresholds (documented in docs/checks.md)
 MIN_MASS = 1e-6  # kg: sdformat drops lighter links (sdformat #199)
-DENSITY_RANGE = (10.0, 25000.0)  # kg/m^3: aerogel-ish foams to osmium
-PART_SIZE_RANGE = (1e-4, 10.0)  # m
 BOX_ERROR, BOX_WARNING = 3.0, 1.5
 FACE_BUDGET = 200_000  # visual faces per link before rendering rates suffer
 COLLISION_VOLUME_RANGE = (0.5, 2.0)  # collision / visual volume
@@ -89,7 +88,7 @@ def _floats(text: str | None, n: int, default: float = 0.0) -> list[float]:
 
 
 def _origin(el) -> np.ndarray:
-    from robotkit.model.robot import rpy_matrix
+    from robotkit.geometry import rpy_matrix
 
     T = np.eye(4)
     o = el.find("origin") if el is not None else None

@@ -15,19 +15,11 @@ import os
 import numpy as np
 
 from robotkit.emit.env import render
+from robotkit.geometry import rpy_quat
 from robotkit.model.robot import Geom, Robot
 
 WORLD = "world"
 MJCF_MESH_EXT = (".stl", ".obj")
-
-
-def quat(rpy) -> tuple[float, float, float, float]:
-    """(w, x, y, z) of fixed-axis roll, pitch, yaw (URDF convention)."""
-    r, p, y = (0.5 * float(a) for a in rpy)
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    q = (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
-         cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy)
-    return q if q[0] >= 0 else tuple(-v for v in q)
 
 
 def mesh_file(mesh, role: str = "visual") -> str:
@@ -78,7 +70,7 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
 def _geom(robot: Robot, geom: Geom, name: str, assets: dict, role: str = "visual") -> dict:
     s = geom.shape
     pose = geom.pose
-    ctx = {"name": name, "pos": pose.xyz, "quat": quat(pose.rpy), "type": s.kind,
+    ctx = {"name": name, "pos": pose.xyz, "quat": rpy_quat(pose.rpy), "type": s.kind,
            "material": geom.material}
     if s.kind == "mesh":
         key = (mesh_file(s.mesh, role), s.mesh.out_scale)
@@ -165,7 +157,7 @@ def context(robot: Robot, lift: float = 0.0) -> dict:
         return {
             "name": name,
             "pos": joint.origin.xyz if joint is not None else (0.0, 0.0, 0.0),
-            "quat": quat(joint.origin.rpy) if joint is not None else (1.0, 0.0, 0.0, 0.0),
+            "quat": rpy_quat(joint.origin.rpy) if joint is not None else (1.0, 0.0, 0.0, 0.0),
             "joints": joints_of(joint) if joint is not None else [],
             "inertial": link.inertial,
             "visuals": [_geom(robot, g, f"{name}_visual_{i}", assets) for i, g in enumerate(link.visuals)],

@@ -86,7 +86,8 @@ def _moved(geom, pose):
     """``geom`` of a frame link, re-posed into the link that carries it."""
     from dataclasses import replace
 
-    from robotkit.model.robot import Pose, matrix_rpy
+    from robotkit.geometry import matrix_rpy
+    from robotkit.model.robot import Pose
 
     T = pose.matrix() @ geom.pose.matrix()
     return replace(geom, origin=Pose(tuple(float(v) for v in T[:3, 3]), matrix_rpy(T[:3, :3])),

@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from robotkit.model.robot import Pose, Robot, Sensor, matrix_rpy
+from robotkit.geometry import matrix_rpy
+from robotkit.model.robot import Pose, Robot, Sensor
 
 MJCF_MAX_RAYS = 64
 SDF_TYPES = {"camera": "camera", "depth": "depth_camera", "lidar": "gpu_lidar", "sonar": "gpu_lidar",

@@ -44,7 +44,7 @@ def _inertial(el: ET.Element, link: str, problems: _Problems) -> dict | None:
     if any(rpy):
         import numpy as np
 
-        from robotkit.model.robot import rpy_matrix
+        from robotkit.geometry import rpy_matrix
 
         I = np.array([[values["ixx"], values["ixy"], values["ixz"]],
                       [values["ixy"], values["iyy"], values["iyz"]],

@@ -38,7 +38,8 @@ from robotkit.importer.parsing import _Problems, _float, _floats, _fmt_list, _lo
 from robotkit.importer.recipe_writer import dump_recipe, fmt  # noqa: F401  (the import's writer)
 from robotkit.errors import Problem, RobotkitError
 from robotkit.emit.urdf import MASSLESS
-from robotkit.recipe.schema import MIN_MASS, UNITS, _g
+from robotkit.errors import short_number
+from robotkit.recipe.schema import MIN_MASS, UNITS
 
 GREY = [0.5, 0.5, 0.5, 1.0]
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
@@ -218,7 +219,7 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
             # robotkit's own URDF writes a massless link as 1e-300 kg with no inertia: read back as massless
             if given["mass"] != MASSLESS:
                 warnings.append(f"link '{name}': mass {given['mass']!r} kg with no inertia, below the smallest mass "
-                                f"a recipe takes ({_g(MIN_MASS)} kg): read as a massless link")
+                                f"a recipe takes ({short_number(MIN_MASS)} kg): read as a massless link")
             given = dict(given, mass=0.0)
         if given is not None and given["mass"] > 0:
             out.explicit[name] = given
@@ -459,7 +460,7 @@ def _capsule(radius: float, length: float, xyz, rpy) -> list[dict]:
     """A capsule (the cylinder's ``length`` between the centres of its end spheres) as shapes."""
     import numpy as np
 
-    from robotkit.model.robot import rpy_matrix
+    from robotkit.geometry import rpy_matrix
 
     axis = rpy_matrix(rpy) @ np.array([0.0, 0.0, length / 2])
     out = []
@@ -623,7 +624,7 @@ def _slid(el: ET.Element, what: str, problems: _Problems, axis: list[float], at:
     joint puts it at position ``at``."""
     import numpy as np
 
-    from robotkit.model.robot import rpy_matrix
+    from robotkit.geometry import rpy_matrix
 
     xyz, rpy = _origin(el.find("origin"), what, problems)
     a = np.asarray(axis, dtype=float)

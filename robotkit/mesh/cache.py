@@ -53,6 +53,9 @@ from typing import Callable
 
 import numpy as np
 
+import robotkit
+from robotkit.mesh.remote import RemoteError, RemoteStore, is_url, read_only
+
 CACHE_FORMAT = 1
 REPORT_ENV = "ROBOTKIT_CACHE_REPORT"
 LIBRARIES = ("trimesh", "coacd", "meshlib", "meshoptimizer", "manifold3d", "numpy", "scipy")
@@ -62,8 +65,6 @@ def default_root() -> Path:
     """The local cache folder: ``$ROBOTKIT_CACHE`` when it is a folder, else (no cache set, or
     a shared one named by URL) ``$ROBOTKIT_CACHE_LOCAL``, ``$XDG_CACHE_HOME/robotkit`` or
     ``~/.cache/robotkit``."""
-    from robotkit.mesh.remote import is_url
-
     env = os.environ.get("ROBOTKIT_CACHE")
     if env and not is_url(env):
         return Path(env).expanduser()
@@ -78,8 +79,6 @@ def default_root() -> Path:
 def library_versions() -> dict:
     """Installed versions of the libraries that shape cached results, plus robotkit's."""
     from importlib import metadata
-
-    import robotkit
 
     out = {}
     for name in LIBRARIES:
@@ -138,15 +137,11 @@ class Cache:
         """``run(compute)`` computes a miss (the pipeline passes one that sends it to a Dask
         cluster when one is configured); by default here, in this process."""
         self.run = run or (lambda compute: compute())
-        from robotkit.mesh.remote import is_url
-
         location = os.fspath(root) if root is not None else os.environ.get("ROBOTKIT_CACHE", "")
         self.remote, self.remote_writable, self.remote_problems = None, False, []
         self.stats = {"hits": 0, "misses": 0, "corrupt": 0, "stored": 0,
                       "remote_hits": 0, "remote_corrupt": 0, "published": 0, "remote_errors": 0}
         if location and is_url(location):
-            from robotkit.mesh.remote import RemoteError, RemoteStore, read_only
-
             try:
                 self.remote = RemoteStore(location)
                 self.remote_writable = not read_only()
@@ -208,8 +203,6 @@ class Cache:
     def _get_remote(self, key: str):
         """The shared copy's entry, verified and copied into the local folder; None on a miss,
         a corrupt entry (republished by the next put) or an unreachable cache."""
-        from robotkit.mesh.remote import RemoteError
-
         try:
             manifest_bytes = self.remote.get(self.entry_name(key, f"{key}.json"))
             if manifest_bytes is None:
@@ -295,8 +288,6 @@ class Cache:
 
     def _publish(self, key: str, payload_file: str, payload: bytes, manifest_bytes: bytes) -> None:
         """Payload first, manifest last: a reader never finds a manifest without its payload."""
-        from robotkit.mesh.remote import RemoteError
-
         try:
             self.remote.put(self.entry_name(key, payload_file), payload)
             self.remote.put(self.entry_name(key, f"{key}.json"), manifest_bytes)

@@ -521,8 +521,8 @@ def surface_distance(a, b, samples: int = DEFAULT_SAMPLES, seed: int = 0) -> dic
     ``b_to_a_max``, ``b_to_a_mean``, ``samples`` (per direction),
     ``method`` (a short description).
     """
-    pa = _samples(a, samples, seed)
-    pb = _samples(b, samples, seed + 1)
+    pa = surface_samples(a, samples, seed)
+    pb = surface_samples(b, samples, seed + 1)
     dab = point_surface_distance(pa, b)
     dba = point_surface_distance(pb, a)
     return distance_summary(dab, dba, samples, "exact point-to-triangle distance from area-uniform samples "
@@ -541,7 +541,8 @@ def distance_summary(dab, dba, samples: int, method: str) -> dict:
     }
 
 
-def _samples(mesh, count: int, seed: int) -> np.ndarray:
+def surface_samples(mesh, count: int, seed: int) -> np.ndarray:
+    """``count`` points on ``mesh``'s surface, area-weighted, reproducible from ``seed``."""
     points, _ = trimesh.sample.sample_surface(mesh, int(count), seed=seed)
     return np.asarray(points, dtype=np.float64)
 

@@ -31,6 +31,9 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
+from robotkit.mesh.decimate import closed_volume, decimate
+from robotkit.mesh.hull import convex_hull
+
 PREPROCESS = ("auto", "on", "off")
 INPUT_FACES = 20_000  # ``auto``: a larger closed input is decimated to this many faces for CoACD
 
@@ -82,8 +85,6 @@ def decompose(mesh, threshold: float = 0.05, max_hulls: int = -1, resolution: in
             mcts_nodes=int(mcts_nodes), mcts_max_depth=int(mcts_max_depth))
     except Exception as exc:  # the ctypes wrapper raises plain exceptions or asserts
         raise RuntimeError(f"CoACD failed: {type(exc).__name__}: {exc}") from exc
-    from robotkit.mesh.hull import convex_hull
-
     pieces = []
     for verts, _faces in parts:
         verts = np.asarray(verts, dtype=np.float64)
@@ -134,8 +135,6 @@ def coacd_input(V: np.ndarray, F: np.ndarray, preprocess: str,
     V = np.ascontiguousarray(np.asarray(mesh.vert_properties)[:, :3], dtype=np.float64)
     F = np.ascontiguousarray(mesh.tri_verts, dtype=np.int32)
     if input_faces and len(F) > input_faces:
-        from robotkit.mesh.decimate import closed_volume, decimate
-
         fewer, _ = decimate(trimesh.Trimesh(V, F, process=False), target_faces=int(input_faces), samples=0)
         if closed_volume(fewer) is not None:
             V = np.ascontiguousarray(fewer.vertices, dtype=np.float64)

@@ -26,8 +26,10 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from robotkit.mesh.decimate import (DEFAULT_SAMPLES, _samples, closed_volume, distance_summary, point_surface_distance,
-                                    surface_distance)
+from robotkit.mesh.decimate import (DEFAULT_SAMPLES, closed_volume, distance_summary, point_surface_distance,
+                                    surface_distance, surface_samples)
+from robotkit.mesh.hull import from_manifold, to_manifold
+from robotkit.mesh.primitives import Primitive
 
 
 def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed: int = 0) -> dict:
@@ -45,8 +47,6 @@ def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed:
     mean in metres) and ``distance_relative`` (max distance over the visual
     bounding-box diagonal).
     """
-    from robotkit.mesh.primitives import Primitive
-
     if not pieces:
         raise ValueError("the collision proxy has no pieces")
     meshes, n_prim, vertex_counts, analytic = [], 0, [], []
@@ -94,15 +94,13 @@ def fidelity(visual_mesh, pieces: list, *, samples: int = DEFAULT_SAMPLES, seed:
 def _primitive_distance(prim, visual_mesh, samples: int, seed: int) -> dict:
     """:func:`surface_distance`'s figures between one primitive's exact surface and ``visual_mesh``."""
     dab = point_surface_distance(prim.sample(samples, seed), visual_mesh)
-    dba = prim.distance(_samples(visual_mesh, samples, seed + 1))
+    dba = prim.distance(surface_samples(visual_mesh, samples, seed + 1))
     return distance_summary(dab, dba, samples, "exact distances between area-uniform samples of the primitive's "
                             "exact surface and of the mesh (fixed seed) and the other surface, both directions")
 
 
 def _union(meshes: list) -> tuple[trimesh.Trimesh, float | None, str]:
     """(surface of the union, its volume or None, method); falls back to all pieces together."""
-    from robotkit.mesh.hull import from_manifold, to_manifold
-
     if len(meshes) == 1:
         m = meshes[0]
         return m, closed_volume(m), "union"

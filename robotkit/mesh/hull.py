@@ -80,7 +80,8 @@ def from_manifold(manifold) -> trimesh.Trimesh:
     return canonical(np.asarray(mm.vert_properties)[:, :3], np.asarray(mm.tri_verts))
 
 
-def _exact_hull(points: np.ndarray) -> trimesh.Trimesh:
+def exact_hull(points: np.ndarray) -> trimesh.Trimesh:
+    """The exact convex hull of ``points`` (manifold3d); ValueError when it has no volume."""
     import manifold3d as m3
 
     points = np.array(points, dtype=np.float64)
@@ -117,7 +118,7 @@ def convex_hull_report(mesh, max_vertices: int | None = None,
     """
     if max_vertices is not None and int(max_vertices) < 4:
         raise ValueError(f"a convex hull needs at least 4 vertices, the budget is {max_vertices}")
-    exact = _exact_hull(np.asarray(mesh.vertices))
+    exact = exact_hull(np.asarray(mesh.vertices))
     P = np.asarray(exact.vertices)
     report = {"exact_vertices": int(len(P)), "exact_volume": float(exact.volume)}
     if max_vertices is None or len(P) <= int(max_vertices):

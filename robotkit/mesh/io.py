@@ -154,7 +154,7 @@ def volume_mesh(mesh, policy: str, name: str, where: Problem | None = None):
     repairs: list[str] = []
     warnings: list[str] = []
     if not mesh.is_volume:
-        from robotkit.mesh.repair import repair
+        from robotkit.mesh.repair import repair  # late: it imports trimesh (0.8 s), not needed to list companions
 
         mesh, report = repair(mesh)
         for key, text in (("vertices_merged", "merged {} vertices"),

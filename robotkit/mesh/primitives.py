@@ -36,6 +36,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import trimesh
 
+from robotkit.geometry import matrix_rpy
+from robotkit.mesh.hull import exact_hull
+
 
 @dataclass(frozen=True, eq=False)
 class Primitive:
@@ -54,8 +57,6 @@ class Primitive:
 
     def to_dict(self) -> dict:
         """Plain JSON-able numbers: kind, params, xyz, rpy (URDF convention), pose, volume."""
-        from robotkit.model.robot import matrix_rpy
-
         params = {k: (tuple(float(x) for x in v) if isinstance(v, (tuple, list, np.ndarray)) else float(v))
                   for k, v in self.params.items()}
         return {"kind": self.kind, "params": params,
@@ -244,9 +245,7 @@ def _hull_points(mesh) -> np.ndarray:
     if len(V) == 0:
         raise ValueError("cannot fit a primitive to an empty mesh")
     try:
-        from robotkit.mesh.hull import _exact_hull
-
-        return np.asarray(_exact_hull(V).vertices)
+        return np.asarray(exact_hull(V).vertices)
     except ValueError:  # flat or tiny: all vertices
         return np.unique(V, axis=0)
 

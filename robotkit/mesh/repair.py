@@ -129,7 +129,8 @@ def _edge_counts(m) -> tuple[int, int]:
 
 
 def _fill_holes(m, max_edges: int) -> dict:
-    """Close boundary loops of at most ``max_edges`` edges, in place; return counts."""
+    """Close boundary loops of at most ``max_edges`` edges that are small against the mesh, in
+    place; return counts."""
     out = {"holes_found": 0, "holes_filled": 0, "faces_added": 0, "vertices_added": 0, "holes_left": 0,
            "hole_area": 0.0, "hole_volume_bound": 0.0}
     if len(m.faces) == 0:
@@ -138,63 +139,18 @@ def _fill_holes(m, max_edges: int) -> dict:
     single = trimesh.grouping.group_rows(np.sort(edges, axis=1), require_count=1)
     if len(single) == 0:
         return out
-    # a hole is walked against the direction of the faces around it: its edges are b -> a
-    starts, ends = edges[single, 1], edges[single, 0]
-    order = np.lexsort((ends, starts))
-    starts, ends = starts[order], ends[order]
-    uniq, first, count = np.unique(starts, return_index=True, return_counts=True)
-    nxt = {int(s): int(ends[i]) for s, i, c in zip(uniq, first, count) if c == 1}
-    pinched = {int(s) for s, c in zip(uniq, count) if c > 1}
-    # holes = connected groups of boundary edges (loops sharing a vertex count as one)
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    bverts, bidx = np.unique(np.concatenate([starts, ends]), return_inverse=True)
-    nb = len(bverts)
-    graph = coo_matrix((np.ones(len(starts)), (bidx[:len(starts)], bidx[len(starts):])), shape=(nb, nb))
-    out["holes_found"] = int(connected_components(graph, directed=True, connection="weak")[0])
-    visited: set[int] = set()
-    loops = []
-    for s in uniq.tolist():
-        if s in visited or s in pinched:
-            continue
-        loop, v = [], s
-        while v not in visited and v in nxt:
-            visited.add(v)
-            loop.append(v)
-            v = nxt[v]
-        if v == s and len(loop) >= 3:  # else it ran into a pinched vertex: left open
-            loops.append(loop)
+    out["holes_found"], loops = _boundary_loops(edges, single)
     V = np.asarray(m.vertices)
     new_faces, new_vertices = [], []
-    nv = len(V)
     max_area = MAX_HOLE_AREA * float(m.area)
     max_perimeter = 2 * 2 * np.sqrt(np.pi * max_area)  # twice a circle's of the largest area
     for loop in loops:
-        k = len(loop)
-        if k > max_edges:
+        if len(loop) > max_edges:
             continue
-        if k == 3:
-            patch = [loop]
-        elif k == 4:
-            a, b, c, d = loop
-            if np.linalg.norm(V[a] - V[c]) <= np.linalg.norm(V[b] - V[d]):
-                patch = [[a, b, c], [a, c, d]]
-            else:
-                patch = [[a, b, d], [b, c, d]]
-        else:
-            centre = V[loop].mean(axis=0)
-            c = nv + len(new_vertices)
-            patch = [[loop[i], loop[(i + 1) % k], c] for i in range(k)]
-        if k > 4:  # the fan's triangles around the new centre vertex
-            tri = np.stack([V[loop], V[np.roll(loop, -1)], np.broadcast_to(centre, (k, 3))], axis=1)
-        else:
-            tri = V[np.array(patch)]
-        area = float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum() / 2)
-        perimeter = float(np.linalg.norm(V[loop] - V[np.roll(loop, -1)], axis=1).sum())
+        patch, centre, area, perimeter = _patch(V, loop, len(V) + len(new_vertices))
         if area > max_area or perimeter > max_perimeter:  # not small against the mesh: left open
             continue
-        if k > 4:
+        if centre is not None:
             new_vertices.append(centre)
         new_faces += patch
         out["hole_area"] += area
@@ -209,6 +165,65 @@ def _fill_holes(m, max_edges: int) -> dict:
         out["faces_added"] = len(new_faces)
         out["vertices_added"] = len(new_vertices)
     return out
+
+
+def _boundary_loops(edges: np.ndarray, single: np.ndarray) -> tuple[int, list[list[int]]]:
+    """(holes, loops): the number of holes (connected groups of boundary edges; loops sharing a
+    vertex count as one) and the simple boundary loops, each walked against the direction of
+    the faces around it.  A loop running into a pinched vertex is left out (left open)."""
+    # a hole is walked against the direction of the faces around it: its edges are b -> a
+    starts, ends = edges[single, 1], edges[single, 0]
+    order = np.lexsort((ends, starts))
+    starts, ends = starts[order], ends[order]
+    uniq, first, count = np.unique(starts, return_index=True, return_counts=True)
+    nxt = {int(s): int(ends[i]) for s, i, c in zip(uniq, first, count) if c == 1}
+    pinched = {int(s) for s, c in zip(uniq, count) if c > 1}
+    from scipy.sparse import coo_matrix  # late: scipy is slow to import and only a mesh with holes needs it
+    from scipy.sparse.csgraph import connected_components
+
+    bverts, bidx = np.unique(np.concatenate([starts, ends]), return_inverse=True)
+    nb = len(bverts)
+    graph = coo_matrix((np.ones(len(starts)), (bidx[:len(starts)], bidx[len(starts):])), shape=(nb, nb))
+    holes = int(connected_components(graph, directed=True, connection="weak")[0])
+    visited: set[int] = set()
+    loops = []
+    for s in uniq.tolist():
+        if s in visited or s in pinched:
+            continue
+        loop, v = [], s
+        while v not in visited and v in nxt:
+            visited.add(v)
+            loop.append(v)
+            v = nxt[v]
+        if v == s and len(loop) >= 3:  # else it ran into a pinched vertex: left open
+            loops.append(loop)
+    return holes, loops
+
+
+def _patch(V: np.ndarray, loop: list[int], c: int):
+    """(faces, new centre vertex or None, area, perimeter) of the patch closing ``loop``: the
+    triangle itself, the shorter diagonal's pair of a quad, or a fan around the loop's centre
+    (new vertex index ``c``)."""
+    k = len(loop)
+    centre = None
+    if k == 3:
+        patch = [loop]
+    elif k == 4:
+        a, b, c4, d = loop
+        if np.linalg.norm(V[a] - V[c4]) <= np.linalg.norm(V[b] - V[d]):
+            patch = [[a, b, c4], [a, c4, d]]
+        else:
+            patch = [[a, b, d], [b, c4, d]]
+    else:
+        centre = V[loop].mean(axis=0)
+        patch = [[loop[i], loop[(i + 1) % k], c] for i in range(k)]
+    if k > 4:  # the fan's triangles around the new centre vertex
+        tri = np.stack([V[loop], V[np.roll(loop, -1)], np.broadcast_to(centre, (k, 3))], axis=1)
+    else:
+        tri = V[np.array(patch)]
+    area = float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum() / 2)
+    perimeter = float(np.linalg.norm(V[loop] - V[np.roll(loop, -1)], axis=1).sum())
+    return patch, centre, area, perimeter
 
 
 def _orient_bodies(m, before: np.ndarray) -> tuple[int, int]:

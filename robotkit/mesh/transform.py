@@ -5,7 +5,7 @@ scaled about its own origin (units, mirroring), shifted so that the
 recentering point ``c`` of the *scaled* mesh (its axis-aligned bounding-box
 centre, or its centre of mass) is at the origin, then rotated by the
 fixed-axis roll-pitch-yaw ``R = Rz(yaw) Ry(pitch) Rx(roll)`` (the URDF
-convention, :func:`robotkit.model.robot.rpy_matrix`) and translated.  This is
+convention, :func:`robotkit.geometry.rpy_matrix`) and translated.  This is
 the same order as a recipe geometry: origin composed with the recentering
 offset, applied to the scaled mesh.
 
@@ -22,14 +22,15 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
+from robotkit.geometry import rpy_matrix
+from robotkit.mesh.inertia import mesh_mass_properties
+
 RECENTER = ("none", "bbox", "com")
 
 
 def transform_matrix(scale=(1.0, 1.0, 1.0), translate=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0),
                      center=(0.0, 0.0, 0.0)) -> np.ndarray:
     """``T(translate) @ R(rpy) @ T(-center) @ S(scale)`` as a 4x4 float64 array."""
-    from robotkit.model.robot import rpy_matrix
-
     S = np.diag(np.append(np.asarray(scale, dtype=np.float64), 1.0))
     C = np.eye(4)
     C[:3, 3] = -np.asarray(center, dtype=np.float64)
@@ -70,8 +71,6 @@ def transform(mesh, scale=(1.0, 1.0, 1.0), translate=(0.0, 0.0, 0.0), rpy=(0.0, 
             if not probe.is_volume:
                 raise ValueError("recenter='com' needs a closed, consistently wound mesh "
                                  "(repair it first, or use recenter='bbox')")
-            from robotkit.mesh.inertia import mesh_mass_properties
-
             center = mesh_mass_properties(probe.vertices, probe.faces).com
     M = transform_matrix(s, translate, rpy, center)
     out = mesh.copy()

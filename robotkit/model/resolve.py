@@ -11,21 +11,27 @@ Two steps:
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import math
 import os
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from robotkit.errors import Problem, RecipeError
-from robotkit.model import inertia_policy
+from robotkit import presets
+from robotkit.errors import Problem, RecipeError, display_path
+from robotkit.geometry import matrix_rpy
+from robotkit.model import inertia_policy, massprops
+from robotkit.model.massprops import Bounding, bounding_primitive, combine
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
-    Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World, matrix_rpy, rpy_matrix,
+    Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World,
 )
-from robotkit.recipe.load import LoadedRecipe
+from robotkit.paths import ReadPolicy, file_stem, recipe_policy
+from robotkit.recipe import schema
+from robotkit.recipe.load import LoadedRecipe, sort_problems
 from robotkit.recipe.schema import UNITS, Collision
 
 
@@ -48,8 +54,6 @@ def _t(v) -> tuple[float, ...]:
 
 def resolve_checked(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
     """The resolved robot; RecipeError with the loading problems and resolution's own, all together."""
-    from robotkit.recipe.load import sort_problems
-
     if not loaded.problems:
         return resolve(loaded, ros)
     problems = list(loaded.problems)
@@ -61,47 +65,27 @@ def resolve_checked(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
     raise RecipeError(sort_problems(problems, loaded.file))
 
 
-def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
-    """The structural robot of a loaded recipe; ``ros`` overrides the recipe's ``ros``."""
-    r = loaded.recipe
-    marks = loaded.marks
-    base_dir = os.path.dirname(str(loaded.file))
-    problems: list[Problem] = []
+@dataclass
+class _Context:
+    """What resolving one recipe reads and collects: the recipe, its line marks and folder, where
+    it may read, each mesh source's output file name, and the problems found so far."""
 
-    materials = tuple(Material(name, _t(m.rgba), m.gazebo) for name, m in r.materials.items())
-    material_names = {m.name for m in materials}
+    r: object  # robotkit.recipe.schema.Recipe
+    marks: object  # robotkit.recipe.load.Marks
+    base_dir: str
+    reads: ReadPolicy
+    sources: dict[str, str]
+    material_names: set[str]
+    problems: list[Problem] = field(default_factory=list)
 
-    # Output file names for meshes: the file's own name, made unique when two
-    # different sources share it.
-    sources: dict[str, str] = {}
-    for link_name, link in r.links.items():
-        for kind in ("visual", "collision"):
-            for geom in _geoms(getattr(link, kind)):
-                if geom.mesh:
-                    sources.setdefault(geom.mesh, "")
-    from robotkit.paths import file_stem
+    def report(self, path: tuple, message: str) -> None:
+        self.problems.append(self.marks.problem(path, message))
 
-    def safe_name(src: str) -> str:  # a mesh file's own name, safe as an output file name
-        stem, ext = os.path.splitext(os.path.basename(src))
-        return file_stem(stem) + (ext if file_stem(ext[1:]) == ext[1:] else "")
-
-    taken: dict[str, int] = {}
-    for src in sources:
-        taken[safe_name(src)] = taken.get(safe_name(src), 0) + 1
-    for src in sources:
-        name = safe_name(src)
-        if taken[name] > 1:
-            stem, ext = os.path.splitext(name)
-            name = f"{stem}-{_h(os.path.relpath(src, base_dir))}{ext}"
-        sources[src] = name
-
-    from robotkit.paths import recipe_policy
-
-    reads = recipe_policy(loaded.file)
-
-    def make_geom(g, path, link_name, policy, role="visual") -> Geom | None:
-        if g.material is not None and g.material not in material_names:
-            problems.append(marks.problem(path + ("material",), _unknown("material", g.material, material_names)))
+    def make_geom(self, g, path: tuple, policy, role: str = "visual") -> Geom | None:
+        """A recipe geometry as a model Geom; None (reported) when its mesh cannot be used."""
+        r = self.r
+        if g.material is not None and g.material not in self.material_names:
+            self.report(path + ("material",), _unknown("material", g.material, self.material_names))
         origin = Pose(_t(g.origin.xyz), _t(g.origin.rpy))
         if g.box is not None:
             shape = Shape("box", size=_t(g.box.size))
@@ -110,17 +94,10 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
         elif g.sphere is not None:
             shape = Shape("sphere", radius=float(g.sphere.radius))
         else:
-            if (why := reads.refusal(g.mesh)) is not None:
-                problems.append(marks.problem(path + ("mesh",), f"mesh file '{_show(g.mesh)}' {why}"))
+            if (why := self._mesh_refusal(g.mesh)) is not None:
+                self.report(path + ("mesh",), f"mesh file '{_show(g.mesh)}' {why}")
                 return None
-            if not os.path.isfile(g.mesh):
-                problems.append(marks.problem(path + ("mesh",), f"mesh file '{_show(g.mesh)}' does not exist"))
-                return None
-            if os.path.splitext(g.mesh)[1].lower() not in (".stl", ".obj", ".dae"):
-                problems.append(marks.problem(path + ("mesh",),
-                                              f"mesh file '{_show(g.mesh)}' has an unsupported format (use STL, OBJ or DAE)"))
-                return None
-            sources.setdefault(g.mesh, safe_name(g.mesh))
+            self.sources.setdefault(g.mesh, _safe_name(g.mesh))
             if g.scale is not None:
                 s = g.scale if isinstance(g.scale, list) else [g.scale] * 3
                 scale = _t(s)
@@ -134,218 +111,311 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
             mirrored = scale[0] * scale[1] * scale[2] < 0
             if mirrored and dec is None:
                 dec = ("none", 0)
-            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((_ident(g.mesh, base_dir), scale, policy, dec)))}"
-            file_name = sources[g.mesh] if dec is None else (
-                os.path.splitext(sources[g.mesh])[0] + ("_mirrored" if mirrored else "") + ".stl")
+            key = f"{os.path.splitext(os.path.basename(g.mesh))[0]}-{_h(repr((_ident(g.mesh, self.base_dir), scale, policy, dec)))}"
+            file_name = self.sources[g.mesh] if dec is None else (
+                os.path.splitext(self.sources[g.mesh])[0] + ("_mirrored" if mirrored else "") + ".stl")
             shape = Shape("mesh", mesh=MeshRef(g.mesh, scale, file_name, key, policy, decimate=dec,
                                                repair=dec is not None and dec[0] != "none" and r.meshes.repair))
         return Geom(shape, origin, (0.0, 0.0, 0.0), g.material, g.recenter)
 
-    links: list[Link] = []
-    for name, link in r.links.items():
-        lp = ("links", name)
-        ispec = link.inertial
-        policy = (ispec.open_mesh if ispec and ispec != "none" and ispec.open_mesh else None) or r.open_mesh
-        visuals = []
-        unusable = set()  # roles with a geometry already reported (a missing mesh): no second line
-        for i, g in _indexed(link.visual):
-            geom = make_geom(g, lp + ("visual",) + i, name, policy)
-            if geom is not None:
-                visuals.append(geom)
-            else:
-                unusable.add("visual")
-        collisions = []
-        format_collisions = []
-        strategy = link.collision if isinstance(link.collision, Collision) else (
-            r.meshes.collision if link.collision == "visual" else None)
-        if isinstance(link.collision, Collision) and r.meshes.collision is not None:
-            # what the link does not say comes from the project default
-            strategy = r.meshes.collision.model_copy(
-                update={k: getattr(link.collision, k) for k in link.collision.model_fields_set})
-        if strategy is not None:
-            made_from = visuals
-            if isinstance(link.collision, Collision) and link.collision.source is not None:
-                made_from = []
-                for i, g in _indexed(link.collision.source):
-                    geom = make_geom(g, lp + ("collision", "source") + i, name, "error", "collision")
-                    if geom is not None:
-                        made_from.append(_display_only(geom, base_dir))
-            collisions = _proxies(made_from, strategy, r.meshes.repair, base_dir)
-            for fmt in ("urdf", "sdf", "mjcf"):
-                if getattr(strategy, fmt) is not None:
-                    format_collisions.append((fmt, tuple(_proxies(made_from, getattr(strategy, fmt),
-                                                                  r.meshes.repair, base_dir))))
-        elif link.collision == "visual":
-            collisions = [replace(v, material=None) for v in visuals]
-        elif link.collision != "none":
-            for i, g in _indexed(link.collision):
-                if g.material is not None:
-                    problems.append(marks.problem(lp + ("collision",) + i + ("material",),
-                                                  "collision geometry has no material"))
-                geom = make_geom(g, lp + ("collision",) + i, name, policy, "collision")
-                if geom is not None:
-                    collisions.append(geom)
-                else:
-                    unusable.add("collision")
-        spec = InertialSpec("none") if ispec == "none" else _inertial_spec(ispec, r.density)
-        source = visuals if spec.source == "visual" else collisions
-        asked = ispec.policy if ispec not in (None, "none") else None
-        use = asked or r.inertia_policy
-        if use in ("recompute", "estimate") and spec.mode in ("explicit", "mass"):
-            if source:
-                spec = InertialSpec("mass" if use == "recompute" else "estimate", mass=spec.mass, source=spec.source)
-            elif asked and spec.source not in unusable:
-                problems.append(marks.problem(lp + ("inertial", "policy"),
-                                              f"'{use}' needs the link's {spec.source} geometry, and the link has "
-                                              "none (give the inertia with 'policy: repair')"))
-                spec = InertialSpec("none")
-            else:
-                use = "repair"  # recipe-wide: the given tensor is all there is
-        if spec.mode in ("density", "mass") and not source:
-            if ispec is None or spec.source in unusable:
-                spec = InertialSpec("none")
-            else:
-                problems.append(marks.problem(lp + ("inertial",),
-                                              f"computing the inertial needs {spec.source} geometry, and the link has none"))
-        if spec.mode == "explicit":
-            if use == "repair":
-                fixed = inertia_policy.repair(spec.explicit.mass, spec.explicit.tensor(), spec.explicit.mass)
-                if fixed.changes:
-                    spec = replace(spec, explicit=Inertial.from_tensor(fixed.mass, spec.explicit.com, fixed.inertia))
-            else:
-                problems.extend(_check_explicit(spec.explicit, marks, lp + ("inertial",)))
-        # meshes no inertial is computed from may be open: they are only drawn and collided (an
-        # estimate only needs their hull)
-        computed = spec.mode in ("density", "mass")
-        old = [g.shape.mesh for g in visuals]
-        visuals = [g if computed and spec.source == "visual" else _display_only(g, base_dir) for g in visuals]
-        collisions = [g if computed and spec.source == "collision" else _display_only(g, base_dir)
-                      for g in collisions]
-        # proxies read their visual mesh's facts (recentering): follow its new key
-        renamed = {m.key: g.shape.mesh for m, g in zip(old, visuals) if m is not None}
+    def _mesh_refusal(self, mesh: str) -> str | None:
+        """Why a mesh file cannot be used (outside the readable folders, missing, a format robotkit
+        does not read), or None."""
+        if (why := self.reads.refusal(mesh)) is not None:
+            return why
+        if not os.path.isfile(mesh):
+            return "does not exist"
+        if os.path.splitext(mesh)[1].lower() not in (".stl", ".obj", ".dae"):
+            return "has an unsupported format (use STL, OBJ or DAE)"
+        return None
 
-        def follow(g: Geom) -> Geom:
-            if g.shape.kind != "proxy":
-                return g
-            return replace(g, shape=replace(g.shape, mesh=renamed.get(g.shape.mesh.key, g.shape.mesh)))
 
-        collisions = [follow(g) for g in collisions]
-        format_collisions = [(f, tuple(follow(g) for g in gs)) for f, gs in format_collisions]
-        contact = None
-        if link.contact is not None:
-            c = link.contact
-            contact = Contact(c.mu1, c.mu2 if c.mu2 is not None else c.mu1, c.kp, c.kd)
-        links.append(Link(name, tuple(visuals), tuple(collisions), spec,
-                          spec.explicit if spec.mode == "explicit" else None, contact, tuple(format_collisions)))
+def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
+    """The structural robot of a loaded recipe; ``ros`` overrides the recipe's ``ros``.
 
-    link_names = [link.name for link in links]
-    joints: list[Joint] = []
-    for name, j in r.joints.items():
-        jp = ("joints", name)
-        for end in ("parent", "child"):
-            value = getattr(j, end)
-            if value not in r.links:
-                problems.append(marks.problem(jp + (end,), _unknown("link", value, link_names)))
-        if j.parent == j.child:
-            problems.append(marks.problem(jp + ("child",), f"a joint cannot connect link '{j.child}' to itself"))
-        axis = np.asarray(j.axis, dtype=float)
-        norm = float(np.linalg.norm(axis))
-        axis = _t(axis / norm) if norm > 0 else (1.0, 0.0, 0.0)
-        limit = None
-        if j.limit is not None:
-            limit = Limit(j.limit.lower, j.limit.upper, j.limit.effort, j.limit.velocity)
-            if j.type in ("continuous",):
-                limit = Limit(None, None, j.limit.effort, j.limit.velocity)
-                if j.limit.lower is not None or j.limit.upper is not None:
-                    problems.append(marks.problem(jp + ("limit",),
-                                                  "a continuous joint has no lower or upper limit (use revolute)"))
-            if j.type in ("fixed", "floating", "planar"):
-                problems.append(marks.problem(jp + ("limit",), f"a {j.type} joint takes no limit"))
-        dyn = Dynamics(j.dynamics.damping, j.dynamics.friction, j.dynamics.armature) if j.dynamics else None
-        mimic = None
-        if j.mimic is not None:
-            mimic = Mimic(j.mimic.joint, j.mimic.multiplier, j.mimic.offset)
-            if j.mimic.joint not in r.joints:
-                problems.append(marks.problem(jp + ("mimic", "joint"), _unknown("joint", j.mimic.joint, list(r.joints))))
-            elif j.mimic.joint == name:
-                problems.append(marks.problem(jp + ("mimic", "joint"), "a joint cannot mimic itself"))
-            elif r.joints[j.mimic.joint].type in ("fixed", "floating", "planar"):
-                problems.append(marks.problem(jp + ("mimic", "joint"),
-                                              f"joint '{j.mimic.joint}' is {r.joints[j.mimic.joint].type} and cannot be mimicked"))
-            if j.type not in ("revolute", "continuous", "prismatic"):
-                problems.append(marks.problem(jp + ("mimic",), f"a {j.type} joint cannot mimic another joint"))
-        joints.append(Joint(name, j.type, j.parent, j.child, Pose(_t(j.origin.xyz), _t(j.origin.rpy)),
-                            axis, limit, dyn, mimic))
-
-    extra_links, extra_joints, sensors = _sensors(r, marks, problems, make_geom, sources, base_dir)
-    known_links = set(link_names)
+    Every problem is collected (links, joints, sensors, actuators, worlds, the ROS and Gazebo
+    pair, the kinematic tree) and raised together as one RecipeError."""
+    r = loaded.recipe
+    base_dir = os.path.dirname(str(loaded.file))
+    materials = tuple(Material(name, _t(m.rgba), m.gazebo) for name, m in r.materials.items())
+    cx = _Context(r, loaded.marks, base_dir, recipe_policy(loaded.file), _mesh_file_names(r, base_dir),
+                  {m.name for m in materials})
+    links = [_link(cx, name, link) for name, link in r.links.items()]
+    joints = [_joint(cx, name, j, [link.name for link in links]) for name, j in r.joints.items()]
+    extra_links, extra_joints, sensors = _sensors(cx)
+    known_links = {link.name for link in links}
     for link in extra_links:
         if link.name in known_links:
-            problems.append(marks.problem(("sensors",), f"sensor frame '{link.name}' is also a link's name; "
-                                          "give the sensor another name or 'frame'"))
+            cx.report(("sensors",), f"sensor frame '{link.name}' is also a link's name; "
+                                    "give the sensor another name or 'frame'")
         known_links.add(link.name)
     links += extra_links
     joints += extra_joints
+    actuators = _actuators(cx, joints)
+    worlds = _worlds(cx)
+    ros, gazebo = _ros_and_gazebo(cx, ros)
     link_names = [link.name for link in links]
-    actuators = []
-    joint_types = {j.name: j for j in joints}
-    for name, a in r.actuators.items():
-        j = joint_types.get(name)
-        if j is None:
-            problems.append(marks.problem(("actuators", name), _unknown("joint", name, list(r.joints))))
-        elif j.type not in ("revolute", "continuous", "prismatic"):
-            problems.append(marks.problem(("actuators", name), f"joint '{name}' is {j.type}: only revolute, "
-                                          "continuous and prismatic joints can be actuated"))
-        elif j.mimic is not None:
-            problems.append(marks.problem(("actuators", name), f"joint '{name}' mimics '{j.mimic.joint}'; "
-                                          "actuate the joint it follows"))
-        elif a.interface == "effort" and (j.limit is None or not j.limit.effort):
-            problems.append(marks.problem(("actuators", name), f"an effort actuator needs joint '{name}' "
-                                          "to have an effort limit"))
-        else:
-            actuators.append(Actuator(name, a.interface, float(a.p), float(a.i), float(a.d)))
-    worlds = []
-    for name, w in r.worlds.items():
-        if (why := reads.refusal(w.map)) is not None:
-            problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' {why}"))
-        elif not os.path.isfile(w.map):
-            problems.append(marks.problem(("worlds", name, "map"), f"map file '{_show(w.map)}' does not exist"))
-        spawn = Pose(_t(w.spawn.xyz), _t(w.spawn.rpy)) if w.spawn is not None else None
-        worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall, spawn))
-    ros = ros or r.ros
-    gazebo = r.gazebo or ("classic" if ros == "ros1" else "sim")
-    if ros == "ros1" and gazebo == "sim":
-        problems.append(marks.problem(("gazebo",), "ROS 1 has no Gazebo Sim plugins (gz_ros2_control, ros_gz): "
-                                                   "use gazebo: classic, or ros: ros2"))
     links = _share_mesh_tasks(links)
     if loaded.partial != "tree":  # joints dropped as invalid would show as false tree problems
-        problems.extend(_check_tree(link_names, joints, marks))
-    if problems:
-        raise RecipeError(problems)
+        cx.problems.extend(_check_tree(link_names, joints, cx.marks))
+    if cx.problems:
+        raise RecipeError(cx.problems)
+    return Robot(r.robot, tuple(links), tuple(joints), materials, _metadata(r.metadata), r.self_collide,
+                 tuple(r.urdf_extras), tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base)
 
-    md = r.metadata
+
+def _safe_name(src: str) -> str:
+    """A mesh file's own name, safe as an output file name."""
+    stem, ext = os.path.splitext(os.path.basename(src))
+    return file_stem(stem) + (ext if file_stem(ext[1:]) == ext[1:] else "")
+
+
+def _mesh_file_names(r, base_dir: str) -> dict[str, str]:
+    """Output file names of the links' meshes by source: the file's own name, made unique when
+    two different sources share it."""
+    sources: dict[str, str] = {}
+    for link in r.links.values():
+        for kind in ("visual", "collision"):
+            for geom in _geoms(getattr(link, kind)):
+                if geom.mesh:
+                    sources.setdefault(geom.mesh, "")
+    taken: dict[str, int] = {}
+    for src in sources:
+        taken[_safe_name(src)] = taken.get(_safe_name(src), 0) + 1
+    for src in sources:
+        name = _safe_name(src)
+        if taken[name] > 1:
+            stem, ext = os.path.splitext(name)
+            name = f"{stem}-{_h(os.path.relpath(src, base_dir))}{ext}"
+        sources[src] = name
+    return sources
+
+
+def _link(cx: _Context, name: str, link) -> Link:
+    """One recipe link: its geometry, how its inertial is obtained, which meshes are only drawn."""
+    lp = ("links", name)
+    ispec = link.inertial
+    policy = (ispec.open_mesh if ispec and ispec != "none" and ispec.open_mesh else None) or cx.r.open_mesh
+    unusable: set[str] = set()  # roles with a geometry already reported (a missing mesh): no second line
+    visuals = _visuals(cx, lp, link, policy, unusable)
+    collisions, format_collisions = _collisions(cx, lp, link, visuals, policy, unusable)
+    spec = _link_inertial(cx, lp, link, visuals, collisions, unusable)
+    visuals, collisions, format_collisions = _drawn_only(spec, visuals, collisions, format_collisions, cx.base_dir)
+    contact = None
+    if link.contact is not None:
+        c = link.contact
+        contact = Contact(c.mu1, c.mu2 if c.mu2 is not None else c.mu1, c.kp, c.kd)
+    return Link(name, tuple(visuals), tuple(collisions), spec,
+                spec.explicit if spec.mode == "explicit" else None, contact, tuple(format_collisions))
+
+
+def _visuals(cx: _Context, lp: tuple, link, policy, unusable: set[str]) -> list[Geom]:
+    visuals = []
+    for i, g in _indexed(link.visual):
+        geom = cx.make_geom(g, lp + ("visual",) + i, policy)
+        if geom is not None:
+            visuals.append(geom)
+        else:
+            unusable.add("visual")
+    return visuals
+
+
+def _collisions(cx: _Context, lp: tuple, link, visuals: list[Geom], policy, unusable: set[str]):
+    """(collision geometry, [(format, its own collision geometry)]) of a link: given, the visual
+    geometry, or made by a strategy from the visual (or the strategy's source) geometry."""
+    r = cx.r
+    collisions: list[Geom] = []
+    format_collisions: list = []
+    strategy = link.collision if isinstance(link.collision, Collision) else (
+        r.meshes.collision if link.collision == "visual" else None)
+    if isinstance(link.collision, Collision) and r.meshes.collision is not None:
+        # what the link does not say comes from the project default
+        strategy = r.meshes.collision.model_copy(
+            update={k: getattr(link.collision, k) for k in link.collision.model_fields_set})
+    if strategy is not None:
+        made_from = visuals
+        if isinstance(link.collision, Collision) and link.collision.source is not None:
+            made_from = []
+            for i, g in _indexed(link.collision.source):
+                geom = cx.make_geom(g, lp + ("collision", "source") + i, "error", "collision")
+                if geom is not None:
+                    made_from.append(_display_only(geom, cx.base_dir))
+        collisions = _proxies(made_from, strategy, r.meshes.repair, cx.base_dir)
+        for fmt in ("urdf", "sdf", "mjcf"):
+            if getattr(strategy, fmt) is not None:
+                format_collisions.append((fmt, tuple(_proxies(made_from, getattr(strategy, fmt),
+                                                              r.meshes.repair, cx.base_dir))))
+    elif link.collision == "visual":
+        collisions = [replace(v, material=None) for v in visuals]
+    elif link.collision != "none":
+        for i, g in _indexed(link.collision):
+            if g.material is not None:
+                cx.report(lp + ("collision",) + i + ("material",), "collision geometry has no material")
+            geom = cx.make_geom(g, lp + ("collision",) + i, policy, "collision")
+            if geom is not None:
+                collisions.append(geom)
+            else:
+                unusable.add("collision")
+    return collisions, format_collisions
+
+
+def _link_inertial(cx: _Context, lp: tuple, link, visuals, collisions, unusable: set[str]) -> InertialSpec:
+    """How the link's inertial is obtained, with the inertia policy applied (the recipe's
+    ``inertia_policy``, or the link's ``inertial.policy``)."""
+    r, ispec = cx.r, link.inertial
+    spec = InertialSpec("none") if ispec == "none" else _inertial_spec(ispec, r.density)
+    source = visuals if spec.source == "visual" else collisions
+    asked = ispec.policy if ispec not in (None, "none") else None
+    use = asked or r.inertia_policy
+    if use in ("recompute", "estimate") and spec.mode in ("explicit", "mass"):
+        if source:
+            spec = InertialSpec("mass" if use == "recompute" else "estimate", mass=spec.mass, source=spec.source)
+        elif asked and spec.source not in unusable:
+            cx.report(lp + ("inertial", "policy"), f"'{use}' needs the link's {spec.source} geometry, and the "
+                                                   "link has none (give the inertia with 'policy: repair')")
+            spec = InertialSpec("none")
+        else:
+            use = "repair"  # recipe-wide: the given tensor is all there is
+    if spec.mode in ("density", "mass") and not source:
+        if ispec is None or spec.source in unusable:
+            spec = InertialSpec("none")
+        else:
+            cx.report(lp + ("inertial",), f"computing the inertial needs {spec.source} geometry, and the link has none")
+    if spec.mode == "explicit":
+        if use == "repair":
+            fixed = inertia_policy.repair(spec.explicit.mass, spec.explicit.tensor(), spec.explicit.mass)
+            if fixed.changes:
+                spec = replace(spec, explicit=Inertial.from_tensor(fixed.mass, spec.explicit.com, fixed.inertia))
+        else:
+            cx.problems.extend(_check_explicit(spec.explicit, cx.marks, lp + ("inertial",)))
+    return spec
+
+
+def _drawn_only(spec: InertialSpec, visuals, collisions, format_collisions, base_dir: str):
+    """Meshes no inertial is computed from may be open: they are only drawn and collided (an
+    estimate only needs their hull).  Proxies follow their visual mesh's new key (they read its
+    facts for recentering)."""
+    computed = spec.mode in ("density", "mass")
+    old = [g.shape.mesh for g in visuals]
+    visuals = [g if computed and spec.source == "visual" else _display_only(g, base_dir) for g in visuals]
+    collisions = [g if computed and spec.source == "collision" else _display_only(g, base_dir)
+                  for g in collisions]
+    renamed = {m.key: g.shape.mesh for m, g in zip(old, visuals) if m is not None}
+
+    def follow(g: Geom) -> Geom:
+        if g.shape.kind != "proxy":
+            return g
+        return replace(g, shape=replace(g.shape, mesh=renamed.get(g.shape.mesh.key, g.shape.mesh)))
+
+    collisions = [follow(g) for g in collisions]
+    format_collisions = [(f, tuple(follow(g) for g in gs)) for f, gs in format_collisions]
+    return visuals, collisions, format_collisions
+
+
+def _joint(cx: _Context, name: str, j, link_names: list[str]) -> Joint:
+    """One recipe joint, its ends, limit and mimic checked."""
+    jp = ("joints", name)
+    for end in ("parent", "child"):
+        value = getattr(j, end)
+        if value not in cx.r.links:
+            cx.report(jp + (end,), _unknown("link", value, link_names))
+    if j.parent == j.child:
+        cx.report(jp + ("child",), f"a joint cannot connect link '{j.child}' to itself")
+    axis = np.asarray(j.axis, dtype=float)
+    norm = float(np.linalg.norm(axis))
+    axis = _t(axis / norm) if norm > 0 else (1.0, 0.0, 0.0)
+    limit = None
+    if j.limit is not None:
+        limit = Limit(j.limit.lower, j.limit.upper, j.limit.effort, j.limit.velocity)
+        if j.type in ("continuous",):
+            limit = Limit(None, None, j.limit.effort, j.limit.velocity)
+            if j.limit.lower is not None or j.limit.upper is not None:
+                cx.report(jp + ("limit",), "a continuous joint has no lower or upper limit (use revolute)")
+        if j.type in ("fixed", "floating", "planar"):
+            cx.report(jp + ("limit",), f"a {j.type} joint takes no limit")
+    dyn = Dynamics(j.dynamics.damping, j.dynamics.friction, j.dynamics.armature) if j.dynamics else None
+    mimic = _mimic(cx, jp, name, j) if j.mimic is not None else None
+    return Joint(name, j.type, j.parent, j.child, Pose(_t(j.origin.xyz), _t(j.origin.rpy)), axis, limit, dyn, mimic)
+
+
+def _mimic(cx: _Context, jp: tuple, name: str, j) -> Mimic:
+    joints = cx.r.joints
+    if j.mimic.joint not in joints:
+        cx.report(jp + ("mimic", "joint"), _unknown("joint", j.mimic.joint, list(joints)))
+    elif j.mimic.joint == name:
+        cx.report(jp + ("mimic", "joint"), "a joint cannot mimic itself")
+    elif joints[j.mimic.joint].type in ("fixed", "floating", "planar"):
+        cx.report(jp + ("mimic", "joint"),
+                  f"joint '{j.mimic.joint}' is {joints[j.mimic.joint].type} and cannot be mimicked")
+    if j.type not in ("revolute", "continuous", "prismatic"):
+        cx.report(jp + ("mimic",), f"a {j.type} joint cannot mimic another joint")
+    return Mimic(j.mimic.joint, j.mimic.multiplier, j.mimic.offset)
+
+
+def _actuators(cx: _Context, joints: list[Joint]) -> list[Actuator]:
+    """The recipe's actuators, each on a revolute, continuous or prismatic joint that mimics none."""
+    actuators = []
+    joint_types = {j.name: j for j in joints}
+    for name, a in cx.r.actuators.items():
+        j = joint_types.get(name)
+        if j is None:
+            cx.report(("actuators", name), _unknown("joint", name, list(cx.r.joints)))
+        elif j.type not in ("revolute", "continuous", "prismatic"):
+            cx.report(("actuators", name), f"joint '{name}' is {j.type}: only revolute, "
+                                           "continuous and prismatic joints can be actuated")
+        elif j.mimic is not None:
+            cx.report(("actuators", name), f"joint '{name}' mimics '{j.mimic.joint}'; "
+                                           "actuate the joint it follows")
+        elif a.interface == "effort" and (j.limit is None or not j.limit.effort):
+            cx.report(("actuators", name), f"an effort actuator needs joint '{name}' "
+                                           "to have an effort limit")
+        else:
+            actuators.append(Actuator(name, a.interface, float(a.p), float(a.i), float(a.d)))
+    return actuators
+
+
+def _worlds(cx: _Context) -> list[World]:
+    worlds = []
+    for name, w in cx.r.worlds.items():
+        if (why := cx.reads.refusal(w.map)) is not None:
+            cx.report(("worlds", name, "map"), f"map file '{_show(w.map)}' {why}")
+        elif not os.path.isfile(w.map):
+            cx.report(("worlds", name, "map"), f"map file '{_show(w.map)}' does not exist")
+        spawn = Pose(_t(w.spawn.xyz), _t(w.spawn.rpy)) if w.spawn is not None else None
+        worlds.append(World(name, w.map, float(w.height), w.unknown_as_wall, spawn))
+    return worlds
+
+
+def _ros_and_gazebo(cx: _Context, ros: str | None) -> tuple[str, str]:
+    """(ros, gazebo): the override or the recipe's ROS, and the Gazebo it implies unless given."""
+    ros = ros or cx.r.ros
+    gazebo = cx.r.gazebo or ("classic" if ros == "ros1" else "sim")
+    if ros == "ros1" and gazebo == "sim":
+        cx.report(("gazebo",), "ROS 1 has no Gazebo Sim plugins (gz_ros2_control, ros_gz): "
+                               "use gazebo: classic, or ros: ros2")
+    return ros, gazebo
+
+
+def _metadata(md) -> Metadata:
     authors = tuple(Author(a.name, a.email) for a in md.authors)
     maintainers = tuple(Author(m.name, m.email) for m in md.maintainers) or tuple(a for a in authors if a.email)
     urls = tuple((k, v) for k, v in md.urls.model_dump().items() if v)
-    metadata = Metadata(md.version, md.description, authors, md.license, maintainers, urls)
-    return Robot(r.robot, tuple(links), tuple(joints), materials, metadata, r.self_collide, tuple(r.urdf_extras),
-                 tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base)
+    return Metadata(md.version, md.description, authors, md.license, maintainers, urls)
 
 
 OPTICAL = (-math.pi / 2, 0.0, -math.pi / 2)
 
 
-def _sensors(r, marks, problems, make_geom, sources, base_dir):
+def _sensors(cx: _Context):
     """Sensor frames (links + fixed joints) and Sensor records; presets expanded."""
-    from robotkit import presets
-
+    r, base_dir = cx.r, cx.base_dir
     links: list[Link] = []
     joints: list[Joint] = []
     sensors: list[Sensor] = []
     for name, s in r.sensors.items():
         sp = ("sensors", name)
         if s.parent not in r.links:
-            problems.append(marks.problem(sp + ("parent",), _unknown("link", s.parent, list(r.links))))
+            cx.report(sp + ("parent",), _unknown("link", s.parent, list(r.links)))
             continue
         origin = Pose(_t(s.origin.xyz), _t(s.origin.rpy))
         topic = s.topic or name
@@ -363,7 +433,7 @@ def _sensors(r, marks, problems, make_geom, sources, base_dir):
                     links.append(Link(lname))
                     continue
                 key = f"d435-{_h(_ident(mesh, base_dir))}"
-                sources.setdefault(mesh, "d435.dae")
+                cx.sources.setdefault(mesh, "d435.dae")
                 visual = Geom(Shape("mesh", mesh=MeshRef(mesh, (1.0, 1.0, 1.0), "d435.dae", key, "visual-only")),
                               Pose(vxyz, vrpy))
                 collision = Geom(Shape("box", size=box), Pose(bxyz))
@@ -382,7 +452,7 @@ def _sensors(r, marks, problems, make_geom, sources, base_dir):
         if s.body is not None:
             geoms = []
             for i, g in _indexed(s.body.visual):
-                geom = make_geom(g, sp + ("body", "visual") + i, frame, r.open_mesh)
+                geom = cx.make_geom(g, sp + ("body", "visual") + i, r.open_mesh)
                 if geom is not None:
                     geoms.append(geom)
             visuals = tuple(geoms)
@@ -402,8 +472,6 @@ def _sensors(r, marks, problems, make_geom, sources, base_dir):
 
 
 def _defaults(kind: str) -> dict:
-    from robotkit.recipe import schema
-
     model = {"camera": schema.CameraParams, "depth": schema.CameraParams, "lidar": schema.LidarParams,
              "sonar": schema.SonarParams, "imu": schema.ImuParams}[kind]
     return model().model_dump()
@@ -478,16 +546,12 @@ def _geoms(value):
 
 
 def _show(path: str) -> str:
-    from robotkit.errors import display_path
-
     if "\0" in path:  # display_path cannot resolve it; show the escape, not the byte
         return repr(path)[1:-1]
     return display_path(path)
 
 
 def _unknown(kind: str, value: str, known) -> str:
-    import difflib
-
     msg = f"no {kind} named '{value}'"
     close = difflib.get_close_matches(value, list(known), n=1)
     return msg + (f" (did you mean '{close[0]}'?)" if close else "")
@@ -571,18 +635,16 @@ def _check_tree(link_names: list[str], joints: list[Joint], marks) -> list[Probl
 
 def geom_mass_props(geom: Geom, facts: dict) -> tuple[float, np.ndarray, np.ndarray]:
     """(volume, com, inertia at unit density) of a geometry in its link frame."""
-    from robotkit.model import massprops as mi
-
     s = geom.shape
     if s.kind == "box":
-        p = mi.box_props(s.size)
+        p = massprops.box_props(s.size)
     elif s.kind == "cylinder":
-        p = mi.cylinder_props(s.radius, s.length)
+        p = massprops.cylinder_props(s.radius, s.length)
     elif s.kind == "sphere":
-        p = mi.sphere_props(s.radius)
+        p = massprops.sphere_props(s.radius)
     else:
         f = facts[s.mesh.key]
-        p = mi.MassProps(f["volume"], np.asarray(f["com"]), np.asarray(f["inertia"]))
+        p = massprops.MassProps(f["volume"], np.asarray(f["com"]), np.asarray(f["inertia"]))
     T = geom.pose.matrix()
     R = T[:3, :3]
     return p.volume, R @ p.com + T[:3, 3], R @ p.inertia @ R.T
@@ -598,8 +660,6 @@ def recenter_offset(geom: Geom, facts: dict) -> tuple[float, float, float]:
 
 def compute_inertial(link: Link, facts: dict) -> Inertial | None:
     """The link's inertial from its spec and the (recentered) source geometry."""
-    from robotkit.model.massprops import combine
-
     spec = link.inertial_spec
     if spec.mode == "explicit":
         return spec.explicit
@@ -618,8 +678,6 @@ def _estimate(link: Link, facts: dict) -> Inertial:
     """The link's mass as its bounding primitive (robotkit.model.massprops.bounding_primitive) of
     its source geometry, in the link frame; a link of one primitive is its own.  A flat or thin
     primitive's tensor (a plate's, a rod's) gets the repair's floor."""
-    from robotkit.model.massprops import Bounding, bounding_primitive
-
     geoms = link.source_geoms()
     s = geoms[0].shape
     if len(geoms) == 1 and s.kind in ("box", "cylinder", "sphere"):
@@ -637,7 +695,7 @@ def _points(geom: Geom, facts: dict) -> np.ndarray:
     """Points whose hull encloses a geometry, in its link frame: a mesh's hull vertices, a box's
     corners, a cylinder's and a sphere's circumscribed polyhedra (64 sections; an icosphere of
     642 vertices), so an enclosure of them encloses the geometry."""
-    import trimesh
+    import trimesh  # late: 0.8 s to import, and only an estimate of a primitive's mass needs it
 
     s = geom.shape
     if s.kind == "box":
@@ -699,7 +757,7 @@ def inertial_from_json(data) -> Inertial | None:
     return Inertial(data["mass"], tuple(data["com"]), tuple(data["inertia"]))
 
 
-__all__ = ["resolve", "finalize", "compute_inertial", "rpy_matrix"]
+__all__ = ["resolve", "finalize", "compute_inertial"]
 
 
 def finalize_link_inertial(link: Link, facts: dict) -> Inertial | None:

@@ -14,39 +14,15 @@ inertials) are filled in by :func:`robotkit.model.resolve.finalize`.
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from robotkit.geometry import rpy_matrix
+
 Vec3 = tuple[float, float, float]
 
 MJCF_MAX_DEPTH = 496  # bodies MuJoCo 4.0's XML reader nests (tinyxml2's element depth), measured
-
-
-def rpy_matrix(rpy) -> np.ndarray:
-    """Rotation matrix of fixed-axis roll, pitch, yaw: R = Rz(y) Ry(p) Rx(r)."""
-    r, p, y = (float(a) for a in rpy)
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array([
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr],
-    ])
-
-
-def matrix_rpy(R: np.ndarray) -> Vec3:
-    """Fixed-axis roll, pitch, yaw of a rotation matrix (inverse of :func:`rpy_matrix`)."""
-    sp = -float(R[2, 0])
-    if abs(sp) >= 1.0 - 1e-12:  # gimbal lock: put everything in yaw
-        p = math.copysign(math.pi / 2, sp)
-        r = 0.0
-        y = math.atan2(-float(R[0, 1]), float(R[1, 1]))
-    else:
-        p = math.asin(sp)
-        r = math.atan2(float(R[2, 1]), float(R[2, 2]))
-        y = math.atan2(float(R[1, 0]), float(R[0, 0]))
-    return (r, p, y)
 
 
 @dataclass(frozen=True)

@@ -20,10 +20,9 @@ import re
 from pathlib import Path
 
 from robotkit.errors import Problem
+from robotkit.model.plausible import DENSITY_RANGE, PART_SIZE_RANGE
 
 WARNING = "warning: "
-DENSITY_RANGE = (10.0, 25000.0)  # kg/m^3, as robotkit.check.lints (not imported: it loads numpy and trimesh)
-PART_SIZE_RANGE = (1e-4, 10.0)  # m
 _LINE = re.compile(r"^(?:(?P<file>.+?)(?::(?P<line>\d+))?: (?:(?P<key>[^\s:]+): )?)?warning: (?P<text>.*)$")
 _PLACE = re.compile(r"^.+?:\d+: [^\s:]+: ")  # the file:line: key: a mesh task put before its warning
 _NAMED = re.compile(r"\b(link|joint|sensor|mesh|actuator|material) '([^']+)'")

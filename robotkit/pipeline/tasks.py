@@ -294,10 +294,10 @@ def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
                    root / f"{w.name}.world", root / "scene.xml"]
         spawn = None
         if w.spawn is not None:
-            from robotkit.emit.mjcf import quat
+            from robotkit.geometry import rpy_quat
 
             spawn = {"name": robot.name, "root": robot.root, "xyz": list(w.spawn.xyz), "rpy": list(w.spawn.rpy),
-                     "quat": list(quat(w.spawn.rpy))}
+                     "quat": list(rpy_quat(w.spawn.rpy))}
         tasks.append({
             "name": f"world:{w.name}",
             "doc": f"world {w.name} from {os.path.basename(w.map)}",

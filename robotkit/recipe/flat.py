@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 
 from robotkit.errors import Problem, RecipeError
+from robotkit.recipe.load import load_recipes
 
 
 def flat_data(loaded) -> dict:
@@ -33,8 +34,6 @@ def flat_data(loaded) -> dict:
 
 def flat_yaml(file: str, args: dict[str, str] | None = None, variant: str | None = None) -> str:
     import yaml
-
-    from robotkit.recipe.load import load_recipes
 
     loaded = load_recipes(file, args)
     if variant is not None:

@@ -15,7 +15,10 @@ from pathlib import Path
 
 import yaml
 
-from robotkit.errors import Problem, RecipeError, yaml_syntax_problem
+from robotkit.errors import Problem, RecipeError, display_path, short_number, yaml_syntax_problem
+from robotkit.paths import recipe_policy
+from robotkit.recipe.expand import convert_units, copy_marks, expand
+from robotkit.recipe.schema import RENAMED, Recipe
 
 Path_ = tuple  # a key path: ("links", "base", "visual", 0, "mesh")
 
@@ -197,8 +200,6 @@ def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = (), re
     """Read ``file`` and, recursively, the files it includes (inside ``reads``, a
     :class:`robotkit.paths.ReadPolicy`); merge their sections."""
     if reads is None:
-        from robotkit.paths import recipe_policy
-
         reads = recipe_policy(file)
     data, marks = _read_yaml(file, problems)
     if data is None:
@@ -270,8 +271,6 @@ def _gather(file: Path, problems: list[Problem], seen: tuple[Path, ...] = (), re
 
 
 def _rel(path: str) -> str:
-    from robotkit.errors import display_path
-
     return display_path(path)
 
 
@@ -414,9 +413,7 @@ def _unwrap(tp):
 
 
 def _num(x) -> str:
-    from robotkit.recipe.schema import _g
-
-    return _g(x) if isinstance(x, float) else str(x)
+    return short_number(x) if isinstance(x, float) else str(x)
 
 
 def _message(err: dict) -> str:
@@ -463,8 +460,6 @@ def _message(err: dict) -> str:
 
 
 def schema_problems(exc, marks: Marks, model) -> list[Problem]:
-    from robotkit.recipe.schema import RENAMED
-
     out: list[Problem] = []
     seen = set()
     for err in exc.errors(include_url=False):
@@ -509,8 +504,6 @@ def read_recipes(file: str | os.PathLike, args: dict[str, str] | None = None,
     recipe with the invalid parts neutralised, so later stages can add their own problems
     (robotkit.model.resolve.resolve_checked).  ``args``: ``--arg`` overrides, name -> text.
     """
-    from robotkit.recipe.expand import copy_marks, expand
-
     file = Path(file).absolute()
     problems: list[Problem] = []
     data, where = _gather(file, problems)
@@ -536,9 +529,6 @@ def read_recipes(file: str | os.PathLike, args: dict[str, str] | None = None,
 
 def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], variant) -> LoadedRecipe:
     from pydantic import ValidationError
-
-    from robotkit.recipe.expand import convert_units
-    from robotkit.recipe.schema import Recipe
 
     _apply_defaults(data, marks)
     convert_units(data, lambda path, msg: problems.append(marks.problem(path, msg)))
@@ -589,8 +579,6 @@ def _salvage(data: dict, exc):
     Returns (recipe or None, partial): None when the remaining data still fails.
     """
     from pydantic import ValidationError
-
-    from robotkit.recipe.schema import Recipe
 
     data = dict(data)
     bad_links, bad_joints, bad_top = set(), set(), set()

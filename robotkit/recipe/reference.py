@@ -12,6 +12,7 @@ import typing
 from pydantic_core import PydanticUndefined
 
 from robotkit.recipe import schema as s
+from robotkit.recipe.expand.units import UNITS
 
 SECTIONS = [
     (s.Recipe, "recipe (top level)"), (s.Metadata, "metadata"), (s.Author, "metadata.authors[]"),
@@ -27,8 +28,6 @@ EXPRESSION = r"\$\{[^{}]*\}"
 
 
 def _quantity_pattern(kind: str) -> str:
-    from robotkit.recipe.expand.units import UNITS
-
     units = "|".join(sorted((u for u, (dim, _) in UNITS.items() if kind == "position" or dim == kind),
                             key=lambda u: (-len(u), u)))
     return rf"^\s*([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|{EXPRESSION})\s*({units})\s*$"

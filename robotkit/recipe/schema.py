@@ -30,6 +30,9 @@ from typing import Annotated, Literal
 from pydantic import (AfterValidator, BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator,
                       model_validator)
 
+from robotkit.errors import short_number
+from robotkit.paths import MAX_NAME, reserved_problem
+
 NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*$")
 NAME_HINT = "a name starts with a letter or '_' and holds only letters, digits, '_', '-' and '.'"
 FRAME_NAME_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]*(/[A-Za-z0-9_.\-]+)*$")
@@ -62,14 +65,9 @@ MAX_COUNT = 10**8
 def _at_least(low: float, unit: str):
     def check(v):
         if 0 < abs(v) < low:
-            raise ValueError(f"must be at least {_g(low)} {unit} (got {_g(v)})")
+            raise ValueError(f"must be at least {short_number(low)} {unit} (got {short_number(v)})")
         return v
     return AfterValidator(check)
-
-
-def _g(x: float) -> str:
-    """A short number for messages: 1e-06 -> 1e-6, 10000.0 -> 10000."""
-    return f"{x:g}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
 
 
 def _bounded(low: float, high: float):
@@ -137,8 +135,6 @@ def _scale_form(value) -> str | None:
 def check_name(value: str) -> str:
     """A name of the recipe (link, joint, sensor, world...): names become file names, so the
     character set is safe on every filesystem and the length is bounded (robotkit.paths)."""
-    from robotkit.paths import MAX_NAME, reserved_problem
-
     if not NAME_RE.match(value):
         raise ValueError(f"invalid name {value[:40]!r}{'...' if len(value) > 40 else ''}: {NAME_HINT}")
     if len(value) > MAX_NAME:
@@ -152,8 +148,6 @@ def check_name(value: str) -> str:
 def check_frame_name(value: str) -> str:
     """Link and joint names: as :func:`check_name`, and '/' between parts (ROS accepts them;
     files named after them go through :func:`robotkit.paths.file_stem`)."""
-    from robotkit.paths import MAX_NAME
-
     if not FRAME_NAME_RE.match(value):
         raise ValueError(f"invalid name {value[:40]!r}{'...' if len(value) > 40 else ''}: {FRAME_NAME_HINT}")
     if len(value) > MAX_NAME:

@@ -24,6 +24,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from robotkit.world.mapfile import OccupancyMap
 
 __all__ = ["OccupancyMap", "build_world", "load_map", "wall_mesh"]
+# The modules doing the work are imported when called: `import robotkit.world` stays free of numpy
+# and PIL until a map is read.
 
 
 def load_map(map_yaml: str | os.PathLike) -> "OccupancyMap":

@@ -20,6 +20,12 @@ from pathlib import Path
 from typing import NamedTuple
 
 from robotkit.errors import MapError, Problem
+from robotkit.emit.env import fmt, render
+from robotkit.ioutil import write_if_changed
+from robotkit.mesh.export import stl_bytes
+from robotkit.paths import name_problem
+from robotkit.world.mapfile import load_map
+from robotkit.world.walls import check_height, extrude, padded_wall_cells, rectangles, to_map
 
 WALL_RGBA = (0.7, 0.7, 0.7, 1.0)
 GROUND_MARGIN = 5.0  # metres of floor around the map
@@ -55,8 +61,6 @@ def check_name(name: str) -> str:
     if not isinstance(name, str) or not _NAME.match(name):
         raise MapError(Problem(f"{name!r} cannot name a Gazebo model and its files "
                                "(use letters, digits, '_', '-' and '.')", key="name"))
-    from robotkit.paths import name_problem
-
     if (why := name_problem(name)) is not None:
         raise MapError(Problem(f"name {why}", key="name"))
     return name
@@ -80,8 +84,6 @@ def world_context(name: str, occupancy_map, height: float, rects) -> WorldContex
     # nanometre so that 0.03 * 513 / 2 reads 7.695, not 7.694999999999999
     # Each number is res * k / 2 for a whole k, so it is formatted once per k (a big map has
     # 10^5 boxes and a few thousand distinct k).
-    from robotkit.emit.env import fmt
-
     x0, y0, x1, y1 = np.asarray(rects, dtype=np.int64).reshape(-1, 4).T
     k = np.stack([x0 + x1, y0 + y1, x1 - x0, y1 - y0])
     distinct, which = np.unique(k, return_inverse=True)
@@ -110,8 +112,6 @@ def world_context(name: str, occupancy_map, height: float, rects) -> WorldContex
 
 
 def _num(x: float) -> str:
-    from robotkit.emit.env import fmt
-
     return fmt(x)
 
 
@@ -122,10 +122,6 @@ def render_world(name: str, occupancy_map, height: float = 2.0, unknown_as_wall:
     ``robot`` (name, root, xyz, rpy, quat) places a robot built into the same output folder
     in the world and the scene."""
     from types import SimpleNamespace
-
-    from robotkit.emit.env import render
-    from robotkit.mesh.export import stl_bytes
-    from robotkit.world.walls import extrude, padded_wall_cells, rectangles, to_map
 
     padded = padded_wall_cells(occupancy_map, unknown_as_wall)
     mask = padded[1:-1, 1:-1]
@@ -151,10 +147,6 @@ def build_world(map_yaml: str | os.PathLike, out_dir: str | os.PathLike, name: s
     ``name`` defaults to the YAML file's stem.  Raises MapError (nothing written) when the
     map, the name or the height is unusable.
     """
-    from robotkit.ioutil import write_if_changed
-    from robotkit.world.mapfile import load_map
-    from robotkit.world.walls import check_height
-
     map_yaml = Path(map_yaml)
     name = map_yaml.stem if name is None else name
     problems: list[Problem] = []

@@ -36,6 +36,9 @@ from pathlib import Path
 import numpy as np
 
 from robotkit.errors import MapError, Problem, display_path, yaml_syntax_problem
+from robotkit.emit.env import fmt
+from robotkit.paths import ReadPolicy
+from robotkit.recipe.load import yaml_limits
 
 MODES = ("trinary", "scale", "raw")
 REQUIRED = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh")
@@ -148,8 +151,6 @@ def _read_yaml(yaml_path: Path, problems: list[Problem]):
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         problems.append(Problem(f"cannot read file: {reason}", file=file))
         return None, {}
-    from robotkit.recipe.load import yaml_limits
-
     limit = yaml_limits(text)  # nesting and alias bombs, before the (recursive) composer sees them
     if limit is not None:
         problems.append(Problem(limit[0], file=file, line=limit[1]))
@@ -222,52 +223,82 @@ def load_map(map_yaml: str | os.PathLike) -> OccupancyMap:
     for key in REQUIRED:
         if key not in data:
             problems.append(Problem("missing (map_server requires this key)", file=file, key=key))
-
-    # image: checked for existence and decoded below, once the other keys are read
     image = data.get("image")
-    image_path = None
-    if "image" in data:
-        if not isinstance(image, str) or not image.strip():
-            bad("image", f"must be the image file name (PGM or PNG), not {_show(image)}")
-        else:
-            image_path = Path(image) if os.path.isabs(image) else yaml_path.parent / image
-            from robotkit.paths import ReadPolicy
+    image_path = _image_path(data, yaml_path, bad)  # decoded below, once the other keys are read
+    resolution = _resolution(data, bad)
+    origin = _origin(data, bad)
+    negate = _negate(data, bad)
+    occ_th, free_th = _thresholds(data, bad)
+    mode = _mode(data, bad)
+    pixels = None
+    if image_path is not None:
+        pixels = _read_image(image_path, image, lambda msg: bad("image", msg))
+    if problems:
+        raise MapError(problems)
+    grid = classify(pixels, mode=mode, negate=negate, occupied_thresh=occ_th, free_thresh=free_th)
+    return OccupancyMap(yaml_path=yaml_path, image_path=image_path, resolution=resolution, origin=origin,
+                        negate=negate, occupied_thresh=occ_th, free_thresh=free_th, mode=mode, grid=grid,
+                        image_name=image, image_line=lines.get("image"))
 
-            if (why := ReadPolicy.for_file(yaml_path).refusal(image_path)) is not None:
-                bad("image", f"image file '{image}' {why}")
-                image_path = None
 
-    resolution = None
-    if "resolution" in data:
-        resolution = _number(data["resolution"])
-        if resolution is None:
-            bad("resolution", f"must be a number (metres per cell), not {_show(data['resolution'])}")
-        elif not math.isfinite(resolution):
-            bad("resolution", "must be a finite number")
-            resolution = None
-        elif resolution <= 0:
-            bad("resolution", "must be > 0")
-            resolution = None
+# Each key's reading below: its value, or None after ``bad(key, message)`` (or when absent).
 
-    origin = None
-    if "origin" in data:
-        raw = data["origin"]
-        values = [_number(v) for v in raw] if isinstance(raw, list) else None
-        if values is None or len(values) != 3 or any(v is None or not math.isfinite(v) for v in values):
-            bad("origin", f"must be [x, y, yaw]: three numbers, not {_show(raw)}")
-        else:
-            origin = tuple(values)
 
-    negate = None
-    if "negate" in data:
-        raw = data["negate"]
-        if isinstance(raw, bool):
-            negate = raw
-        elif isinstance(raw, int) and raw in (0, 1):
-            negate = bool(raw)
-        else:
-            bad("negate", f"must be 0 or 1, not {_show(raw)}")
+def _image_path(data: dict, yaml_path: Path, bad) -> Path | None:
+    """The image file ``image`` names (relative to the YAML file's folder), where it may be read."""
+    if "image" not in data:
+        return None
+    image = data["image"]
+    if not isinstance(image, str) or not image.strip():
+        bad("image", f"must be the image file name (PGM or PNG), not {_show(image)}")
+        return None
+    image_path = Path(image) if os.path.isabs(image) else yaml_path.parent / image
+    if (why := ReadPolicy.for_file(yaml_path).refusal(image_path)) is not None:
+        bad("image", f"image file '{image}' {why}")
+        return None
+    return image_path
 
+
+def _resolution(data: dict, bad) -> float | None:
+    if "resolution" not in data:
+        return None
+    resolution = _number(data["resolution"])
+    if resolution is None:
+        bad("resolution", f"must be a number (metres per cell), not {_show(data['resolution'])}")
+    elif not math.isfinite(resolution):
+        bad("resolution", "must be a finite number")
+        resolution = None
+    elif resolution <= 0:
+        bad("resolution", "must be > 0")
+        resolution = None
+    return resolution
+
+
+def _origin(data: dict, bad) -> tuple | None:
+    if "origin" not in data:
+        return None
+    raw = data["origin"]
+    values = [_number(v) for v in raw] if isinstance(raw, list) else None
+    if values is None or len(values) != 3 or any(v is None or not math.isfinite(v) for v in values):
+        bad("origin", f"must be [x, y, yaw]: three numbers, not {_show(raw)}")
+        return None
+    return tuple(values)
+
+
+def _negate(data: dict, bad) -> bool | None:
+    if "negate" not in data:
+        return None
+    raw = data["negate"]
+    if isinstance(raw, bool):
+        return raw
+    if isinstance(raw, int) and raw in (0, 1):
+        return bool(raw)
+    bad("negate", f"must be 0 or 1, not {_show(raw)}")
+    return None
+
+
+def _thresholds(data: dict, bad) -> tuple[float | None, float | None]:
+    """(occupied_thresh, free_thresh), each between 0 and 1, free below occupied."""
     thresholds = {}
     for key in ("occupied_thresh", "free_thresh"):
         if key not in data:
@@ -281,30 +312,19 @@ def load_map(map_yaml: str | os.PathLike) -> OccupancyMap:
             thresholds[key] = value
     occ_th, free_th = thresholds.get("occupied_thresh"), thresholds.get("free_thresh")
     if occ_th is not None and free_th is not None and not free_th < occ_th:
-        from robotkit.emit.env import fmt
-
         bad("free_thresh", f"must be below occupied_thresh ({fmt(occ_th)})")
+    return occ_th, free_th
 
-    mode = "trinary"
-    if "mode" in data:
-        raw = data["mode"]
-        if raw not in MODES:
-            bad("mode", f"must be trinary, scale or raw, not {_show(raw)}")
-            mode = None
-        else:
-            mode = raw
 
-    pixels = None
-    if image_path is not None:
-        pixels = _read_image(image_path, image, lambda msg: bad("image", msg))
-
-    if problems:
-        raise MapError(problems)
-
-    grid = classify(pixels, mode=mode, negate=negate, occupied_thresh=occ_th, free_thresh=free_th)
-    return OccupancyMap(yaml_path=yaml_path, image_path=image_path, resolution=resolution, origin=origin,
-                        negate=negate, occupied_thresh=occ_th, free_thresh=free_th, mode=mode, grid=grid,
-                        image_name=image, image_line=lines.get("image"))
+def _mode(data: dict, bad) -> str | None:
+    """``mode``: trinary when absent."""
+    if "mode" not in data:
+        return "trinary"
+    raw = data["mode"]
+    if raw not in MODES:
+        bad("mode", f"must be trinary, scale or raw, not {_show(raw)}")
+        return None
+    return raw
 
 
 # ---------------------------------------------------------------- image

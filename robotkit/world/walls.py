@@ -32,6 +32,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robotkit.errors import MapError, Problem
+
 
 # manifold3d's time on a piece of wall grows with its holes times its points (about 7e-9 s
 # each: 31 s for the 16,632 holes in 227,238 points of a 600 x 600 map of 70 % noise); past
@@ -597,8 +599,6 @@ def padded_wall_cells(occupancy_map, unknown_as_wall: bool = False) -> np.ndarra
 
 def _walls_image(occupancy_map, unknown_as_wall: bool) -> np.ndarray:
     """The image-order mask of wall cells; MapError when there is none."""
-    from robotkit.errors import MapError
-
     walls = occupancy_map.walls(unknown_as_wall)
     if not walls.any():
         om = occupancy_map
@@ -613,8 +613,6 @@ def _walls_image(occupancy_map, unknown_as_wall: bool) -> np.ndarray:
 
 
 def check_height(height) -> float:
-    from robotkit.errors import MapError, Problem
-
     try:
         value = float(height)
     except (TypeError, ValueError):

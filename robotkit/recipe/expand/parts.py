@@ -19,15 +19,18 @@ limits [lower, upper] become [-upper, -lower] and mimic gains follow.
 
 from __future__ import annotations
 
+import difflib
 import math
 import os
 from pathlib import Path
 
 from robotkit.errors import display_path
-from robotkit.recipe.expand import (
+from robotkit.geometry import matrix_rpy, rpy_rows
+from robotkit.recipe import schema
+from robotkit.recipe.expand.language import (
     ITEM_SECTIONS, Source, bind_args, declare_args, declare_values, evaluate_tree, keep,
 )
-from robotkit.recipe.expand import units as _units
+from robotkit.recipe.expand.units import convert_tree
 
 INSTANCE_KEYS = ("part", "parent", "origin", "args", "prefix", "mirror", "if")
 PART_KEYS = ("description", "args", "values", "parts", "links", "joints", "sensors", "actuators", "instances")
@@ -35,10 +38,8 @@ MIRRORS = {"yz": 0, "xz": 1, "xy": 2}  # the plane -> the axis the reflection fl
 UNIT_FACTORS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}  # as robotkit.recipe.schema.UNITS
 
 
-def _models():
-    from robotkit.recipe import schema
-
-    return {"links": schema.Link, "joints": schema.Joint, "sensors": schema.Sensor, "actuators": schema.Actuator}
+MODELS = {"links": schema.Link, "joints": schema.Joint, "sensors": schema.Sensor, "actuators": schema.Actuator}
+"""The schema model of each item section (quantities in an instance are converted by it)."""
 
 
 def expand_instances(block, src: Source, scope: dict, parts_env: list, ctx, flat: dict, items: dict,
@@ -90,17 +91,47 @@ def _find_part(part: str, parts_env: list, ctx):
 
 
 def _instance(name, spec, isrc: Source, scope, parts_env, ctx, flat, items, default_units, chain):
+    """Expand one instance into ``flat``: its spec checked, its part found, the part's body
+    evaluated with the instance's arguments (nested instances too), then its items renamed,
+    placed at the parent, mirrored and merged."""
     spec = evaluate_tree(spec, scope, ctx, isrc)
+    checked = _checked_spec(name, spec, isrc, ctx)
+    if checked is None:
+        return
+    prefix, mirror, pose = checked
+    found = _find_part(spec["part"], parts_env, ctx)
+    if found is None:
+        _report_unknown_part(spec["part"], parts_env, isrc, ctx)
+        return
+    body, bsrc, def_scope, env = found
+    file, line = isrc.locate(())
+    chain = chain + (f"{name} at {display_path(file)}:{line}",)
+    bsrc = Source(bsrc.where, bsrc.prefix, f" (in instance {' > '.join(chain)})")
+    for key in body:
+        if key not in PART_KEYS:
+            ctx.report(bsrc, (key,), f"unknown key (expected one of: {', '.join(PART_KEYS)})")
+    pscope = _part_scope(spec, body, bsrc, def_scope, prefix, isrc, ctx)
+    local, local_items = _part_items(body, bsrc, pscope, ctx)
+    expand_instances(body.get("instances"), bsrc.sub("instances"), pscope, env, ctx, local, local_items,
+                     default_units, chain)
+    renamed = _rename(local, prefix)
+    _attach(renamed, spec["part"], spec["parent"], pose, isrc, ctx)
+    if mirror is not None:
+        _mirror(renamed, MIRRORS[mirror], default_units, set(renamed["joints"]))
+    _merge(renamed, local_items, flat, items, isrc, ctx)
+
+
+def _checked_spec(name, spec, isrc: Source, ctx):
+    """(prefix, mirror, pose) of an evaluated instance spec, or None when it is not usable (the
+    problems reported) or its ``if:`` is false."""
     if not isinstance(spec, dict):
         ctx.report(isrc, (), f"an instance is a mapping with 'part' and 'parent' (got {spec!r})")
-        return
+        return None
     if not keep(spec, ctx, isrc, ()):
-        return
+        return None
     bad = False
     for key in spec:
         if key not in INSTANCE_KEYS:
-            import difflib
-
             close = difflib.get_close_matches(str(key), INSTANCE_KEYS, n=1)
             hint = f" (did you mean '{close[0]}'?)" if close else f" (expected one of: {', '.join(INSTANCE_KEYS)})"
             ctx.report(isrc, (key,), "unknown key" + hint)
@@ -123,50 +154,53 @@ def _instance(name, spec, isrc: Source, scope, parts_env, ctx, flat, items, defa
         ctx.report(isrc, ("origin",), "must be a mapping with xyz and rpy")
         bad = True
     if bad:
-        return
-    from robotkit.recipe.schema import Origin
+        return None
+    pose = _instance_pose(origin, isrc, ctx)
+    return None if pose is None else (prefix, mirror, pose)
 
-    _units._walk(origin, Origin, (), None, lambda p, m: ctx.report(isrc, ("origin",) + p, m))
+
+def _instance_pose(origin: dict, isrc: Source, ctx):
+    """[xyz, rpy] of an instance's ``origin`` (quantities converted), or None (reported)."""
+    convert_tree(origin, schema.Origin, (), None, lambda p, m: ctx.report(isrc, ("origin",) + p, m))
     pose = []
     for key in ("xyz", "rpy"):
         v = origin.get(key, [0, 0, 0])
         if not (isinstance(v, list) and len(v) == 3 and all(_is_num(x) for x in v)):
             ctx.report(isrc, ("origin", key), f"must be 3 numbers (got {v!r})")
-            return
+            return None
         pose.append([float(x) for x in v])
-    found = _find_part(spec["part"], parts_env, ctx)
-    if found is None:
-        if not any(isinstance(b, dict) and spec["part"] in b for b, *_ in parts_env):
-            import difflib
+    return pose
 
-            known = sorted({k for b, *_ in parts_env if isinstance(b, dict) for k in b})
-            close = difflib.get_close_matches(spec["part"], known, n=1)
-            hint = f" (did you mean '{close[0]}'?)" if close else ""
-            ctx.report(isrc, ("part",), f"no part named '{spec['part']}'{hint}")
+
+def _report_unknown_part(part: str, parts_env: list, isrc: Source, ctx):
+    """'no part named' with a did-you-mean, unless the part exists and its own problem is reported."""
+    if any(isinstance(b, dict) and part in b for b, *_ in parts_env):
         return
-    body, bsrc, def_scope, env = found
-    file, line = isrc.locate(())
-    hop = f"{name} at {display_path(file)}:{line}"
-    chain = chain + (hop,)
-    via = f" (in instance {' > '.join(chain)})"
-    bsrc = Source(bsrc.where, bsrc.prefix, via)
-    for key in body:
-        if key not in PART_KEYS:
-            ctx.report(bsrc, (key,), f"unknown key (expected one of: {', '.join(PART_KEYS)})")
-    part = spec["part"]
-    parent = spec["parent"]
+    known = sorted({k for b, *_ in parts_env if isinstance(b, dict) for k in b})
+    close = difflib.get_close_matches(part, known, n=1)
+    hint = f" (did you mean '{close[0]}'?)" if close else ""
+    ctx.report(isrc, ("part",), f"no part named '{part}'{hint}")
+
+
+def _part_scope(spec: dict, body: dict, bsrc: Source, def_scope: dict, prefix: str, isrc: Source, ctx) -> dict:
+    """The names the part's body sees: its defining scope, its arguments bound to the instance's
+    ``args``, ``parent``, ``prefix`` and its own ``values``."""
     declared = declare_args(body.get("args"), def_scope, ctx, bsrc.sub("args"))
     given = spec.get("args") or {}
     if not isinstance(given, dict):
         ctx.report(isrc, ("args",), f"must be a mapping of argument values (got {given!r})")
         given = {}
-    values = bind_args(declared, given, ctx, f"part '{part}'", lambda n: (isrc, ("args", n)), from_text=False)
-    pscope = {**def_scope, **values, "parent": parent, "prefix": prefix}
-    pscope = declare_values(body.get("values"), pscope, ctx, bsrc.sub("values"))
+    values = bind_args(declared, given, ctx, f"part '{spec['part']}'", lambda n: (isrc, ("args", n)),
+                       from_text=False)
+    pscope = {**def_scope, **values, "parent": spec["parent"], "prefix": prefix}
+    return declare_values(body.get("values"), pscope, ctx, bsrc.sub("values"))
 
+
+def _part_items(body: dict, bsrc: Source, pscope: dict, ctx) -> tuple[dict, dict]:
+    """The part's own items evaluated in ``pscope`` (those whose ``if:`` holds), by section, and
+    where each was written."""
     local = {s: {} for s in ITEM_SECTIONS}
     local_items: dict = {}
-    models = _models()
     for section in ITEM_SECTIONS:
         block = body.get(section)
         if block is None:
@@ -180,13 +214,15 @@ def _instance(name, spec, isrc: Source, scope, parts_env, ctx, flat, items, defa
             if not keep(item, ctx, isrc_item, ()):
                 continue
             if isinstance(item, dict):
-                _units._walk(item, models[section], (), None, lambda p, m, s=isrc_item: ctx.report(s, p, m))
+                convert_tree(item, MODELS[section], (), None, lambda p, m, s=isrc_item: ctx.report(s, p, m))
             local[section][n] = item if item is not None else {}
             local_items[(section, n)] = (bsrc, bsrc.prefix + (section, n))
-    expand_instances(body.get("instances"), bsrc.sub("instances"), pscope, env, ctx, local, local_items,
-                     default_units, chain)
+    return local, local_items
 
-    renamed = _rename(local, prefix)
+
+def _attach(renamed: dict, part: str, parent: str, pose, isrc: Source, ctx):
+    """Place the joints and sensors whose parent is the instance's ``parent`` at its pose; a
+    part with links and nothing attached is a problem."""
     attached = False
     for j in renamed["joints"].values():
         if isinstance(j, dict) and j.get("parent") == parent and parent not in renamed["links"]:
@@ -199,8 +235,10 @@ def _instance(name, spec, isrc: Source, scope, parts_env, ctx, flat, items, defa
     if not attached and renamed["links"]:
         ctx.report(isrc, ("parent",), f"no joint of part '{part}' has parent ${{parent}}: the instance "
                                       "would not be attached to link '" + parent + "'")
-    if mirror is not None:
-        _mirror(renamed, MIRRORS[mirror], default_units, set(renamed["joints"]))
+
+
+def _merge(renamed: dict, local_items: dict, flat: dict, items: dict, isrc: Source, ctx):
+    """The instance's renamed items into ``flat`` (a name that exists already is a problem)."""
     for section in ITEM_SECTIONS:
         target = flat.setdefault(section, {})
         if not isinstance(target, dict):
@@ -262,21 +300,6 @@ def _rename(local: dict, prefix: str) -> dict:
 # ---------------------------------------------------------------- poses
 
 
-def _rpy_matrix(rpy):
-    r, p, y = rpy
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return [[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr]]
-
-
-def _matrix_rpy(R):
-    sp = -R[2][0]
-    if abs(sp) >= 1.0 - 1e-12:
-        return [0.0, math.copysign(math.pi / 2, sp), math.atan2(-R[0][1], R[1][1])]
-    return [math.atan2(R[2][1], R[2][2]), math.asin(sp), math.atan2(R[1][0], R[0][0])]
-
-
 def _compose(pose, origin):
     """The instance pose (xyz, rpy) followed by a joint's own origin: exact when either is a pure translation."""
     xyz0, rpy0 = pose
@@ -289,13 +312,13 @@ def _compose(pose, origin):
         return origin  # the schema reports it
     if not any(rpy0):
         return {"xyz": [a + b for a, b in zip(xyz0, xyz1)], "rpy": list(rpy1)}
-    R0 = _rpy_matrix(rpy0)
+    R0 = rpy_rows(rpy0)
     xyz = [xyz0[i] + sum(R0[i][k] * xyz1[k] for k in range(3)) for i in range(3)]
     if not any(rpy1):
         return {"xyz": xyz, "rpy": list(rpy0)}
-    R1 = _rpy_matrix(rpy1)
+    R1 = rpy_rows(rpy1)
     R = [[sum(R0[i][k] * R1[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
-    return {"xyz": xyz, "rpy": _matrix_rpy(R)}
+    return {"xyz": xyz, "rpy": list(matrix_rpy(R))}
 
 
 def _neg(x):

@@ -13,6 +13,10 @@ import re
 import types
 import typing
 
+from pydantic import BaseModel
+
+from robotkit.recipe.schema import Dim, Recipe
+
 # unit -> (dimension, convert to SI); division by powers of ten keeps 5 cm == 0.05 exactly
 UNITS = {
     "m": ("length", lambda x: float(x)), "cm": ("length", lambda x: x / 100), "mm": ("length", lambda x: x / 1000),
@@ -46,16 +50,12 @@ def convert(data: dict, problem) -> dict:
     """Replace every quantity in the flat recipe ``data`` by its SI number (in place).
 
     ``problem(path, message)`` records a problem at a key path."""
-    from robotkit.recipe.schema import Recipe
-
-    _walk(data, Recipe, (), None, problem)
+    convert_tree(data, Recipe, (), None, problem)
     return data
 
 
 def _dims_and_kinds(tp, dims: list, kinds: list):
     """Flatten Annotated/Union: the Dim markers and the bare types (models, list, dict, scalars)."""
-    from robotkit.recipe.schema import Dim
-
     origin = typing.get_origin(tp)
     if origin is typing.Annotated:
         args = typing.get_args(tp)
@@ -89,9 +89,10 @@ def _fields(model):
     return _CACHE[key]
 
 
-def _walk(value, tp, path, joint_type, problem):
-    from pydantic import BaseModel
-
+def convert_tree(value, tp, path, joint_type, problem):
+    """``value`` (read as schema type ``tp``, at key ``path``) with its quantities replaced by SI
+    numbers (mappings and lists changed in place); ``problem(path, message)`` records what
+    cannot be converted."""
     dims, kinds = _split(tp)
     if isinstance(value, dict):
         for k in kinds:
@@ -100,7 +101,7 @@ def _walk(value, tp, path, joint_type, problem):
                 jt = value.get("type") if k.__name__ == "Joint" else joint_type
                 for key, v in value.items():
                     if key in fields:
-                        new = _walk(v, fields[key], path + (key,), jt, problem)
+                        new = convert_tree(v, fields[key], path + (key,), jt, problem)
                         if new is not v:
                             value[key] = new
                 return value
@@ -108,7 +109,7 @@ def _walk(value, tp, path, joint_type, problem):
                 sub = typing.get_args(k)[1] if typing.get_args(k) else None
                 if sub is not None:
                     for key, v in value.items():
-                        new = _walk(v, sub, path + (key,), joint_type, problem)
+                        new = convert_tree(v, sub, path + (key,), joint_type, problem)
                         if new is not v:
                             value[key] = new
                 return value
@@ -118,7 +119,7 @@ def _walk(value, tp, path, joint_type, problem):
             if typing.get_origin(k) is list:
                 sub = typing.get_args(k)[0]
                 for i, v in enumerate(value):
-                    new = _walk(v, sub, path + (i,), joint_type, problem)
+                    new = convert_tree(v, sub, path + (i,), joint_type, problem)
                     if new is not v:
                         value[i] = new
                 return value
