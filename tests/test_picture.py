@@ -50,7 +50,7 @@ def pixels(path) -> np.ndarray:
 
 
 def test_equivalent_box_known_answer():
-    from robotkit.picture.render import equivalent_box
+    from robotkit.check.lints import equivalent_box
 
     m, (a, b, c) = 2.0, (0.3, 0.2, 0.1)
     moments = (m / 12 * (b * b + c * c), m / 12 * (a * a + c * c), m / 12 * (a * a + b * b))

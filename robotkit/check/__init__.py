@@ -9,14 +9,23 @@ which, and building a recipe first, is ``robotkit.commands.check``'s job.
 from __future__ import annotations
 
 import re
+import tempfile
+import xml.etree.ElementTree as ET
 from dataclasses import replace
 from pathlib import Path
 
+from robotkit.check.consumers import Build, consumer_findings
+from robotkit.check.equivalence import equivalence
 from robotkit.check.findings import Finding
+from robotkit.check.kinematics import read_mjcf, read_sdf
+from robotkit.check.lints import LinkFacts, lint, lint_link, read_urdf_facts
 from robotkit.check.locate import locate
+from robotkit.check.simulation import smoke_test
 from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
 from robotkit.emit.layout import robot_layout
 from robotkit.errors import Problem, RobotkitError
+from robotkit.importer.package_xml import with_own_package
+from robotkit.importer.xacro_expand import check_package_paths, expand
 
 
 URDF_CONSUMERS = ["Gazebo (URDF)", "Drake (URDF)", "Pinocchio (URDF)", "PyBullet (URDF)"]
@@ -35,10 +44,6 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     """Findings on a URDF, each located at its link's or joint's line.  A broken tree (a
     cycle, a second parent, a missing link) is found here first: the validators and
     consumers are not given it (check_urdf prints a cycle forever, simulators crash)."""
-    from robotkit.check.consumers import Build, consumer_findings
-    from robotkit.check.lints import lint, read_urdf_facts
-    from robotkit.importer.package_xml import with_own_package
-
     package_paths = with_own_package(path.absolute(), package_paths)
     try:
         links, joints, notes = read_urdf_facts(path, package_paths)
@@ -54,15 +59,15 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
                    for f in findings], path)
 
 
+def xacro_robot(path: Path) -> str:
+    """The robot a xacro file is checked as: its name without ``.xacro`` and ``.urdf``."""
+    return path.name.removesuffix(".xacro").removesuffix(".urdf")
+
+
 def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, str]) -> list[Finding]:
     """A xacro file expanded in the import's sandbox (``$(find)`` through ``package_paths``,
     ``args`` as xacro arguments), then checked as the URDF it expands to; findings name the
     xacro file."""
-    import tempfile
-
-    from robotkit.importer.package_xml import with_own_package
-    from robotkit.importer.xacro_expand import check_package_paths, expand
-
     packages = with_own_package(path.absolute(), check_package_paths(package_paths))
     text = expand(path, packages, args).text
 
@@ -73,7 +78,7 @@ def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, 
         return f'{m.group(1)}{(path.parent / uri).absolute().as_posix()}{m.group(3)}'
 
     text = re.sub(r'(<mesh\b[^>]*?\bfilename=")([^"]*)(")', absolute, text)
-    stem = path.name.removesuffix(".xacro").removesuffix(".urdf")
+    stem = xacro_robot(path)
     with tempfile.TemporaryDirectory(prefix="robotkit-check-") as tmp:
         urdf = Path(tmp) / f"{stem}.urdf"
         urdf.write_text(text, encoding="utf-8")
@@ -133,11 +138,6 @@ def urdf_tree(path: Path) -> tuple[dict[str, int], list[Finding]]:
 def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list[Finding]:
     """Every stage on a build folder: lints, validators, equivalence of the formats, what each
     consuming program sees, and the MuJoCo scene's own simulation.  Every stage always runs."""
-    from robotkit.check.consumers import Build, consumer_findings
-    from robotkit.check.equivalence import equivalence
-    from robotkit.check.lints import lint, read_urdf_facts
-    from robotkit.check.simulation import smoke_test
-
     layout = robot_layout(robot_dir)
     name, urdf, sdf, mjcf, scene = layout.name, layout.urdf, layout.sdf, layout.mjcf, layout.scene
     for p in (urdf, sdf, mjcf, scene):
@@ -176,17 +176,12 @@ def check_model_file(path: Path, kind: str) -> list[Finding]:
 
 
 def _inertial_lints(path: Path, kind: str) -> list[Finding]:
-    from robotkit.check.lints import LinkFacts, lint_link
-    from robotkit.check import kinematics as k
-
     try:
-        model = k.read_sdf(path) if kind == "sdf" else k.read_mjcf(path)
+        model = read_sdf(path) if kind == "sdf" else read_mjcf(path)
     except Exception as exc:  # an invalid file is reported by its validator
         return [Finding("warning", "inertia", str(path), f"could not read inertials: {exc}")]
     out = []
     if kind == "sdf":  # what Gazebo and Drake will see: SDF's default for a link without <inertial>
-        import xml.etree.ElementTree as ET
-
         for el in ET.parse(path).getroot().iter("link"):
             if el.find("inertial") is None:
                 out.append(Finding("error", "consumer", f"link '{el.get('name')}'",

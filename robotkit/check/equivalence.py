@@ -4,21 +4,20 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from robotkit.check import kinematics as k
+from robotkit.emit.layout import robot_layout
+
 
 def equivalence(robot_dir: str | Path, tol: float = 1e-9, configs: int = 100,
                 notes: list[str] | None = None) -> dict[str, list[str]]:
     """Compare the URDF, SDF and MJCF of a build folder pairwise; {comparison: differences}.
 
     ``notes`` is kept for comparisons that cannot be made (none today)."""
-    from robotkit.check import kinematics as k
-
-    robot_dir = Path(robot_dir)
-    name = robot_dir.name
-    urdf = robot_dir / "urdf" / f"{name}.urdf"
-    u = k.read_urdf(urdf)
-    m = k.read_mjcf(robot_dir / "mjcf" / f"{name}.xml")
-    s = k.read_sdf(robot_dir / "model.sdf")
-    g = k.read_urdf_via_libsdformat(urdf)
+    layout = robot_layout(robot_dir)
+    u = k.read_urdf(layout.urdf)
+    m = k.read_mjcf(layout.mjcf)
+    s = k.read_sdf(layout.sdf)
+    g = k.read_urdf_via_libsdformat(layout.urdf)
     result = {
         "URDF (MuJoCo) vs MJCF (MuJoCo)": k.compare(u, m, tol, configs, ignore=("velocity",)),
         "URDF (MuJoCo) vs SDF": k.compare(u, s, tol, configs, ignore=("mimic",)),

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from robotkit.errors import display_path
+
 SEVERITIES = ("error", "warning")
 STAGES = ("check_urdf", "ign sdf -k", "mujoco", "equivalence", "consumer", "consumers", "simulation", "build",
           "input")
@@ -37,6 +39,4 @@ def input_findings(problems, source: str) -> list[Finding]:
 
 
 def _display(path: str) -> str:
-    from robotkit.errors import display_path
-
     return display_path(path)

@@ -8,13 +8,15 @@ a parser that is not robotkit's emitter, and compared.
 
 :func:`compare` reports every difference in links, joints, masses, centres of mass,
 inertia tensors (link axes), limits, damping, friction, and link poses relative to the
-root at random joint configurations.
+root at random joint configurations.  MuJoCo (heavy) is imported by the readers that use it.
 """
 
 from __future__ import annotations
 
+import copy
 import math
 import re
+import subprocess
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
@@ -24,7 +26,8 @@ WORLD = "world"
 NEGLIGIBLE = 1e-200  # kg: robotkit's URDF writes massless links as 1e-300 kg (see emit/urdf.py)
 
 
-def _mass(m: float) -> float:
+def real_mass(m: float) -> float:
+    """The mass, 0 for one below NEGLIGIBLE (robotkit's URDF marks a massless link with 1e-300 kg)."""
     return 0.0 if abs(m) < NEGLIGIBLE else m
 
 
@@ -226,20 +229,41 @@ def _pose(el) -> tuple[np.ndarray, str | None]:
 
 
 def read_sdf_text(text: str, source: str) -> KModel:
+    """An SDF model (our model.sdf, or libsdformat's printout of a URDF) as a KModel: its links
+    with SDF's inertial defaults, its frames as massless links fixed where they are attached,
+    and its joints between link frames resolved through the pose graph."""
     # libsdformat prints namespaced elements (<ignition::corrected_offsets>, the PR2's Gazebo 1
     # <sensor:contact>) without their namespace declaration, which no XML parser accepts
-    root = ET.fromstring(re.sub(r"(</?|\s)(\w+)::?(?=\w)", r"\1\2__", text))
-    model = root.find("model")
-    frames: dict[str, tuple[np.ndarray, str]] = {}  # name -> (pose, relative_to)
+    model = ET.fromstring(re.sub(r"(</?|\s)(\w+)::?(?=\w)", r"\1\2__", text)).find("model")
     link_els = {lk.get("name"): lk for lk in model.findall("link")}
     joint_els = {j.get("name"): j for j in model.findall("joint")}
+    world = _frame_graph(link_els, joint_els, model.findall("frame"), source)
+    links = {name: _sdf_link(name, lk) for name, lk in link_els.items()}
+    joints = {}
+    for f in model.findall("frame"):  # a frame is a massless link fixed where it is attached
+        links[f.get("name")] = KLink(f.get("name"))
+        joint = _sdf_frame_joint(f, world)
+        if joint is not None:
+            joints[joint.name] = joint
+    for name, j in joint_els.items():
+        joint = _sdf_joint(name, j, world)
+        if joint is not None:
+            joints[name] = joint
+    return KModel(source, links, joints)
+
+
+def _frame_graph(link_els: dict, joint_els: dict, frame_els: list, source: str):
+    """``world(name)``: the pose of a link, joint or frame of an SDF model in the model frame,
+    following ``relative_to`` (SDF's defaults: a link's pose is relative to the model, a joint's
+    to its child link, a frame's to the frame it is attached to)."""
+    frames: dict[str, tuple[np.ndarray, str]] = {}  # name -> (pose, relative_to)
     for name, lk in link_els.items():
         T, rel = _pose(lk)
         frames[name] = (T, rel or "__model__")
     for name, j in joint_els.items():
         T, rel = _pose(j)
         frames[name] = (T, rel or j.find("child").text.strip())
-    for f in model.findall("frame"):
+    for f in frame_els:
         T, rel = _pose(f)
         frames[f.get("name")] = (T, rel or f.get("attached_to") or "__model__")
     resolved: dict[str, np.ndarray] = {"__model__": np.eye(4)}
@@ -255,68 +279,76 @@ def read_sdf_text(text: str, source: str) -> KModel:
         resolved[name] = world(rel, depth + 1) @ T
         return resolved[name]
 
-    links = {}
-    for name, lk in link_els.items():
-        # SDF's defaults, as libsdformat, Gazebo and Drake apply them: a link without <inertial>
-        # weighs 1 kg with a unit inertia (never 0: a massless thing must be a <frame>)
-        inertial = lk.find("inertial")
-        if inertial is None:
-            links[name] = KLink(name, 1.0, np.zeros(3), np.eye(3))
-            continue
-        T, _ = _pose(inertial)
-        mass = float(inertial.findtext("mass", "1"))
-        i = inertial.find("inertia")
-        defaults = {"ixx": "1", "iyy": "1", "izz": "1"}
-        g = {k: float(i.findtext(k, defaults.get(k, "0")) if i is not None else defaults.get(k, "0"))
-             for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-        I = np.array([[g["ixx"], g["ixy"], g["ixz"]],
-                      [g["ixy"], g["iyy"], g["iyz"]],
-                      [g["ixz"], g["iyz"], g["izz"]]])
-        R = T[:3, :3]
-        links[name] = KLink(name, mass, T[:3, 3].copy(), R @ I @ R.T)
-    joints = {}
-    for f in model.findall("frame"):  # a frame is a massless link fixed where it is attached
-        name = f.get("name")
-        attached = f.get("attached_to") or "__model__"
-        links[name] = KLink(name)
-        if attached != "__model__":
-            X_a, X_f = world(attached), world(name)
-            joints[f"(frame {name})"] = KJoint(f"(frame {name})", "fixed", attached, name,
-                                               np.linalg.inv(X_a) @ X_f, np.eye(4), np.array([1.0, 0, 0]))
-    for name, j in joint_els.items():
-        parent, child = j.find("parent").text.strip(), j.find("child").text.strip()
-        if parent == WORLD:
-            continue
-        X_j = world(name)
-        X_p, X_c = world(parent), world(child)
-        kind = j.get("type")
-        axis_el = j.find("axis")
-        axis = np.array([0, 0, 1.0])
-        lower = upper = effort = velocity = damping = friction = None
-        if axis_el is not None:
-            xyz = axis_el.find("xyz")
-            axis = np.array([float(v) for v in xyz.text.split()])
-            expressed = xyz.get("expressed_in")
-            if expressed:
-                axis = np.linalg.inv(X_j[:3, :3]) @ (world(expressed)[:3, :3] @ axis)
-            lim = axis_el.find("limit")
-            if lim is not None:
-                lo, hi = lim.findtext("lower"), lim.findtext("upper")
-                if lo is not None and abs(float(lo)) < 1e15:
-                    lower, upper = float(lo), float(hi)
-                if lim.findtext("effort") is not None:
-                    effort = float(lim.findtext("effort"))
-                if lim.findtext("velocity") is not None:
-                    velocity = float(lim.findtext("velocity"))
-            dyn = axis_el.find("dynamics")
-            if dyn is not None:
-                damping = float(dyn.findtext("damping", "0"))
-                friction = float(dyn.findtext("friction", "0"))
-        if kind == "revolute" and lower is None:
-            kind = "continuous"
-        joints[name] = KJoint(name, kind, parent, child, np.linalg.inv(X_p) @ X_j, np.linalg.inv(X_j) @ X_c,
-                              axis / np.linalg.norm(axis), lower, upper, effort, velocity, damping, friction)
-    return KModel(source, links, joints)
+    return world
+
+
+def _sdf_link(name: str, lk) -> KLink:
+    """A ``<link>``'s mass, centre of mass and inertia (link axes), with SDF's defaults as
+    libsdformat, Gazebo and Drake apply them: a link without ``<inertial>`` weighs 1 kg with a
+    unit inertia (never 0: a massless thing must be a ``<frame>``)."""
+    inertial = lk.find("inertial")
+    if inertial is None:
+        return KLink(name, 1.0, np.zeros(3), np.eye(3))
+    T, _ = _pose(inertial)
+    mass = float(inertial.findtext("mass", "1"))
+    i = inertial.find("inertia")
+    defaults = {"ixx": "1", "iyy": "1", "izz": "1"}
+    g = {k: float(i.findtext(k, defaults.get(k, "0")) if i is not None else defaults.get(k, "0"))
+         for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+    I = np.array([[g["ixx"], g["ixy"], g["ixz"]],
+                  [g["ixy"], g["iyy"], g["iyz"]],
+                  [g["ixz"], g["iyz"], g["izz"]]])
+    R = T[:3, :3]
+    return KLink(name, mass, T[:3, 3].copy(), R @ I @ R.T)
+
+
+def _sdf_frame_joint(f, world) -> KJoint | None:
+    """The fixed joint holding a ``<frame>`` where it is attached (none on the model itself)."""
+    name = f.get("name")
+    attached = f.get("attached_to") or "__model__"
+    if attached == "__model__":
+        return None
+    X_a, X_f = world(attached), world(name)
+    return KJoint(f"(frame {name})", "fixed", attached, name, np.linalg.inv(X_a) @ X_f, np.eye(4),
+                  np.array([1.0, 0, 0]))
+
+
+def _sdf_joint(name: str, j, world) -> KJoint | None:
+    """A ``<joint>`` between its parent's and child's frames: axis in the joint frame, limits
+    (a revolute joint without them is continuous), damping and friction; None for a joint to
+    the world (the model's placement, not part of the robot)."""
+    parent, child = j.find("parent").text.strip(), j.find("child").text.strip()
+    if parent == WORLD:
+        return None
+    X_j = world(name)
+    X_p, X_c = world(parent), world(child)
+    kind = j.get("type")
+    axis_el = j.find("axis")
+    axis = np.array([0, 0, 1.0])
+    lower = upper = effort = velocity = damping = friction = None
+    if axis_el is not None:
+        xyz = axis_el.find("xyz")
+        axis = np.array([float(v) for v in xyz.text.split()])
+        expressed = xyz.get("expressed_in")
+        if expressed:
+            axis = np.linalg.inv(X_j[:3, :3]) @ (world(expressed)[:3, :3] @ axis)
+        lim = axis_el.find("limit")
+        if lim is not None:
+            lo, hi = lim.findtext("lower"), lim.findtext("upper")
+            if lo is not None and abs(float(lo)) < 1e15:
+                lower, upper = float(lo), float(hi)
+            if lim.findtext("effort") is not None:
+                effort = float(lim.findtext("effort"))
+            if lim.findtext("velocity") is not None:
+                velocity = float(lim.findtext("velocity"))
+        dyn = axis_el.find("dynamics")
+        if dyn is not None:
+            damping = float(dyn.findtext("damping", "0"))
+            friction = float(dyn.findtext("friction", "0"))
+    if kind == "revolute" and lower is None:
+        kind = "continuous"
+    return KJoint(name, kind, parent, child, np.linalg.inv(X_p) @ X_j, np.linalg.inv(X_j) @ X_c,
+                  axis / np.linalg.norm(axis), lower, upper, effort, velocity, damping, friction)
 
 
 def read_sdf(path) -> KModel:
@@ -325,8 +357,6 @@ def read_sdf(path) -> KModel:
 
 def read_urdf_via_libsdformat(path) -> KModel:
     """libsdformat's own reading of the URDF (`ign sdf -p`), as SDF."""
-    import subprocess
-
     proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
     if proc.returncode != 0 or "<sdf" not in proc.stdout:
         raise RuntimeError(f"ign sdf -p {path} failed: {proc.stderr.strip() or proc.stdout.strip()}")
@@ -354,15 +384,15 @@ def lump(model: KModel) -> KModel:
         sums.setdefault(top, []).append((link, T))
     links = {}
     for top, parts in sums.items():
-        m = sum(_mass(p.mass) for p, _ in parts)
+        m = sum(real_mass(p.mass) for p, _ in parts)
         if m <= 0:
             links[top] = KLink(top)
             continue
-        com = sum(_mass(p.mass) * (T[:3, :3] @ p.com + T[:3, 3]) for p, T in parts) / m
+        com = sum(real_mass(p.mass) * (T[:3, :3] @ p.com + T[:3, 3]) for p, T in parts) / m
         inertia = np.zeros((3, 3))
         for p, T in parts:
             R, d = T[:3, :3], T[:3, :3] @ p.com + T[:3, 3] - com
-            inertia += R @ p.inertia @ R.T + _mass(p.mass) * (d @ d * np.eye(3) - np.outer(d, d))
+            inertia += R @ p.inertia @ R.T + real_mass(p.mass) * (d @ d * np.eye(3) - np.outer(d, d))
         links[top] = KLink(top, m, com, inertia)
     joints = {}
     for name, j in model.joints.items():
@@ -401,7 +431,7 @@ def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: i
         if not rigid and (par_a or WORLD) != (par_b or WORLD) and not ({par_a, par_b} <= {None, WORLD}):
             diffs.append(f"link '{name}': parent '{par_a}' in {a.source}, '{par_b}' in {b.source}")
         A, B = a.links[name], b.links[name]
-        mass_a, mass_b = _mass(A.mass), _mass(B.mass)
+        mass_a, mass_b = real_mass(A.mass), real_mass(B.mass)
         if not _close(mass_a, mass_b, tol, abs(mass_a)):
             diffs.append(f"link '{name}': mass {A.mass!r} vs {B.mass!r}")
         size = max(1.0, float(np.abs(A.com).max()))
@@ -432,8 +462,6 @@ def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: i
     if diffs:
         return diffs
     if "mimic" in ignore:  # one side cannot hold mimic relations: move both by the other's
-        import copy
-
         b = copy.deepcopy(b)
         for name, j in b.joints.items():
             if j.mimic is None and name in a.joints and a.joints[name].mimic is not None:

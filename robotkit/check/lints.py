@@ -17,9 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from robotkit.check.findings import Finding
-from robotkit.model import inertia_policy
 from robotkit.check.kinematics import NEGLIGIBLE
 from robotkit.errors import Problem, RobotkitError
+from robotkit.mesh.inertia import mesh_mass_properties
+from robotkit.mesh.io import load_mesh
+from robotkit.model import inertia_policy
+from robotkit.model import massprops as mi
 from robotkit.model.plausible import DENSITY_RANGE, PART_SIZE_RANGE
 
 # thresholds (documented in docs/checks.md)
@@ -125,8 +128,6 @@ def _geom_facts(el, role: str, base: Path, package_paths: dict[str, str], subjec
     shape = g[0]
     T = _origin(el)
     kind = shape.tag
-    from robotkit.model import massprops as mi
-
     props = None
     if kind == "box":
         size = _floats(shape.get("size"), 3)
@@ -176,9 +177,6 @@ def _geom_facts(el, role: str, base: Path, package_paths: dict[str, str], subjec
 
 def _mesh_facts(path: Path, scale: np.ndarray):
     try:
-        from robotkit.mesh.inertia import mesh_mass_properties
-        from robotkit.mesh.io import load_mesh
-
         mesh = load_mesh(str(path), tuple(scale))
     except (RobotkitError, ValueError, OSError):
         return None, None, 0
@@ -319,7 +317,7 @@ def lint_link(link: LinkFacts) -> list[Finding]:
             add("error", "triangle-inequality", f"principal moments {a:.4g}, {b:.4g}, {c:.4g} violate "
                 "the triangle inequality (I1 + I2 >= I3): no real body has them", hint)
         return out
-    volume = _link_volume(link)
+    volume = link_volume(link)
     if volume:
         density = link.mass / volume
         if density < DENSITY_RANGE[0]:
@@ -359,7 +357,8 @@ def _volume(geoms: list[GeomFacts]) -> float | None:
     return sum(g.volume for g in geoms)
 
 
-def _link_volume(link: LinkFacts) -> float | None:
+def link_volume(link: LinkFacts) -> float | None:
+    """The volume of the link's closed geometry (visual, else collision), None when open or unknown."""
     return _volume(link.shape("visual")) or _volume(link.shape("collision"))
 
 
@@ -372,18 +371,18 @@ def _geometry_points(link: LinkFacts) -> np.ndarray | None:
 
 def _geometry_props(link: LinkFacts):
     """(volume, com, unit-density inertia) of the link's closed geometry, or None."""
-    from robotkit.model.massprops import combine
-
     geoms = link.shape("visual") or link.shape("collision")
     if not geoms or any(g.inertia is None for g in geoms):
         return None
-    volume, com, I = combine([(g.volume, g.com, g.inertia) for g in geoms])
+    volume, com, I = mi.combine([(g.volume, g.com, g.inertia) for g in geoms])
     return volume, com, I
 
 
-def _eq_box(diag, mass: float) -> np.ndarray:
-    """Edge lengths of the uniform box with these moments about its axes."""
-    a, b, c = diag
+def equivalent_box(mass: float, moments) -> np.ndarray:
+    """Full side lengths of the uniform box with ``mass`` and principal ``moments`` (Gazebo's
+    View > Inertia): a = sqrt(6 (I2 + I3 - I1) / m), and so on; a side that comes out imaginary
+    (moments that break the triangle inequality) is 0."""
+    a, b, c = moments
     return np.sqrt(np.maximum(0.0, 6.0 / mass * np.array([b + c - a, a + c - b, a + b - c])))
 
 
@@ -394,7 +393,7 @@ def _box_check_geometry(link: LinkFacts, geometry, s: str) -> list[Finding]:
     volume, _, I_geom = geometry
     vals, vecs = np.linalg.eigh(I_geom * (link.mass / volume))
     declared = np.diag(vecs.T @ link.inertia @ vecs)
-    want, got = _eq_box(vals, link.mass), _eq_box(declared, link.mass)
+    want, got = equivalent_box(link.mass, vals), equivalent_box(link.mass, declared)
     worst, axis = 1.0, 0
     for k in range(3):
         if want[k] < 1e-9 * max(want.max(), 1e-12):
@@ -415,7 +414,7 @@ def _box_check_geometry(link: LinkFacts, geometry, s: str) -> list[Finding]:
 def _com_check(link: LinkFacts, geometry, s: str) -> list[Finding]:
     volume, centroid, I_geom = geometry
     vals, vecs = np.linalg.eigh(I_geom)
-    size = _eq_box(vals * 1.0, volume)  # the geometry's own equivalent box, along its principal axes
+    size = equivalent_box(volume, vals * 1.0)  # the geometry's own equivalent box, along its principal axes
     offset = np.abs(vecs.T @ (link.com - centroid))
     rel = offset / np.maximum(size, 1e-12)
     if rel.max() <= 0.1:
@@ -431,10 +430,7 @@ def _box_check(link: LinkFacts, eig, points: np.ndarray, s: str) -> list[Finding
     along the same principal axes.  A uniform body's box can exceed its extent by up to
     sqrt(3) (mass at the ends), so only larger boxes beyond that are flagged."""
     vals, vecs = np.linalg.eigh(0.5 * (link.inertia + link.inertia.T))
-    m = link.mass
-    dims = np.sqrt(np.maximum(0.0, 6.0 / m * np.array([vals[1] + vals[2] - vals[0],
-                                                       vals[0] + vals[2] - vals[1],
-                                                       vals[0] + vals[1] - vals[2]])))
+    dims = equivalent_box(link.mass, vals)
     local = (points - link.com) @ vecs
     extent = local.max(axis=0) - local.min(axis=0)
     worst = max([max(dims[k], 1e-12) / max(extent[k], 1e-12) for k in range(3)

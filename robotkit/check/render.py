@@ -4,9 +4,11 @@ annotations."""
 from __future__ import annotations
 
 import json
+import xml.etree.ElementTree as ET
 from dataclasses import asdict
 
 from robotkit.check.findings import STAGES, Finding
+from robotkit.errors import display_path
 
 
 def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error",
@@ -33,8 +35,6 @@ def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error
     for subject, items in groups.items():
         where = ""
         if items[0].file:
-            from robotkit.errors import display_path
-
             where = f" ({display_path(items[0].file)}" + (f":{items[0].line}" if items[0].line else "") + ")"
         out.append(f"{subject}{where}")
         for f in items:
@@ -61,8 +61,6 @@ def _escape_property(text: str) -> str:
 def annotation(f: Finding, fail_on: str = "error") -> str:
     """One GitHub workflow command: ``::error file=F,line=L,title=T::message``.  A finding that
     fails the check (``--fail-on``) is an ``error`` whatever its severity; the title keeps it."""
-    from robotkit.errors import display_path
-
     props = []
     if f.file:  # GitHub wants paths relative to the repository (the working directory)
         props.append(f"file={_escape_property(display_path(f.file))}")
@@ -78,8 +76,6 @@ def _junit(findings: list[Finding], source: str, fail_on: str, ran: list[tuple[s
     """One test case per check and subject, so CI test reporters list them; a case fails when
     one of its findings fails the check (``--fail-on``).  The checks that ran and found nothing
     are passing cases (``robotkit.lints`` for a link or joint no physics lint fired on)."""
-    import xml.etree.ElementTree as ET
-
     cases: dict[tuple[str, str], list[Finding]] = {}
     for f in findings:
         cases.setdefault((f.check, f.subject), []).append(f)
@@ -111,8 +107,6 @@ def _where(f: Finding) -> str:
     """``file:line: `` of a finding (the JUnit schema has no place for it but the text)."""
     if not f.file:
         return ""
-    from robotkit.errors import display_path
-
     return display_path(f.file) + (f":{f.line}" if f.line else "") + ": "
 
 

@@ -7,6 +7,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
+
 START_GAP = 1e-3  # m: a free robot must start on the floor, not above it or inside it
 REST_SPEED = 1e-2  # |qvel| of a free base at the end (m/s, rad/s)
 MAX_TILT = 2.0  # degrees a free base may tip while it settles
@@ -16,8 +18,7 @@ def smoke_test(scene: str | Path, seconds: float = 3.0, notes: list[str] | None 
     """Problems seen while stepping ``scene``: NaN, an explosion, a MuJoCo warning, a robot
     that starts inside the floor, and a free base that tips over or does not come to rest.
     ``notes`` collects what is worth a warning: a free robot that starts above the floor."""
-    import mujoco
-    import numpy as np
+    import mujoco  # heavy: imported when the scene is stepped
 
     model = mujoco.MjModel.from_xml_path(str(scene))
     data = mujoco.MjData(model)

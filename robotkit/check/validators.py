@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import resource
 import shutil
 import subprocess
+import tempfile
 from pathlib import Path
 
 from robotkit.check.findings import Finding
@@ -16,15 +18,11 @@ TIMEOUT = 300
 
 
 def _limit_output():  # in the child: writing past MAX_OUTPUT to its output file ends it (SIGXFSZ)
-    import resource
-
     resource.setrlimit(resource.RLIMIT_FSIZE, (MAX_OUTPUT, MAX_OUTPUT))
 
 
 def _run(cmd: list[str]) -> tuple[int, str]:
     """Run a validator with bounded output and time: (exit status, its output without noise)."""
-    import tempfile
-
     with tempfile.TemporaryFile() as f:
         try:
             proc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, timeout=TIMEOUT, preexec_fn=_limit_output)
@@ -62,7 +60,7 @@ def validate_sdf(path: Path) -> list[Finding]:
 
 
 def validate_mjcf(path: Path) -> list[Finding]:
-    try:
+    try:  # heavy and optional: imported when an MJCF is validated
         import mujoco
     except ImportError:
         return [Finding("warning", "mujoco", str(path), "mujoco is not installed", "pip install mujoco")]

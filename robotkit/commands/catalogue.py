@@ -25,10 +25,18 @@ import math
 import os
 import re
 import sys
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from robotkit import paths
+from robotkit.commands.build import cache_messages, scheduler
+from robotkit.emit.layout import robot_layout
 from robotkit.errors import Problem, RobotkitError
+from robotkit.mesh.io import load_mesh
+from robotkit.paths import file_stem
+from robotkit.pipeline.progress import Progress
+from robotkit.pipeline.runner import build
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae")
 STATE = Path(".robotkit") / "catalogue"
@@ -80,8 +88,6 @@ def find_meshes(source: Path) -> tuple[Path, list[Path]]:
 def object_names(base: Path, files: list[Path]) -> list[tuple[str, str]]:
     """(name, path relative to base) per file: the relative path without suffix, with every
     character a file name cannot hold as ``_``; names that collide get a numeric suffix."""
-    from robotkit.paths import file_stem
-
     out, seen = [], set()
     for f in files:
         try:
@@ -139,8 +145,6 @@ def read_table(path: Path) -> dict[str, dict]:
 
 def _guess_units(items: list[Item], state: Path) -> None:
     """Fill each item's units from the size of its mesh (remembered by file size and mtime)."""
-    from robotkit.mesh.io import load_mesh
-
     memo_path = state / "units.json"
     try:
         memo = json.loads(memo_path.read_text(encoding="utf-8"))
@@ -214,8 +218,6 @@ def catalogue(source: str | os.PathLike, out_dir: str | os.PathLike, *, density:
               units: str | None = None, masses: str | os.PathLike | None = None, collision: str = "decompose",
               jobs: int = 1, progress=sys.stderr) -> "Result":
     """Build every mesh of ``source`` into ``out_dir`` and write the index."""
-    from robotkit import paths
-
     if not (math.isfinite(density) and density > 0):
         raise RobotkitError(Problem(f"--density must be a number > 0 (got {density})"))
     source, out = Path(source), Path(out_dir)
@@ -254,10 +256,6 @@ def catalogue(source: str | os.PathLike, out_dir: str | os.PathLike, *, density:
 
     result = None
     if recipes:
-        from robotkit.pipeline.runner import build
-
-        from robotkit.pipeline.progress import Progress
-
         bar = Progress(progress, slow=float("inf"), eta=True, log_every=10.0, label="catalogue ")
         with paths.widened([base.resolve()]):  # the generated recipes read the meshes where they are
             result = build(recipes, out, jobs=jobs, report=False, keep_going=True, progress=bar)
@@ -300,20 +298,20 @@ def _index(items: list[Item], out: Path, base: Path) -> dict:
                  "warnings": it.warnings}
         if it.status == "ok":
             try:
-                report = json.loads((out / it.name / "report.json").read_text(encoding="utf-8"))
+                report = json.loads(robot_layout(out / it.name).report_json.read_text(encoding="utf-8"))
             except (OSError, ValueError):
                 report = {}
             inertial = report.get("inertials", {}).get(it.name, {})
             coll = next(iter(report.get("collision", {}).values()), {})
             fid = coll.get("fidelity", {})
+            built = robot_layout(it.name)  # the files, relative to the index
             entry.update({
                 "mass": inertial.get("mass"), "com": inertial.get("com"), "inertia": inertial.get("inertia"),
                 "mass_source": inertial.get("source"),
                 "collision_pieces": len(coll.get("pieces", [])) or None,
                 "collision_volume_ratio": fid.get("volume_ratio"),
                 "collision_distance": (fid.get("distance") or {}).get("max"),
-                "urdf": f"{it.name}/urdf/{it.name}.urdf", "sdf": f"{it.name}/model.sdf",
-                "mjcf": f"{it.name}/mjcf/{it.name}.xml",
+                "urdf": built.urdf.as_posix(), "sdf": built.sdf.as_posix(), "mjcf": built.mjcf.as_posix(),
             })
         objects.append(entry)
     ok = sum(o["status"] == "ok" for o in objects)
@@ -342,10 +340,6 @@ def _csv(index: dict) -> str:
 
 
 def run(args) -> int:
-    import time
-
-    from robotkit.commands.build import cache_messages, scheduler
-
     if args.jobs is not None and args.jobs < 1:
         print("robotkit: error: -j must be at least 1", file=sys.stderr)
         return 2

@@ -10,7 +10,7 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-from robotkit.check import check_build_dir, check_model_file, check_urdf_file, check_xacro_file
+from robotkit.check import check_build_dir, check_model_file, check_urdf_file, check_xacro_file, xacro_robot
 from robotkit.check.findings import Finding, input_findings
 from robotkit.check.locate import element_lines, locate
 from robotkit.check.render import job_summary, render
@@ -130,7 +130,7 @@ def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None)
     if what.kind == "urdf":
         return [("check_urdf", str(p)), ("consumer", f"robot '{p.stem}'")] + _described(p)
     if what.kind == "xacro":
-        return [("check_urdf", str(p)), ("consumer", f"robot '{p.name.removesuffix('.xacro').removesuffix('.urdf')}'")]
+        return [("check_urdf", str(p)), ("consumer", f"robot '{xacro_robot(p)}'")]
     if what.kind == "sdf":
         return [("ign sdf -k", str(p))]
     return [("mujoco", str(p))]

@@ -10,6 +10,7 @@ answer every verb uses (check, report, view, the job summary).
 from __future__ import annotations
 
 import os
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,6 +46,13 @@ def robot_dirs(folder: Path) -> list[RobotLayout]:
     return [layout for d in sorted(folder.iterdir()) if (layout := robot_layout(d)).is_build()]
 
 
+def enclosing_build(path: Path) -> RobotLayout | None:
+    """The robot build folder a description file sits at the top of (a build's model.sdf), when
+    that folder holds its MJCF; None for a file written anywhere else."""
+    layout = robot_layout(path.parent)
+    return layout if layout.mjcf.is_file() else None
+
+
 def classify(path: str | os.PathLike, kinds: tuple[str, ...] = ("recipe", "build", "urdf", "xacro", "sdf", "mjcf"),
              expected: str = "a recipe .yaml, .urdf, .xacro, .sdf or MJCF .xml") -> Input:
     """What PATH is, among the ``kinds`` the command takes; bad input raises with the file named."""
@@ -64,8 +72,6 @@ def classify(path: str | os.PathLike, kinds: tuple[str, ...] = ("recipe", "build
 
 def package_paths(items: list[str]) -> dict[str, str] | None:
     """``--package-path PKG=DIR`` items as a dict; None (after one line on stderr) when one is malformed."""
-    import sys
-
     packages = {}
     for item in items:
         pkg, sep, folder = item.partition("=")

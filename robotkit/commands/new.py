@@ -3,9 +3,13 @@ millimetres, a material, the editor modeline) with its mesh and the JSON Schema 
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from robotkit.errors import Problem, RobotkitError
+from robotkit.mesh.export import stl_bytes
+from robotkit.paths import name_problem
+from robotkit.recipe.reference import json_schema
 
 RECIPE = """\
 # yaml-language-server: $schema=recipe.schema.json
@@ -45,17 +49,13 @@ joints:
 
 def arm_mesh():
     """The starter's mesh: a 20 x 20 x 200 mm bar standing on the origin, in millimetres."""
-    import trimesh
+    import trimesh  # heavy: only when the starter is written
 
     return trimesh.creation.box(extents=(20.0, 20.0, 200.0)).apply_translation((0.0, 0.0, 100.0))
 
 
 def new(name: str, folder: str = ".") -> list[Path]:
     """Write ``folder/NAME.yaml``, its mesh and ``recipe.schema.json``; refuse to overwrite."""
-    from robotkit.mesh.export import stl_bytes
-    from robotkit.paths import name_problem
-    from robotkit.recipe.reference import json_schema
-
     why = name_problem(name)
     if why:
         raise RobotkitError(Problem(f"robot name '{name}' {why}"))
@@ -74,8 +74,6 @@ def new(name: str, folder: str = ".") -> list[Path]:
 
 
 def run(args) -> int:
-    import os
-
     for path in new(args.name, args.dir):
         print(os.path.relpath(path))
     print(f"build it: robotkit build {os.path.relpath(os.path.join(args.dir, args.name + '.yaml'))}")

@@ -9,7 +9,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from robotkit.commands.inputs import classify, package_paths
+from robotkit.commands.inputs import classify, enclosing_build, package_paths
 from robotkit.emit.layout import robot_layout
 from robotkit.errors import RobotkitError
 from robotkit.importer import import_file
@@ -44,7 +44,7 @@ def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = No
         robot = robot_layout(Path(build_out) / loaded.recipe.robot)
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
                                 loaded.recipe.measured_mass)
-    if what.kind == "sdf" and (robot := robot_layout(p.parent)).mjcf.is_file():  # a build folder's SDF
+    if what.kind == "sdf" and (robot := enclosing_build(p)) is not None:  # a build folder's SDF is drawn
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p))
     out = Path(out_dir) if out_dir else p.parent / f"{p.stem}-report"
     if what.kind == "urdf":

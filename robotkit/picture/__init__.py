@@ -12,21 +12,22 @@ What PATH is, and building a recipe or a foreign URDF for its pictures, is
 from __future__ import annotations
 
 import re
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
-from robotkit.emit.layout import robot_layout
+from robotkit.check.kinematics import read_mjcf, read_sdf
+from robotkit.check.lints import JointFacts, LinkFacts, lint, lint_joints, lint_link, read_urdf_facts
+from robotkit.emit.layout import REPORT_HTML, robot_layout
 from robotkit.errors import Problem, RobotkitError
+from robotkit.ioutil import write_if_changed
+from robotkit.picture import page
 
-PAGE = "report.html"
+PAGE = PurePosixPath(REPORT_HTML).name  # report.html, in whichever folder the report is written
 VERSION = 1  # bump when the pictures or the page change for the same build
 
 
 def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: float | None = None) -> Path:
     """The report of a robotkit build folder: pictures from mjcf/<robot>.xml, tables from the URDF
     (the check package's facts and lints) and report.json (collision fidelity, losses)."""
-    from robotkit.check.lints import lint, read_urdf_facts
-    from robotkit.picture import page
-
     layout = robot_layout(robot_dir)
     name, urdf, mjcf = layout.name, layout.urdf, layout.mjcf
     for f in (urdf, mjcf):
@@ -45,8 +46,6 @@ def report_urdf(urdf: Path, out: Path, package_paths: dict[str, str], mjcf: Path
                 notes: list[str]) -> Path:
     """A URDF written anywhere: its table from the file; its pictures from ``mjcf`` (the MJCF of a
     build of its import), none when that could not be built (``notes`` say why)."""
-    from robotkit.check.lints import lint, read_urdf_facts
-
     links, joints, lint_notes = read_urdf_facts(urdf, package_paths)
     findings = lint_notes + lint(links, joints)
     text = urdf.read_text(encoding="utf-8")
@@ -58,11 +57,8 @@ def report_urdf(urdf: Path, out: Path, package_paths: dict[str, str], mjcf: Path
 
 def report_model_file(path: Path, out: Path, kind: str) -> Path:
     """An SDF or MJCF file: masses and inertias (no geometry measured); pictures of an MJCF."""
-    from robotkit.check import kinematics as k
-    from robotkit.check.lints import JointFacts, LinkFacts, lint_link, lint_joints
-
     try:
-        model = k.read_sdf(path) if kind == "sdf" else k.read_mjcf(path)
+        model = read_sdf(path) if kind == "sdf" else read_mjcf(path)
     except Exception as exc:  # noqa: BLE001  (any reader error is the file's problem)
         raise RobotkitError(Problem(f"cannot read: {str(exc).splitlines()[0] if str(exc) else exc!r}",
                                     file=str(path))) from None
@@ -81,7 +77,7 @@ def report_model_file(path: Path, out: Path, kind: str) -> Path:
 
 
 def _pictures(mjcf: Path, out: Path, findings) -> list:
-    from robotkit.picture.render import render_pictures
+    from robotkit.picture.render import render_pictures  # imports MuJoCo (heavy): only to draw
 
     flagged = {f.subject[6:-1] for f in findings if f.subject.startswith("link '")}
     pictures = render_pictures(mjcf, out, flagged)
@@ -94,9 +90,6 @@ def _pictures(mjcf: Path, out: Path, findings) -> list:
 
 def _write(out: Path, robot: str, source: str, pictures, links, joints, findings, losses, collision,
            urdf_text: str | None, notes=()) -> Path:
-    from robotkit.ioutil import write_if_changed
-    from robotkit.picture import page
-
     rows = page.link_rows(links, findings, losses, collision)
     jrows = page.joint_rows(urdf_text, joints, findings, losses)
     html = page.render_page(robot, source, pictures, rows, jrows, page.other_findings(findings, rows, jrows),

@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from robotkit.check.findings import Finding
+from robotkit.check.lints import equivalent_box, link_volume
+from robotkit.emit.env import environment
 
 FORMATS = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF"}
 TEMPLATE = "report/report.html.j2"
@@ -48,8 +50,6 @@ class JointRow:
 
 def link_rows(links, findings: list[Finding], losses: dict[str, list[str]], collision: dict) -> list[LinkRow]:
     """One row per link from the check package's LinkFacts."""
-    from robotkit.check.lints import _eq_box, _link_volume
-
     rows = []
     for link in links:
         row = LinkRow(link.name)
@@ -59,8 +59,8 @@ def link_rows(links, findings: list[Finding], losses: dict[str, list[str]], coll
             moments = np.linalg.eigvalsh(np.asarray(link.inertia, dtype=float))
             row.moments = [float(v) for v in moments]
             if link.mass > 0:
-                row.box = [float(v) for v in _eq_box(moments, link.mass)]
-        row.volume = _link_volume(link)
+                row.box = [float(v) for v in equivalent_box(link.mass, moments)]
+        row.volume = link_volume(link)
         if row.volume and row.mass:
             row.density = row.mass / row.volume
         subject = f"link '{link.name}'"
@@ -132,8 +132,6 @@ def _vec(v, digits: int = 4) -> str:
 
 def render_page(robot: str, source: str, pictures, links: list[LinkRow], joints: list[JointRow],
                 findings: list[Finding], losses: list[str], notes: list[str] = ()) -> str:
-    from robotkit.emit.env import environment
-
     env = environment().overlay()
     env.filters["num"] = _num
     env.filters["v"] = _vec

@@ -9,8 +9,10 @@ centres of mass, link frames, joint axes, sensor frames and fields of view.
 
 from __future__ import annotations
 
+import io
 import math
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +20,10 @@ os.environ.setdefault("MUJOCO_GL", "osmesa")  # before mujoco is imported: softw
 
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
+
+from robotkit.check.lints import equivalent_box  # noqa: E402
+from robotkit.errors import Problem, RobotkitError  # noqa: E402
+from robotkit.ioutil import write_if_changed  # noqa: E402
 
 VISUAL, COLLISION, SENSOR = 2, 3, 4  # MuJoCo geom/site groups in robotkit's MJCF
 HINGE, SLIDE = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
@@ -39,17 +45,6 @@ class Picture:
     title: str
     caption: str
     kind: str  # view | collision | inertia | frames | joint
-
-
-def equivalent_box(mass: float, moments) -> np.ndarray:
-    """Full side lengths of the uniform box with ``mass`` and principal ``moments`` (Gazebo's
-    View > Inertia): a = sqrt(6 (I2 + I3 - I1) / m), and so on; a side that comes out
-    imaginary (moments that break the triangle inequality) is drawn flat."""
-    i1, i2, i3 = (float(v) for v in moments)
-    if mass <= 0:
-        return np.zeros(3)
-    sides = [6.0 * (i2 + i3 - i1) / mass, 6.0 * (i1 + i3 - i2) / mass, 6.0 * (i1 + i2 - i3) / mass]
-    return np.sqrt(np.maximum(sides, 0.0))
 
 
 def bounds(model, data) -> tuple[np.ndarray, float]:
@@ -76,8 +71,6 @@ def box(model, data) -> tuple[np.ndarray, np.ndarray]:
 def load_model(mjcf: str | os.PathLike):
     """The MJCF compiled by MuJoCo, with a plain light background (a flat skybox) unless it has
     a skybox of its own; a file MuJoCo cannot load is a RobotkitError naming it."""
-    from robotkit.errors import Problem, RobotkitError
-
     try:
         spec = mujoco.MjSpec.from_file(str(mjcf))
         if not any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in spec.textures):
@@ -91,8 +84,6 @@ def load_model(mjcf: str | os.PathLike):
 
 def renderer(model, height: int, width: int):
     """MuJoCo's offscreen renderer, or a RobotkitError that says how to get one."""
-    from robotkit.errors import Problem, RobotkitError
-
     try:
         return mujoco.Renderer(model, height, width)
     except Exception as exc:  # noqa: BLE001  (no GL context: the backend is missing or needs a display)
@@ -292,11 +283,7 @@ class Painter:
 
 
 def _save(img: np.ndarray, path: Path) -> None:
-    import io
-
-    from PIL import Image
-
-    from robotkit.ioutil import write_if_changed
+    from PIL import Image  # only when a picture is saved
 
     buf = io.BytesIO()
     Image.fromarray(img).save(buf, format="PNG")
@@ -305,7 +292,7 @@ def _save(img: np.ndarray, path: Path) -> None:
 
 def _strip(images: list[np.ndarray], labels: list[str]) -> np.ndarray:
     """Images side by side, each labelled at its top left."""
-    from PIL import Image, ImageDraw
+    from PIL import Image, ImageDraw  # only when a picture is saved
 
     h, w = images[0].shape[:2]
     out = Image.new("RGB", (w * len(images), h))
@@ -355,8 +342,6 @@ def render_pictures(mjcf: str | os.PathLike, out_dir: str | os.PathLike, flagged
 
 
 def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
-    import re
-
     pics = []
     small = Painter(p.model, 320, 240, data=p.data)  # the same model, smaller pictures for the strips
     small.flagged = p.flagged

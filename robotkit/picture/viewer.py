@@ -14,12 +14,15 @@ from __future__ import annotations
 import sys
 import threading
 import time
+import warnings
+import webbrowser
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from robotkit.check.lints import equivalent_box, resolve_uri
 from robotkit.errors import RobotkitError
 
 POLL = 0.3  # seconds between looks at the watched files
@@ -35,9 +38,7 @@ class Built:
 
 
 def load_urdf(built: Built):
-    import yourdfpy
-
-    from robotkit.check.lints import resolve_uri
+    import yourdfpy  # heavy (trimesh): viser and yourdfpy load only when viewing
 
     def handler(fname: str) -> str:
         found = resolve_uri(fname, built.urdf.parent, built.packages)
@@ -64,7 +65,7 @@ def sensors_of(urdf_file: Path) -> list[tuple[str, str, str, float, float]]:
 
 
 def _wxyz(R: np.ndarray) -> np.ndarray:
-    import viser.transforms as tf
+    import viser.transforms as tf  # heavy: see load_urdf
 
     if np.linalg.det(R) < 0:
         R = R.copy()
@@ -132,11 +133,9 @@ class Viewer:
         return any(_mtime(f) != t for f, t in self.watch.items())
 
     def _show(self, urdf, built: Built) -> None:
-        from viser.extras import ViserUrdf
+        from viser.extras import ViserUrdf  # heavy: see load_urdf
 
         if self.viser_urdf is not None:
-            import warnings
-
             with warnings.catch_warnings():  # ViserUrdf removes meshes whose frames went first
                 warnings.simplefilter("ignore", UserWarning)
                 self.viser_urdf.remove()
@@ -205,8 +204,6 @@ class Viewer:
 
     # ---------------------------------------------------------------- overlays
     def _overlays(self, urdf, built: Built) -> None:
-        from robotkit.check.lints import _eq_box
-
         scene = self.server.scene
         lo, hi = urdf.scene.bounds
         size = max(float(np.linalg.norm(hi - lo)), 0.05)
@@ -232,7 +229,7 @@ class Viewer:
             T = inertial.origin if inertial.origin is not None else np.eye(4)
             I = T[:3, :3] @ np.asarray(inertial.inertia, dtype=float) @ T[:3, :3].T
             moments, axes_R = np.linalg.eigh(I)
-            sides = np.maximum(_eq_box(moments, inertial.mass), size * 0.002)
+            sides = np.maximum(equivalent_box(inertial.mass, moments), size * 0.002)
             colour = palette[i % len(palette)]
             box = scene.add_box(f"/overlays/{name}/inertia", colour, tuple(sides), opacity=0.5,
                                 wxyz=_wxyz(axes_R), position=T[:3, 3], cast_shadow=False)
@@ -267,7 +264,7 @@ def serve(label: str, kind: str, make, port: int = 8080, open_browser: bool = Tr
           stop: threading.Event | None = None) -> int:
     """Serve the viewer of ``make()`` (a :class:`Built`, rebuilt when what it watches changes)
     until interrupted (or ``stop`` is set); ``kind`` is what PATH was (recipe, build, urdf)."""
-    import viser
+    import viser  # heavy: see load_urdf
 
     server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
     server.gui.configure_theme(control_width="large")
@@ -276,8 +273,6 @@ def serve(label: str, kind: str, make, port: int = 8080, open_browser: bool = Tr
     url = f"http://127.0.0.1:{server.get_port()}"
     print(f"viewing {label} at {url} (Ctrl-C stops)", flush=True)
     if open_browser:
-        import webbrowser
-
         webbrowser.open(url)
     stop = stop or threading.Event()
     try:

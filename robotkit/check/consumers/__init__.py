@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import importlib
 import math
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -22,6 +23,10 @@ from typing import Callable
 import numpy as np
 
 from robotkit.check.findings import Finding
+from robotkit.check.kinematics import lump, read_urdf, real_mass
+from robotkit.check.lints import resolve_uri
+from robotkit.mesh.export import obj_bytes
+from robotkit.mesh.io import load_mesh
 
 CONSUMERS = {
     "Gazebo (URDF)": ("robotkit.check.consumers.gazebo", "from_urdf"),
@@ -103,12 +108,6 @@ def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
     if not build.foreign:
         yield build.urdf, []
         return
-    import tempfile
-
-    from robotkit.check.lints import resolve_uri
-    from robotkit.mesh.export import obj_bytes
-    from robotkit.mesh.io import load_mesh
-
     tree = parse_urdf(build.urdf)
     for el in tree.getroot().iter():  # a line after each element: PyBullet loses characters of long lines
         el.tail = (el.tail or "") + "\n"  # (measured with 3.2.7: a xacro expansion on one line of 9 kB fails)
@@ -157,22 +156,20 @@ def configurations(reference, count: int, seed: int = 0) -> list[dict[str, float
 
 def compare(reference, view: View, configs: list[dict[str, float]], tol: float = REL_TOL) -> list[str]:
     """Differences between the description (``reference``, a KModel) and a program's view."""
-    from robotkit.check.kinematics import _mass, lump
-
     ref = lump(reference) if view.lumped else reference
-    expected = {n: _mass(link.mass) for n, link in ref.links.items() if n != "world"}
+    expected = {n: real_mass(link.mass) for n, link in ref.links.items() if n != "world"}
     total = sum(expected.values())
     scale = max(total, 1e-12)
     diffs = []
-    got_total = sum(_mass(m) for m in view.masses.values())
+    got_total = sum(real_mass(m) for m in view.masses.values())
     if abs(got_total - total) > tol * scale:
         diffs.append(f"total mass {got_total:.12g} kg, the description's is {total:.12g} kg")
     for name, m in sorted(view.masses.items()):
         if name not in expected:
-            if _mass(m) > 0:
+            if real_mass(m) > 0:
                 diffs.append(f"link '{name}' weighs {m:.12g} kg and is not in the description")
             continue
-        if abs(_mass(m) - expected[name]) > tol * max(expected[name], 1e-12 * scale):
+        if abs(real_mass(m) - expected[name]) > tol * max(expected[name], 1e-12 * scale):
             hint = " (its default for a link without <inertial>)" if m == 1.0 and expected[name] == 0 else ""
             diffs.append(f"link '{name}' weighs {m:.12g} kg{hint}, the description says {expected[name]:.12g} kg")
     for name, m in sorted(expected.items()):
@@ -201,8 +198,6 @@ def compare(reference, view: View, configs: list[dict[str, float]], tol: float =
 def consumer_findings(build: Build, consumers=None, configs: int = 20) -> tuple[list[Finding], dict]:
     """Each program's reading compared with the description: findings, and a summary per
     program (what it loaded, its total mass, its notes) for report.json."""
-    from robotkit.check.kinematics import read_urdf
-
     findings, summary = [], {}
     subject = f"robot '{build.name}'"
     try:

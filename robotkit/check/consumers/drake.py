@@ -3,21 +3,23 @@ SceneGraph (so collision geometry is loaded too: Drake takes convex meshes as OB
 
 from __future__ import annotations
 
+import logging
+import xml.etree.ElementTree as ET
+
 import numpy as np
 
 from robotkit.check.consumers import Missing, Refused, Unreadable, View, listed, with_mesh_paths
+from robotkit.emit.urdf import typed_transmissions
 
 
 def _load(build, path) -> View:
-    try:
+    try:  # optional and heavy: imported when Drake is asked
         from pydrake.multibody.parsing import Parser
         from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
         from pydrake.multibody.tree import PrismaticJoint, RevoluteJoint
         from pydrake.systems.framework import DiagramBuilder
     except ImportError:
         raise Missing("Drake is not installed (pip install drake)") from None
-    import logging
-
     logging.getLogger("drake").setLevel(logging.ERROR)  # its warnings (joint friction, sensors) are not failures
     if _unnamed(path):
         raise Refused('the robot has no name (<robot name="">): Drake stops the whole program on it '
@@ -58,8 +60,6 @@ def _load(build, path) -> View:
 
 def _unnamed(path) -> bool:
     """A URDF whose robot name is empty (checked before Drake, which aborts the process on it)."""
-    import xml.etree.ElementTree as ET
-
     try:
         for _, el in ET.iterparse(str(path), events=("start",)):
             return el.tag == "robot" and not el.get("name")
@@ -74,8 +74,6 @@ DRAKE_MESHES = (".obj", ".vtk", ".gltf")
 def from_urdf(build) -> View:
     if not build.foreign:
         return _load(build, build.urdf)
-    from robotkit.emit.urdf import typed_transmissions
-
     with with_mesh_paths(build, DRAKE_MESHES) as (urdf, converted):
         text, typed = typed_transmissions(urdf.read_text(encoding="utf-8"))
         urdf.write_text(text, encoding="utf-8")

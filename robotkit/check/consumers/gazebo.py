@@ -8,6 +8,7 @@ import shutil
 import subprocess
 
 from robotkit.check.consumers import Missing, Refused, View
+from robotkit.check.kinematics import read_sdf_text
 
 
 def _parsed(path) -> str:
@@ -24,8 +25,6 @@ def _parsed(path) -> str:
 
 
 def _view(text: str, source: str, lumped: bool) -> View:
-    from robotkit.check.kinematics import read_sdf_text
-
     try:
         model = read_sdf_text(text, source)
     except ValueError as exc:  # libsdformat wrote a model it cannot load (a URDF planar joint drops)

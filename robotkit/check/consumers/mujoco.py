@@ -8,7 +8,7 @@ from robotkit.check.consumers import Missing, Refused, View
 
 
 def from_mjcf(build) -> View:
-    try:
+    try:  # heavy: imported when MuJoCo is asked
         import mujoco
     except ImportError:
         raise Missing("MuJoCo is not installed (pip install mujoco)") from None

@@ -3,6 +3,8 @@ Pinocchio merges links joined by fixed joints into the body of their moving join
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from robotkit.check.consumers import Missing, Refused, View
@@ -13,8 +15,6 @@ DATA_BYTES_PER_DOF3 = 65
 
 
 def _available_memory() -> float:
-    import os
-
     try:
         return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     except (ValueError, OSError):
@@ -22,7 +22,7 @@ def _available_memory() -> float:
 
 
 def from_urdf(build) -> View:
-    try:
+    try:  # optional and heavy: imported when Pinocchio is asked
         import pinocchio as pin
     except ImportError:
         raise Missing("Pinocchio is not installed (pip install pin)") from None

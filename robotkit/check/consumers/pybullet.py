@@ -49,7 +49,7 @@ def _T(pos, orn) -> np.ndarray:
 
 
 def from_urdf(build) -> View:
-    try:
+    try:  # optional: imported when PyBullet is asked (quietly: it prints its build banner)
         with _quiet():
             import pybullet as p
     except ImportError:
