@@ -99,13 +99,12 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     # collision pieces before the other mesh work: CoACD is the longest, and doit -j N hands
     # out tasks in list order, so the slow ones start first and the quick ones fill in around them
     collisions = collision_tasks(place)
-    visuals, copies, textures, converts = visual_tasks(place), copy_tasks(place), texture_tasks(place), \
-        convert_tasks(place)
-    written = [t["targets"][0] for t in visuals + copies + converts]  # mesh files below meshes/
-    tasks = meshes + collisions + visuals + copies + textures + converts + inertial_tasks(place) \
-        + output_tasks(place, written)
+    files = visual_tasks(place) + copy_tasks(place) + convert_tasks(place)  # the mesh files below meshes/
+    textures = texture_tasks(place)
+    outputs = output_tasks(place, [t["targets"][0] for t in files])
+    tasks = meshes + collisions + files + textures + inertial_tasks(place) + outputs
     if report:
-        tasks.append(report_task(place, collisions + visuals + copies + textures + converts, meshes))
+        tasks.append(report_task(place, collisions + files + textures, meshes))
     return tasks + world_tasks(robot, out_dir)
 
 
