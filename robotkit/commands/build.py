@@ -32,7 +32,7 @@ def run(args) -> int:
     done = stamp.up_to_date(args.out, opts)  # nothing changed since the last successful build?
     if done is not None:
         return _up_to_date(args, done, start)
-    from robotkit.pipeline.runner import build
+    from robotkit.pipeline.runner import build  # past the stamp: the no-op path imports only robotkit.pipeline.stamp
 
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
     with scheduler(args) as jobs, cache_messages():
@@ -90,7 +90,7 @@ def cache_messages():
         return
     import tempfile
 
-    from robotkit.ioutil import environ
+    from robotkit.ioutil import environ  # past the stamp, as every import of this module but stamp
     from robotkit.mesh.cache import REPORT_ENV
 
     fd, path = tempfile.mkstemp(prefix="robotkit-cache-", suffix=".log")
@@ -113,7 +113,7 @@ def cache_messages():
 def scheduler(args):
     """The number of doit jobs, with the Dask scheduler (``--scheduler``, ``local`` or
     $DASK_SCHEDULER_ADDRESS) exported to the task processes (robotkit.pipeline.distributed)."""
-    from robotkit.ioutil import environ
+    from robotkit.ioutil import environ  # past the stamp, as every import of this module but stamp
     from robotkit.pipeline import distributed
 
     address = args.scheduler or os.environ.get(distributed.DASK_ENV)
@@ -132,7 +132,7 @@ def collision_summary(out: str, robots: list[str]) -> None:
     """One line per collision proxy: strategy, pieces, volume against the visual, distance."""
     import json
 
-    from robotkit.emit.layout import robot_layout
+    from robotkit.emit.layout import robot_layout  # past the stamp (it loads the emitters)
 
     for name in robots:
         try:

@@ -2,15 +2,18 @@
 
 ``OUT/<robot>/`` is at once a ROS package and a Gazebo model folder.  The output formats
 (:mod:`robotkit.emit`) declare their paths with the templates below; everything that reads a
-build folder (check, picture, the viewer, the commands) asks :class:`RobotLayout`."""
+build folder (check, picture, the viewer, the commands) asks :class:`RobotLayout`.  The
+build's own records (mesh facts, collision pieces, inertials) live in ``OUT/.robotkit/<robot>/``
+(:data:`RECORDS`), the worlds in ``OUT/<world>/`` (:data:`WORLD_FILES`)."""
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Mapping
 
-# below OUT/<robot>/; {name} is the robot's name
+# below OUT/<robot>/; {name} is the robot's name; a mapping gives the path per ROS version (``ros``)
 URDF = "urdf/{name}.urdf"
 XACRO = "urdf/{name}.urdf.xacro"
 SDF = "model.sdf"
@@ -20,6 +23,9 @@ SUMMARY = "report.json"  # computed inertials, mesh facts, what each format lost
 MODEL_CONFIG = "model.config"
 PACKAGE_XML = "package.xml"
 CMAKELISTS = "CMakeLists.txt"
+ENV_HOOK = {"ros1": "env-hooks/50.{name}.sh.in", "ros2": "hooks/{name}.dsv.in"}
+DISPLAY_LAUNCH = {"ros1": "launch/display.launch", "ros2": "launch/display.launch.py"}
+GAZEBO_LAUNCH = {"ros1": "launch/gazebo.launch", "ros2": "launch/gazebo.launch.py"}
 RVIZ = "rviz/{name}.rviz"
 CONTROLLERS = "config/controllers.yaml"
 PICTURES = "report"  # the picture report's folder
@@ -27,7 +33,21 @@ REPORT_HTML = "report/report.html"
 MESHES = "meshes"
 VISUAL_MESHES = "meshes/visual"
 COLLISION_MESHES = "meshes/collision"
-WORLDS = "worlds"
+WORLDS = "worlds"  # the package's copies of the worlds, without the robot
+
+# below OUT/<world>/ (and OUT/<robot>/worlds/<world>/); {name} is the world's name
+WORLD_FILES = ("model.config", "model.sdf", "meshes/{name}.stl", "{name}.world", "scene.xml")
+
+# the build's records, below OUT/.robotkit/<robot>/; {key} is a mesh key, a proxy key or a link's file stem
+RECORDS = {"mesh": "mesh/{key}.json", "collision": "collision/{key}.json", "visual": "visual/{key}.json",
+           "inertial": "inertial/{key}.json"}
+
+
+def output_path(template: str | Mapping[str, str], name: str, ros: str = "ros2") -> str:
+    """The path below ``OUT/<robot>/`` of one of the templates above, for robot ``name`` (and ``ros``)."""
+    if not isinstance(template, str):
+        template = template[ros]
+    return template.format(name=name)
 
 
 @dataclass(frozen=True)
@@ -40,8 +60,8 @@ class RobotLayout:
     def name(self) -> str:
         return self.root.name
 
-    def path(self, template: str) -> Path:
-        return self.root / template.format(name=self.name)
+    def path(self, template: str | Mapping[str, str], ros: str = "ros2") -> Path:
+        return self.root / output_path(template, self.name, ros)
 
     @property
     def urdf(self) -> Path:
@@ -70,6 +90,10 @@ class RobotLayout:
     @property
     def report_html(self) -> Path:
         return self.path(REPORT_HTML)
+
+    @property
+    def meshes(self) -> Path:
+        return self.path(MESHES)
 
     def is_build(self) -> bool:
         """A robotkit build folder: its model.sdf and its mjcf/ folder are there."""

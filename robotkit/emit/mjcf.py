@@ -14,8 +14,14 @@ import os
 
 import numpy as np
 
+from robotkit.emit import layout
 from robotkit.emit.env import render
 from robotkit.geometry import rpy_quat
+from robotkit.emit.formats import Format
+from robotkit.emit.meshfiles import collision_file, conversions, visual_file
+from robotkit.emit.sdf import extras_losses
+from robotkit.emit.sensors import losses as sensor_losses
+from robotkit.emit.sensors import mjcf_context
 from robotkit.model.robot import Geom, Robot
 
 WORLD = "world"
@@ -24,20 +30,16 @@ MJCF_MESH_EXT = (".stl", ".obj")
 
 def mesh_file(mesh, role: str = "visual") -> str:
     """The mesh file MJCF reads, relative to the robot's meshes/ folder."""
-    from robotkit.emit.meshfiles import collision_file, visual_file
-
     return collision_file(mesh) if role == "collision" else visual_file(mesh, "mjcf")
 
 
 def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     out = []
-    from robotkit.emit.meshfiles import conversions
-
     for rel, (src, _) in conversions(robot).items():
         if not rel.startswith("mjcf/"):
             continue
         out.append(f"mesh '{os.path.basename(src)}': MuJoCo reads no {os.path.splitext(src)[1].upper()[1:]}; "
-                   f"converted to meshes/{rel} (the file's own colours and textures are dropped, "
+                   f"converted to {layout.MESHES}/{rel} (the file's own colours and textures are dropped, "
                    "the recipe's material is used)")
     for j in robot.joints:
         if j.type == "planar":
@@ -61,9 +63,6 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
                 if f is not None and not f.get("convex", True):
                     out.append(f"link '{link.name}': collision mesh '{g.shape.mesh.file_name}' is not convex; "
                                "MuJoCo collides with its convex hull")
-    from robotkit.emit.sdf import extras_losses
-    from robotkit.emit.sensors import losses as sensor_losses
-
     return out + extras_losses(robot, "the MJCF") + sensor_losses(robot)["mjcf"]
 
 
@@ -115,72 +114,76 @@ def _plane_axes(normal) -> tuple[tuple, tuple]:
     return tuple(u), tuple(v)
 
 
-def context(robot: Robot, lift: float = 0.0) -> dict:
-    """``lift``: height of the root body (a robot not rooted in ``world`` stands on the floor)."""
-    assets = _assets(robot)
-    by_parent: dict[str, list] = {}
-    for j in robot.joints:
-        by_parent.setdefault(j.parent, []).append(j)
+def joints_of(j) -> list[dict]:
+    """The MJCF joints of a URDF joint (none for a fixed one; three for a planar one)."""
+    if j.type in ("revolute", "continuous", "prismatic"):
+        d = {"name": j.name, "type": "slide" if j.type == "prismatic" else "hinge", "axis": j.axis}
+        if j.type != "continuous":
+            d["range"] = (j.limit.lower, j.limit.upper)
+        if j.limit is not None and j.limit.effort:
+            d["frcrange"] = j.limit.effort
+        if j.dynamics is not None:
+            d.update(damping=j.dynamics.damping, friction=j.dynamics.friction, armature=j.dynamics.armature)
+        return [d]
+    if j.type == "planar":
+        u, v = _plane_axes(j.axis)
+        return [{"name": f"{j.name}_x", "type": "slide", "axis": u},
+                {"name": f"{j.name}_y", "type": "slide", "axis": v},
+                {"name": f"{j.name}_rz", "type": "hinge", "axis": j.axis}]
+    if j.type == "floating" and j.parent == WORLD:
+        return [{"name": j.name, "type": "free"}]
+    return []
+
+
+def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str]) -> dict:
+    """The context of one body: its place, joints, inertial, geoms, cameras and sites, and its
+    ``children`` (link names)."""
+    name = link.name
+    extras = sens["bodies"].get(name, {"cameras": [], "sites": []})
+    for site in extras["sites"]:
+        if site.get("touch"):
+            site["size"], site["pos"] = _touch_volume(link)
+    c = link.contact
+    friction = c.mu1 if c is not None else None
+    return {
+        "name": name,
+        "pos": joint.origin.xyz if joint is not None else (0.0, 0.0, 0.0),
+        "quat": rpy_quat(joint.origin.rpy) if joint is not None else (1.0, 0.0, 0.0, 0.0),
+        "joints": joints_of(joint) if joint is not None else [],
+        "inertial": link.inertial,
+        "visuals": [_geom(robot, g, f"{name}_visual_{i}", assets) for i, g in enumerate(link.visuals)],
+        "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets, "collision"), friction=friction)
+                       for i, g in enumerate(link.collisions_for("mjcf"))],
+        "children": children,
+        "cameras": extras["cameras"],
+        "sites": extras["sites"],
+    }
+
+
+def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list[dict], list[dict]]:
+    """(geoms of the worldbody, the body tree as opening and closing steps, depth first, without
+    recursion: chains of 1000 links)."""
     links = {link.name: link for link in robot.links}
+    children: dict[str, list[str]] = {}
+    for j in robot.joints:
+        children.setdefault(j.parent, []).append(j.child)
+    parent_joint = {j.child: j for j in robot.joints}
 
-    def joints_of(j) -> list[dict]:
-        if j.type in ("revolute", "continuous", "prismatic"):
-            d = {"name": j.name, "type": "slide" if j.type == "prismatic" else "hinge", "axis": j.axis}
-            if j.type != "continuous":
-                d["range"] = (j.limit.lower, j.limit.upper)
-            if j.limit is not None and j.limit.effort:
-                d["frcrange"] = j.limit.effort
-            if j.dynamics is not None:
-                d.update(damping=j.dynamics.damping, friction=j.dynamics.friction, armature=j.dynamics.armature)
-            return [d]
-        if j.type == "planar":
-            u, v = _plane_axes(j.axis)
-            return [{"name": f"{j.name}_x", "type": "slide", "axis": u},
-                    {"name": f"{j.name}_y", "type": "slide", "axis": v},
-                    {"name": f"{j.name}_rz", "type": "hinge", "axis": j.axis}]
-        if j.type == "floating" and j.parent == WORLD:
-            return [{"name": j.name, "type": "free"}]
-        return []
-
-    from robotkit.emit.sensors import mjcf_context
-
-    sens = mjcf_context(robot)
-
-    def body(name: str, joint) -> dict:
-        link = links[name]
-        extras = sens["bodies"].get(name, {"cameras": [], "sites": []})
-        for site in extras["sites"]:
-            if site.get("touch"):
-                site["size"], site["pos"] = _touch_volume(link)
-        c = link.contact
-        friction = c.mu1 if c is not None else None
-        return {
-            "name": name,
-            "pos": joint.origin.xyz if joint is not None else (0.0, 0.0, 0.0),
-            "quat": rpy_quat(joint.origin.rpy) if joint is not None else (1.0, 0.0, 0.0, 0.0),
-            "joints": joints_of(joint) if joint is not None else [],
-            "inertial": link.inertial,
-            "visuals": [_geom(robot, g, f"{name}_visual_{i}", assets) for i, g in enumerate(link.visuals)],
-            "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets, "collision"), friction=friction)
-                           for i, g in enumerate(link.collisions_for("mjcf"))],
-            "children": [j.child for j in by_parent.get(name, [])],
-            "cameras": extras["cameras"],
-            "sites": extras["sites"],
-        }
+    def make(name: str, joint) -> dict:
+        return body(robot, links[name], joint, assets, sens, children.get(name, []))
 
     root = robot.root
-    parent_joint = {j.child: j for j in robot.joints}
     if root == WORLD:
-        world = body(root, None)
+        world = make(root, None)
         world_geoms = world["visuals"] + world["collisions"]
-        tops = [body(name, parent_joint[name]) for name in world["children"]]
+        tops = [make(name, parent_joint[name]) for name in world["children"]]
     else:
         world_geoms = []
-        tops = [body(root, None)]
+        tops = [make(root, None)]
         tops[0]["pos"] = (0.0, 0.0, lift) if lift else tops[0]["pos"]
         if robot.base == "free":
             tops[0]["joints"] = [{"name": f"{root}_free", "type": "free"}]
-    tree = []  # opening and closing steps, depth first, without recursion (chains of 1000 links)
+    tree = []
     stack = [(b, 2) for b in reversed(tops)]
     while stack:
         b, depth = stack.pop()
@@ -189,11 +192,12 @@ def context(robot: Robot, lift: float = 0.0) -> dict:
             continue
         tree.append({"body": b, "indent": "  " * depth})
         stack.append((None, depth))
-        stack.extend((body(c, parent_joint[c]), depth + 1) for c in reversed(b["children"]))
-    equalities = [{"name": f"{j.name}_mimic", "joint1": j.name, "joint2": j.mimic.joint,
-                   "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
-                  for j in robot.joints if j.mimic is not None]
-    excludes = [(j.parent, j.child) for j in robot.joints if j.parent != WORLD]
+        stack.extend((make(c, parent_joint[c]), depth + 1) for c in reversed(b["children"]))
+    return world_geoms, tree
+
+
+def actuator_contexts(robot: Robot) -> list[dict]:
+    """One MJCF actuator per recipe actuator: position and velocity servos, motors."""
     joint_by_name = {j.name: j for j in robot.joints}
     actuators = []
     for a in robot.actuators:
@@ -209,7 +213,20 @@ def context(robot: Robot, lift: float = 0.0) -> dict:
         else:
             act.update(kind="motor", ctrlrange=(-effort, effort))
         actuators.append(act)
-    return {"robot": robot, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "assets": sorted(assets.values(), key=lambda a: a["name"]),
+    return actuators
+
+
+def context(robot: Robot, lift: float = 0.0) -> dict:
+    """``lift``: height of the root body (a robot not rooted in ``world`` stands on the floor)."""
+    assets = _assets(robot)
+    sens = mjcf_context(robot)
+    world_geoms, tree = body_tree(robot, lift, assets, sens)
+    equalities = [{"name": f"{j.name}_mimic", "joint1": j.name, "joint2": j.mimic.joint,
+                   "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
+                  for j in robot.joints if j.mimic is not None]
+    excludes = [(j.parent, j.child) for j in robot.joints if j.parent != WORLD]
+    return {"robot": robot, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuator_contexts(robot),
+            "assets": sorted(assets.values(), key=lambda a: a["name"]),
             "materials": robot.materials, "world_geoms": world_geoms, "tree": tree,
             "equalities": equalities}
 
@@ -250,9 +267,17 @@ def zero_pose_frames(robot: Robot) -> dict[str, np.ndarray]:
     return frames
 
 
-def lowest_point(robot: Robot, meshes_dir: str | None) -> float | None:
+def collision_meshes(robot: Robot) -> list[str]:
+    """The mesh files (below ``meshes/``) of the MJCF's collision geometry: the build reads their
+    vertices for :func:`render_mjcf` (keyword ``points``)."""
+    return sorted({mesh_file(g.shape.mesh, "collision") for link in robot.links
+                   for g in link.collisions_for("mjcf") if g.shape.kind == "mesh"})
+
+
+def lowest_point(robot: Robot, points: dict[str, np.ndarray] | None) -> float | None:
     """Lowest z of the robot's MJCF collision geometry at its zero pose, in the root frame
-    (mesh geoms: their vertices, as MuJoCo collides with their convex hulls); None without any."""
+    (mesh geoms: the vertices of their files in ``points``, as MuJoCo collides with their convex
+    hulls; none without ``points``); None without any."""
     frames = zero_pose_frames(robot)
     lows = []
     for link in robot.links:
@@ -270,20 +295,19 @@ def lowest_point(robot: Robot, meshes_dir: str | None) -> float | None:
                     lows.append(c[2] - abs(axis[2]) - s.radius * math.sqrt(max(0.0, 1 - R[2, 2] ** 2)))
             elif s.kind == "box":
                 lows.append(c[2] - float(np.abs(R[2, :]) @ (np.asarray(s.size) / 2)))
-            elif s.kind == "mesh" and meshes_dir is not None:
-                from robotkit.mesh.io import read_vertices
-
-                v = read_vertices(os.path.join(meshes_dir, mesh_file(s.mesh, "collision"))) * np.asarray(s.mesh.out_scale)
+            elif s.kind == "mesh" and points is not None:
+                v = points[mesh_file(s.mesh, "collision")] * np.asarray(s.mesh.out_scale)
                 lows.append(float((v @ R[2, :]).min() + c[2]))
     return min(lows) if lows else None
 
 
-def render_mjcf(robot: Robot, meshes_dir: str | None = None) -> str:
+def render_mjcf(robot: Robot, points: dict[str, np.ndarray] | None = None) -> str:
     """The robot's MJCF.  A robot not rooted in ``world`` stands on the floor at its zero pose:
-    its root body is raised (or lowered) so that its lowest collision point is at z = 0."""
+    its root body is raised (or lowered) so that its lowest collision point is at z = 0
+    (``points``: the vertices of :func:`collision_meshes`; without them, mesh geoms are left out)."""
     lift = 0.0
     if robot.root != WORLD:
-        low = lowest_point(robot, meshes_dir)
+        low = lowest_point(robot, points)
         # up to the next micrometre: never inside the floor, and no float32 noise in the file
         lift = math.ceil(-low * 1e6) / 1e6 if low is not None else 0.0
     return render("mjcf/robot.xml.j2", **context(robot, lift=lift))
@@ -291,3 +315,9 @@ def render_mjcf(robot: Robot, meshes_dir: str | None = None) -> str:
 
 def render_scene(robot: Robot) -> str:
     return render("mjcf/scene.xml.j2", robot=robot)
+
+
+FORMATS = [
+    Format("mjcf", render_mjcf, layout.MJCF, ("mjcf/robot.xml.j2",), consumed=True, points=collision_meshes),
+    Format("mjcf-scene", render_scene, layout.SCENE, ("mjcf/scene.xml.j2",), reads="metadata"),
+]

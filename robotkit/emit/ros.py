@@ -15,8 +15,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import yaml
 
-from robotkit.emit.env import render
+from robotkit.emit import layout
+from robotkit.emit.controllers import controllers
+from robotkit.emit.env import fmt, render
+from robotkit.emit.formats import Format
+from robotkit.emit.sensors import ros_topics
+from robotkit.model.resolve import recenter_offset
 from robotkit.model.robot import Robot
 
 # controller type prefix -> the package that provides it
@@ -24,27 +30,40 @@ CONTROLLER_PACKAGES = {"position_controllers", "velocity_controllers", "effort_c
                        "joint_trajectory_controller", "joint_state_controller", "joint_state_broadcaster"}
 
 
+# the templates of the files that differ between ROS 1 and ROS 2
+ENV_HOOK = {"ros1": "ros/env-hook.sh.in.j2", "ros2": "ros/env-hook.dsv.in.j2"}
+DISPLAY_LAUNCH = {"ros1": "ros/display.launch.j2", "ros2": "ros/display.launch.py.j2"}
+GAZEBO_LAUNCH = {"ros1": "ros/gazebo.launch.j2", "ros2": "ros/gazebo.launch.py.j2"}
+
+
 def is_ros1(robot: Robot) -> bool:
     return robot.ros == "ros1"
 
 
+def flavour(robot: Robot) -> str:
+    return "ros1" if is_ros1(robot) else "ros2"
+
+
 def folders(robot: Robot) -> list[str]:
     """The folders of the package, as the build writes them (CMakeLists installs each)."""
-    out = ["urdf"]
+    out = [top(layout.URDF)]
     if robot.meshes():
-        out.append("meshes")
-    out += ["mjcf", "launch", "rviz"]
+        out.append(layout.MESHES)
+    out += [top(layout.MJCF), top(layout.DISPLAY_LAUNCH["ros2"]), top(layout.RVIZ)]
     if robot.actuators:
-        out.append("config")
+        out.append(top(layout.CONTROLLERS))
     if robot.worlds:
-        out.append("worlds")
+        out.append(layout.WORLDS)
     return out
+
+
+def top(template: str) -> str:
+    """The top folder of a path template of :mod:`robotkit.emit.layout`."""
+    return template.split("/", 1)[0]
 
 
 def controller_names(robot: Robot) -> list[str]:
     """The controllers of config/controllers.yaml, in the order the launch file spawns them."""
-    from robotkit.emit.controllers import controllers
-
     if not robot.actuators:
         return []
     data = controllers(robot)
@@ -54,8 +73,6 @@ def controller_names(robot: Robot) -> list[str]:
 
 
 def _controller_packages(robot: Robot) -> set[str]:
-    from robotkit.emit.controllers import controllers
-
     if not robot.actuators:
         return set()
     data = controllers(robot)
@@ -68,8 +85,6 @@ def _controller_packages(robot: Robot) -> set[str]:
 
 def exec_depends(robot: Robot) -> list[str]:
     """Every package the launch files start, the URDF's plugins load and the controllers need."""
-    from robotkit.emit.sensors import ros_topics
-
     deps = {"robot_state_publisher", "joint_state_publisher", "joint_state_publisher_gui"}
     if is_ros1(robot):
         deps |= {"rviz", "gazebo_ros"}
@@ -109,22 +124,12 @@ def render_cmakelists(robot: Robot) -> str:
     return render("ros/CMakeLists.txt.j2", robot=robot, ros1=is_ros1(robot), folders=folders(robot))
 
 
-def env_hook_path(robot: Robot) -> str:
-    return f"env-hooks/50.{robot.name}.sh.in" if is_ros1(robot) else f"hooks/{robot.name}.dsv.in"
-
-
 def render_env_hook(robot: Robot) -> str:
-    template = "ros/env-hook.sh.in.j2" if is_ros1(robot) else "ros/env-hook.dsv.in.j2"
-    return render(template, robot=robot)
-
-
-def launch_path(robot: Robot, kind: str) -> str:
-    return f"launch/{kind}.launch" if is_ros1(robot) else f"launch/{kind}.launch.py"
+    return render(ENV_HOOK[flavour(robot)], robot=robot)
 
 
 def render_display_launch(robot: Robot) -> str:
-    template = "ros/display.launch.j2" if is_ros1(robot) else "ros/display.launch.py.j2"
-    return render(template, robot=robot)
+    return render(DISPLAY_LAUNCH[flavour(robot)], robot=robot)
 
 
 def spawn_pose(robot: Robot) -> dict:
@@ -136,17 +141,13 @@ def spawn_pose(robot: Robot) -> dict:
 
 def bridge(robot: Robot) -> list[str]:
     """ros_gz_bridge arguments: the clock and every sensor topic (Gazebo Sim -> ROS)."""
-    from robotkit.emit.sensors import ros_topics
-
     out = ["/clock@rosgraph_msgs/msg/Clock[gz.msgs.Clock"]
     out += [f"{t['topic']}@{t['ros_type']}[{t['gz_type']}" for t in ros_topics(robot) if t["gz_type"]]
     return out
 
 
 def render_gazebo_launch(robot: Robot) -> str:
-    from robotkit.emit.env import fmt
-
-    template = "ros/gazebo.launch.j2" if is_ros1(robot) else "ros/gazebo.launch.py.j2"
+    template = GAZEBO_LAUNCH[flavour(robot)]
     pose = {k: fmt(v) for k, v in spawn_pose(robot).items()}
     return render(template, robot=robot, worlds=[w.name for w in robot.worlds], pose=pose,
                   controllers=controller_names(robot), bridge=bridge(robot))
@@ -157,7 +158,7 @@ def render_gazebo_launch(robot: Robot) -> str:
 
 def _motion(joint, q: float) -> np.ndarray:
     """The transform a joint at position ``q`` adds after its origin."""
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # scipy: heavy, only for the RViz file
 
     T = np.eye(4)
     axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
@@ -208,8 +209,6 @@ def _corners(geom, facts: dict) -> np.ndarray | None:
 def bounds(robot: Robot, facts: dict) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned box around the visual geometry and every link origin, in the root frame
     (``robot`` as resolved: recentering offsets are taken from the mesh ``facts``)."""
-    from robotkit.model.resolve import recenter_offset
-
     poses = link_poses(robot)
     points = [T[:3, 3] for T in poses.values()]
     for link in robot.links:
@@ -240,8 +239,6 @@ def camera(robot: Robot, facts: dict) -> dict:
 
 
 def rviz_config(robot: Robot, facts: dict) -> dict:
-    from robotkit.emit.sensors import ros_topics
-
     ros1 = is_ros1(robot)
     cls = (lambda name: f"rviz/{name}") if ros1 else (lambda name: f"rviz_default_plugins/{name}")
     view = camera(robot, facts)
@@ -300,8 +297,6 @@ def rviz_config(robot: Robot, facts: dict) -> dict:
 
 
 def render_rviz(robot: Robot, facts: dict | None = None) -> str:
-    import yaml
-
     header = f"# RViz configuration for {robot.name}, generated by robotkit; edit the recipe, not this file.\n"
     return header + yaml.safe_dump(rviz_config(robot, facts or {}), sort_keys=False, default_flow_style=False)
 
@@ -313,3 +308,15 @@ def losses(robot: Robot) -> list[str]:
         out.append("no maintainer: package.xml names none, and catkin and colcon refuse a package without one "
                    "(give metadata.maintainers, or an author with an email)")
     return out
+
+
+FORMATS = [
+    Format("package.xml", render_package_xml, layout.PACKAGE_XML, ("ros/package.xml.j2",), reads="ros-package"),
+    Format("CMakeLists.txt", render_cmakelists, layout.CMAKELISTS, ("ros/CMakeLists.txt.j2",), reads="ros-package"),
+    Format("env-hook", render_env_hook, layout.ENV_HOOK, tuple(ENV_HOOK.values()), reads="ros-package"),
+    Format("display-launch", render_display_launch, layout.DISPLAY_LAUNCH, tuple(DISPLAY_LAUNCH.values()),
+           reads="ros-package"),
+    Format("gazebo-launch", render_gazebo_launch, layout.GAZEBO_LAUNCH, tuple(GAZEBO_LAUNCH.values()),
+           reads="ros-package"),
+    Format("rviz", render_rviz, layout.RVIZ, reads="rviz"),
+]

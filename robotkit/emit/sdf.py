@@ -12,9 +12,17 @@ renamed (:func:`joint_names`).  What SDF 1.9 cannot express is listed by :func:`
 
 from __future__ import annotations
 
+from dataclasses import replace
+
+from robotkit.emit import layout
 from robotkit.emit.env import render
+from robotkit.emit.formats import Format
+from robotkit.emit.meshfiles import collision_file
 from robotkit.emit.urdf import MASSLESS, geom_context
-from robotkit.model.robot import Inertial, Robot
+from robotkit.emit.sensors import contexts, host_of
+from robotkit.emit.sensors import losses as sensor_losses
+from robotkit.geometry import matrix_rpy
+from robotkit.model.robot import Inertial, Pose, Robot
 
 SDF_VERSION = "1.9"
 JOINT_TYPES = {"revolute": "revolute", "continuous": "continuous", "prismatic": "prismatic", "fixed": "fixed"}
@@ -22,8 +30,6 @@ SPECULAR = (0.1, 0.1, 0.1, 1.0)
 
 
 def losses(robot: Robot) -> list[str]:
-    from robotkit.emit.sensors import losses as sensor_losses
-
     out = []
     names = joint_names(robot)
     for j in robot.joints:
@@ -84,19 +90,12 @@ def names_apart(links, joints) -> dict[str, str]:
 
 def _moved(geom, pose):
     """``geom`` of a frame link, re-posed into the link that carries it."""
-    from dataclasses import replace
-
-    from robotkit.geometry import matrix_rpy
-    from robotkit.model.robot import Pose
-
     T = pose.matrix() @ geom.pose.matrix()
     return replace(geom, origin=Pose(tuple(float(v) for v in T[:3, 3]), matrix_rpy(T[:3, :3])),
                    offset=(0.0, 0.0, 0.0))
 
 
 def context(robot: Robot) -> dict:
-    from robotkit.emit.sensors import contexts, host_of
-
     materials = {m.name: m for m in robot.materials}
     parent_joint = {j.child: j for j in robot.joints}
     frames = robot.frame_links()
@@ -148,13 +147,14 @@ def context(robot: Robot) -> dict:
 
 
 def _uri(robot: Robot, geom, role: str = "visual") -> str | None:
-    from robotkit.emit.meshfiles import collision_file
-
     if geom.shape.mesh is None:
         return None
     path = collision_file(geom.shape.mesh) if role == "collision" else geom.shape.mesh.path
-    return f"model://{robot.name}/meshes/{path}"
+    return f"model://{robot.name}/{layout.MESHES}/{path}"
 
 
 def render_sdf(robot: Robot) -> str:
     return render("sdf/model.sdf.j2", **context(robot))
+
+
+FORMATS = [Format("sdf", render_sdf, layout.SDF, ("sdf/model.sdf.j2", "sensors/sdf.j2"), consumed=True)]

@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
+from robotkit.emit import layout
 from robotkit.emit.env import render
-from robotkit.model.robot import Geom, Robot
+from robotkit.emit.formats import Format
+from robotkit.emit.meshfiles import collision_file
+from robotkit.emit.sensors import contexts
+from robotkit.model.robot import Geom, Robot, Shape
 
 
 MASSLESS = 1e-300
@@ -43,18 +49,12 @@ def typed_transmissions(text: str) -> tuple[str, list[tuple[str, str]]]:
 
 
 def mesh_uri(robot: Robot, geom: Geom, role: str = "visual") -> str:
-    from robotkit.emit.meshfiles import collision_file
-
     path = collision_file(geom.shape.mesh) if role == "collision" else geom.shape.mesh.path
-    return f"package://{robot.name}/meshes/{path}"
+    return f"package://{robot.name}/{layout.MESHES}/{path}"
 
 
 def urdf_geoms(geoms) -> list[Geom]:
     """URDF has no capsule: a cylinder and two spheres make the same shape."""
-    from dataclasses import replace
-
-    from robotkit.model.robot import Shape
-
     out = []
     for g in geoms:
         s = g.shape
@@ -101,8 +101,6 @@ def context(robot: Robot) -> dict:
             "gazebo_material": gazebo_material,
             "contact": link.contact if link.collisions else None,
         })
-    from robotkit.emit.sensors import contexts
-
     return {
         "robot": robot,
         "extras": [typed_transmissions(x)[0] for x in robot.urdf_extras],
@@ -135,3 +133,8 @@ def actuator_contexts(robot: Robot) -> list[dict]:
 
 def render_urdf(robot: Robot) -> str:
     return render("urdf/robot.urdf.j2", **context(robot))
+
+
+TEMPLATES = ("urdf/robot.urdf.j2", "sensors/sdf.j2", "sensors/classic.j2")
+
+FORMATS = [Format("urdf", render_urdf, layout.URDF, TEMPLATES, consumed=True)]

@@ -21,8 +21,10 @@ import re
 import xml.dom.minidom as minidom
 from dataclasses import replace
 
+from robotkit.emit import layout
 from robotkit.emit.env import render
-from robotkit.emit.urdf import context
+from robotkit.emit.formats import Format
+from robotkit.emit.urdf import TEMPLATES, context
 from robotkit.model.robot import Robot
 
 PREFIX = "${prefix}"
@@ -103,3 +105,6 @@ def render_xacro_macro(robot: Robot) -> str:
     ctx["robot"] = replace(p, name=PREFIX + robot.name)
     return render("urdf/robot.urdf.xacro.j2", **ctx, package=robot.name, macro_name=robot.name,
                   root=p.root, root_name=robot.root, mount_joint=PREFIX + mount)
+
+
+FORMATS = [Format("xacro", render_xacro_macro, layout.XACRO, ("urdf/robot.urdf.xacro.j2", *TEMPLATES))]

@@ -8,13 +8,29 @@ build turns those into exit status 2.
 
 from __future__ import annotations
 
+import filecmp
 import functools
-import os
 import json
+import os
 import shutil
+from pathlib import Path
 
-from robotkit.errors import Problem, RobotkitError
+import numpy as np
+from doit.exceptions import TaskFailed
+
+from robotkit.emit import FORMATS
+from robotkit.emit.layout import robot_layout
+from robotkit.errors import ConsumerError, Problem, RobotkitError, display_path
 from robotkit.ioutil import write_if_changed
+from robotkit.mesh.cache import Cache, plain
+from robotkit.mesh.export import obj_bytes, stl_bytes
+from robotkit.mesh.inertia import hull_points, mesh_mass_properties
+from robotkit.mesh.io import load_mesh, read_vertices, volume_mesh
+from robotkit.model.resolve import finalize, finalize_link_inertial, inertial_from_json, inertial_to_json
+from robotkit.picture import report_build_dir
+from robotkit.pipeline.distributed import run as run_distributed  # on a Dask cluster when one is configured
+from robotkit.pipeline.publish import publish, staged_files
+from robotkit.world import build_world
 
 FACTS_VERSION = 4  # 3: sources relative to the recipe (no absolute or working-folder paths); 4: hull points
 
@@ -22,8 +38,6 @@ FACTS_VERSION = 4  # 3: sources relative to the recipe (no absolute or working-f
 def _user_errors_fail(fn):
     @functools.wraps(fn)
     def run(*args, **kwargs):
-        from doit.exceptions import TaskFailed
-
         try:
             fn(*args, **kwargs)
         except RobotkitError as exc:
@@ -42,14 +56,9 @@ def dump_json(data) -> str:
 @_user_errors_fail
 def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
     """Load a mesh, make it a closed volume, record its unit-density mass properties."""
-    import numpy as np
-
-    from robotkit.mesh.inertia import hull_points, mesh_mass_properties
-    from robotkit.mesh.io import load_mesh, volume_mesh
-
     loc = Problem("", **where)
     mesh = load_mesh(source, scale, loc)
-    name = _display(source)
+    name = display_path(source)
     faces_in = len(mesh.faces)
     bbox_min, bbox_max = mesh.bounds
     vol_mesh, repairs, used, warnings = volume_mesh(mesh, policy, name, loc)
@@ -76,17 +85,9 @@ def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
     write_if_changed(target, dump_json(facts))
 
 
-def _display(path: str) -> str:
-    from robotkit.errors import display_path
-
-    return display_path(path)
-
-
 def _label(source: str, where: dict) -> str:
     """A mesh file as recorded in the build's JSON (and report.json): relative to the recipe
     file that names it, so records never depend on where the recipe sits or robotkit runs."""
-    from pathlib import Path
-
     base = os.path.dirname(where["file"]) if where.get("file") else os.path.dirname(source)
     return Path(os.path.relpath(source, base)).as_posix()
 
@@ -107,15 +108,11 @@ def read_facts(paths: dict[str, str]) -> dict:
 @_user_errors_fail
 def link_inertial(link, fact_paths: dict[str, str], target: str):
     """Compute one link's inertial from the mesh facts of its source geometry."""
-    from robotkit.model.resolve import finalize_link_inertial, inertial_to_json
-
     inertial = finalize_link_inertial(link, read_facts(fact_paths))
     write_if_changed(target, dump_json(inertial_to_json(inertial)))
 
 
 def _finalized(robot, fact_paths: dict[str, str], inertial_paths: dict[str, str]):
-    from robotkit.model.resolve import finalize, inertial_from_json
-
     inertials = {}
     for link, path in inertial_paths.items():
         with open(path, encoding="utf-8") as f:
@@ -124,37 +121,34 @@ def _finalized(robot, fact_paths: dict[str, str], inertial_paths: dict[str, str]
 
 
 @_user_errors_fail
-def emit(emitter: str, robot, fact_paths: dict[str, str], inertial_paths: dict[str, str], target: str,
-         options: dict, where: dict | None = None):
-    """Render one output file of a finalized robot through a registered emitter.
+def emit(name: str, robot, fact_paths: dict[str, str], inertial_paths: dict[str, str], target: str,
+         how: dict, where: dict | None = None):
+    """Render one output file through the registered format ``name`` (robotkit.emit.FORMATS).
 
-    The robot descriptions (URDF, SDF, MJCF) are not written for a robot that their consumers
-    would refuse (a moving link without mass...): ConsumerError, naming the link (``where``:
-    link -> recipe location)."""
-    from robotkit.emit import CONSUMED, EMITTERS
-
-    full = robot if options.get("raw") else _finalized(robot, fact_paths, inertial_paths)
-    if emitter in CONSUMED:
-        from robotkit.errors import ConsumerError
-
+    ``how``: ``raw`` renders the resolved robot (else the robot finalized with the facts and
+    inertials), ``facts`` gives the render the mesh facts, ``meshes`` is the folder of the mesh files
+    whose vertices the format needs.  The robot descriptions (URDF, SDF, MJCF) are not written for a
+    robot that their consumers would refuse (a moving link without mass...): ConsumerError, naming the
+    link (``where``: link -> recipe location)."""
+    fmt = FORMATS[name]
+    full = robot if how.get("raw") else _finalized(robot, fact_paths, inertial_paths)
+    if fmt.consumed:
         problems = [Problem(msg, **(where or {}).get(link, {}))
-                    for link, msg, formats in full.consumer_problems() if emitter in formats]
+                    for link, msg, formats in full.consumer_problems() if name in formats]
         if problems:
             raise ConsumerError(problems)
-    if options.get("facts"):
-        options = dict(options, facts=read_facts(fact_paths))
-    if options.get("meshes"):  # the emitter measures the mesh files written beside it
-        options = dict(options, meshes=os.path.join(os.path.dirname(os.path.dirname(target)), "meshes"))
-    write_if_changed(target, EMITTERS[emitter](full, **options))
+    options = dict(fmt.options)
+    if how.get("facts"):
+        options["facts"] = read_facts(fact_paths)
+    if fmt.points is not None and how.get("meshes"):  # the vertices of the mesh files written beside it
+        options["points"] = {rel: read_vertices(os.path.join(how["meshes"], rel)) for rel in fmt.points(full)}
+    write_if_changed(target, fmt.render(full, **options))
 
 
 @_user_errors_fail
 def convert_mesh(source: str, target: str, scale=(1.0, 1.0, 1.0)):
     """A mesh in a format its consumers read (OBJ for collision, binary STL for MuJoCo's
     visuals), coordinates times ``scale``, byte-reproducible."""
-    from robotkit.mesh.export import obj_bytes, stl_bytes
-    from robotkit.mesh.io import load_mesh
-
     mesh = load_mesh(source, scale)
     write_if_changed(target, obj_bytes(mesh) if target.lower().endswith(".obj") else stl_bytes(mesh))
 
@@ -162,8 +156,6 @@ def convert_mesh(source: str, target: str, scale=(1.0, 1.0, 1.0)):
 @_user_errors_fail
 def copy_file(source: str, target: str):
     """Copy a file verbatim (visual meshes keep their format, colours and textures)."""
-    import os
-
     if os.path.exists(target) and _same_file(source, target):
         return
     tmp = target + ".tmp"
@@ -173,32 +165,24 @@ def copy_file(source: str, target: str):
 
 
 def _same_file(a: str, b: str) -> bool:
-    import filecmp
-
     return filecmp.cmp(a, b, shallow=False)
 
 
 @_user_errors_fail
 def world(map_yaml: str, out_dir: str, name: str, height: float, unknown_as_wall: bool, robot: dict | None = None):
     """One world from an occupancy map (robotkit.world), optionally with the robot placed in it."""
-    from robotkit.world import build_world
-
     build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall, robot=robot)
 
 
 def _cache():
-    from robotkit.mesh.cache import Cache
-    from robotkit.pipeline.distributed import run  # on a Dask cluster when one is configured
-
-    return Cache(run=run)
+    return Cache(run=run_distributed)
 
 
 @_user_errors_fail
 def process_visual(source: str, scale, decimate, repair: bool, where: dict, target: str, report: str):
     """A processed visual mesh: repaired and decimated, written as a binary STL in metres."""
+    # trimesh: loaded by these modules, only in the tasks that need it
     from robotkit.mesh.decimate import decimate as run_decimate, library
-    from robotkit.mesh.export import stl_bytes
-    from robotkit.mesh.io import load_mesh
     from robotkit.mesh.repair import repair as run_repair
 
     loc = Problem("", **where)
@@ -209,13 +193,13 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
     kind, value = decimate
     if kind == "none":  # only mirrored (load_mesh flipped the faces of a mirroring scale)
         write_if_changed(target, stl_bytes(mesh))
-        write_if_changed(report, dump_json(_plain(info)))
+        write_if_changed(report, dump_json(plain(info)))
         return
     faces = len(mesh.faces)
     target_faces = int(value) if kind == "faces" else max(4, int(round(faces * float(value))))
     if target_faces > faces:
         raise RobotkitError(Problem(f"decimation target {target_faces} faces is above the mesh's {faces} "
-                                    f"faces ('{_display(source)}')", **where))
+                                    f"faces ('{display_path(source)}')", **where))
 
     def compute():
         out, rep = run_decimate(mesh, target_faces=target_faces)
@@ -224,26 +208,14 @@ def process_visual(source: str, scale, decimate, repair: bool, where: dict, targ
     out, rep = _cache().get_or_compute("decimate/4", {"faces": target_faces, **library(), "samples": 4000,
                                                       "seed": 0, "report": True}, [mesh], compute)
     info["decimate"] = rep
-    from robotkit.mesh.export import stl_bytes
-
     write_if_changed(target, stl_bytes(out))
-    write_if_changed(report, dump_json(_plain(info)))
-
-
-def _plain(value):
-    from robotkit.mesh.cache import plain
-
-    return plain(value)
+    write_if_changed(report, dump_json(plain(info)))
 
 
 @_user_errors_fail
 def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: str, where: dict, target: str):
     """Collision pieces for one mesh and strategy (cached), their files, and a fidelity report."""
-    import os
-
-    from robotkit.mesh.export import obj_bytes
-    from robotkit.mesh.io import load_mesh
-    from robotkit.mesh.repair import repair as run_repair
+    from robotkit.mesh.repair import repair as run_repair  # trimesh: only in the tasks that need it
 
     loc = Problem("", **where)
     mesh = load_mesh(source, scale, loc)
@@ -255,7 +227,7 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
     try:
         pieces, fid = _proxy_pieces(mesh, kind, strategy, params)
     except (ValueError, RuntimeError) as exc:
-        raise RobotkitError(Problem(f"collision '{kind}' of '{_display(source)}' failed: {exc}", **where)) from None
+        raise RobotkitError(Problem(f"collision '{kind}' of '{display_path(source)}' failed: {exc}", **where)) from None
     out_pieces = []
     for i, piece in enumerate(pieces):
         if hasattr(piece, "vertices"):
@@ -268,12 +240,13 @@ def collision_proxy(source: str, scale, strategy: dict, stem: str, meshes_dir: s
             out_pieces.append({"kind": d["kind"], **d["params"], "xyz": list(d["xyz"]), "rpy": list(d["rpy"])})
     info["pieces"] = out_pieces
     info["fidelity"] = fid
-    write_if_changed(target, dump_json(_plain(info)))
+    write_if_changed(target, dump_json(plain(info)))
 
 
 def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
     """(pieces, fidelity report).  Mesh results and their report come from the cache: the
-    report's surface sampling costs as much as a hull."""
+    report's surface sampling costs as much as a hull.  (The mesh modules load trimesh: imported
+    here, in the tasks that need them.)"""
     from robotkit.mesh.fidelity import fidelity
 
     cache = _cache()
@@ -321,18 +294,12 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
 
 def publish_outputs(out_dir: str, robot: str, tasks: list[dict]):
     """``<robot>:publish`` (dodo.py): the robot's staged folders, published (robotkit.pipeline.publish)."""
-    from robotkit.pipeline.publish import publish, staged_files
-
     publish(out_dir, robot, staged_files(tasks, out_dir))
 
 
 @_user_errors_fail
 def picture_report(robot_dir: str, out_dir: str):
-    """report.html and its pictures (robotkit.picture; MuJoCo is imported here, in the task)."""
-    from pathlib import Path
-
-    from robotkit.picture import report_build_dir
-
+    """report.html and its pictures (robotkit.picture imports MuJoCo in the task)."""
     shutil.rmtree(out_dir, ignore_errors=True)  # the staged report folder: no picture of an earlier build stays
-    name = Path(robot_dir).name
-    report_build_dir(Path(robot_dir), Path(out_dir), f"../urdf/{name}.urdf")
+    urdf = Path(os.path.relpath(robot_layout(robot_dir).urdf, out_dir)).as_posix()  # ../urdf/<robot>.urdf
+    report_build_dir(Path(robot_dir), Path(out_dir), urdf)

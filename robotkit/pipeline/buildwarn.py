@@ -19,8 +19,11 @@ import os
 import re
 from pathlib import Path
 
+from robotkit.emit import layout
 from robotkit.errors import Problem
 from robotkit.model.plausible import DENSITY_RANGE, PART_SIZE_RANGE
+from robotkit.model.load import mesh_locations
+from robotkit.pipeline.publish import STATE
 
 WARNING = "warning: "
 _LINE = re.compile(r"^(?:(?P<file>.+?)(?::(?P<line>\d+))?: (?:(?P<key>[^\s:]+): )?)?warning: (?P<text>.*)$")
@@ -48,10 +51,7 @@ def build_warnings(robots, out: Path) -> list[tuple[str, str]]:
     (``file:line: key: warning: text``) as the command line prints it.  The mesh tasks' own
     warnings come first (shown on every build, not only the one that ran them), then the losses
     and the lints."""
-    from robotkit.model.load import mesh_locations
-    from robotkit.pipeline.publish import STATE
-
-    places = [(loaded, robot, mesh_locations(loaded, robot), _mesh_facts(out / STATE / robot.name / "mesh", robot))
+    places = [(loaded, robot, mesh_locations(loaded, robot), _mesh_facts(out / STATE / robot.name, robot))
               for loaded, robot in robots]
     pairs = []
     for loaded, robot, where, facts in places:
@@ -65,11 +65,12 @@ def build_warnings(robots, out: Path) -> list[tuple[str, str]]:
     return [(text, line) for line, text in seen.items()]
 
 
-def _mesh_facts(folder: Path, robot) -> dict[str, dict]:
+def _mesh_facts(state: Path, robot) -> dict[str, dict]:
+    """The facts the mesh tasks recorded (below the robot's ``state`` folder)."""
     out = {}
     for key in robot.meshes():
         try:
-            out[key] = json.loads((folder / f"{key}.json").read_text(encoding="utf-8"))
+            out[key] = json.loads((state / layout.RECORDS["mesh"].format(key=key)).read_text(encoding="utf-8"))
         except (OSError, ValueError):
             pass
     return out
@@ -95,7 +96,7 @@ def _losses(loaded, robot, out: Path, where: dict) -> list[tuple[str, str]]:
     """What each output format could not express (from the robot's report.json)."""
     names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF", "package": "ROS package"}
     try:
-        data = json.loads((out / robot.name / "report.json").read_text(encoding="utf-8"))
+        data = json.loads(layout.robot_layout(out / robot.name).report_json.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return []
     lines = []

@@ -27,6 +27,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from robotkit.errors import Problem, RobotkitError
+
 ENV = "ROBOTKIT_SCHEDULER"
 DASK_ENV = "DASK_SCHEDULER_ADDRESS"
 
@@ -55,8 +57,6 @@ def _get_client(address: str):
         try:
             from distributed import Client
         except ImportError:
-            from robotkit.errors import Problem, RobotkitError
-
             raise RobotkitError(Problem("--scheduler needs Dask: pip install 'robotkit[distributed]'")) from None
         _client = Client(address, timeout="30s", set_as_default=False)
         _client_pid = os.getpid()
@@ -73,8 +73,6 @@ def cluster_threads(address: str) -> int:
                              timeout=120, check=True).stdout
         return max(1, int(out.strip().splitlines()[-1]))
     except (subprocess.SubprocessError, ValueError, IndexError, OSError) as exc:
-        from robotkit.errors import Problem, RobotkitError
-
         raise RobotkitError(Problem(f"--scheduler {address}: cannot reach the Dask scheduler ({exc})")) from None
 
 
@@ -109,8 +107,6 @@ class LocalCluster:
                 time.sleep(0.1)
         if not self.address:
             self.__exit__(None, None, None)
-            from robotkit.errors import Problem, RobotkitError
-
             raise RobotkitError(Problem("--scheduler local: the Dask scheduler did not start"))
         self.procs.append(subprocess.Popen(
             [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nworkers", str(self.workers),

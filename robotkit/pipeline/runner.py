@@ -16,7 +16,19 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from doit.cmd_base import TaskLoader2
+from doit.doit_cmd import DoitMain
+from doit.exceptions import TaskFailed, UnmetDependency
+from doit.task import dict_to_task
+
+from robotkit.emit.env import template_dirs
 from robotkit.errors import Problem, RobotkitError
+from robotkit.model.load import load_robots, mesh_locations
+from robotkit.pipeline import stamp
+from robotkit.pipeline.buildwarn import build_warnings
+from robotkit.pipeline.progress import Progress
+from robotkit.pipeline.publish import STATE, publish, staged_files
+from robotkit.pipeline.tasks import robot_tasks
 
 
 @dataclass
@@ -38,8 +50,6 @@ class _Recorder:
     """A doit reporter that records instead of printing."""
 
     def __init__(self, result: BuildResult, echo=None, progress=None):
-        from robotkit.pipeline.progress import Progress
-
         self.result = result
         self.echo = echo
         # the progress line on a terminal (robotkit.pipeline.progress); quiet with echo or no stream
@@ -65,8 +75,6 @@ class _Recorder:
             self.progress.started(task.name)
 
     def add_failure(self, task, fail):
-        from doit.exceptions import TaskFailed, UnmetDependency
-
         self.progress.finished(task.name, ran=False)
         if isinstance(fail, UnmetDependency):
             self.not_written.add(task.name)
@@ -104,8 +112,6 @@ class _Recorder:
 
 
 def state_db(out_dir: Path) -> str:
-    from robotkit.pipeline.publish import STATE
-
     return str(out_dir / STATE / "doit.sqlite3")
 
 
@@ -145,59 +151,23 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     again when the build succeeds; ``stamp_options`` are the options it is kept under
     (default :func:`robotkit.pipeline.stamp.options` of the recipes and the output folder).
     """
-    from doit.cmd_base import TaskLoader2
-    from doit.doit_cmd import DoitMain
-    from doit.task import dict_to_task
-
-    from robotkit.pipeline import stamp
-
     if stamp_options is None:  # a build without the report is another build than one with it
         stamp_options = stamp.options(recipes, out_dir, None if report else {"no_report": True})
     stamp.remove(out_dir, stamp_options)
-
-    from robotkit.pipeline.buildwarn import build_warnings
-    from robotkit.model.load import load_robots, mesh_locations
-    from robotkit.pipeline.tasks import robot_tasks
-
     out = Path(out_dir).absolute()
     robots = load_robots(recipes, ros, args)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
-    tasks = []
-    for loaded, robot in robots:
-        tasks.extend(robot_tasks(robot, out, mesh_locations(loaded, robot), report=report))
-    (out / ".robotkit").mkdir(parents=True, exist_ok=True)
+    tasks = [t for loaded, robot in robots for t in robot_tasks(robot, out, mesh_locations(loaded, robot),
+                                                                 report=report)]
+    (out / STATE).mkdir(parents=True, exist_ok=True)
     recorder = _Recorder(result, echo, progress)
     inputs = _input_stats(robots, tasks)  # before running: an edit during the build is a change
-
-    class Loader(TaskLoader2):
-        def setup(self, opt_values):
-            pass
-
-        def load_doit_config(self):
-            return doit_config(out, recorder)
-
-        def load_tasks(self, cmd, pos_args):
-            return [dict_to_task(dict(t)) for t in tasks]
-
-    args = ["run"]
-    if jobs > 1:
-        args += ["-n", str(jobs), "-P", "process"]
-    try:
-        rc = DoitMain(Loader(), config_filenames=()).run(args)
-    finally:
-        recorder.progress.clear()  # no progress line left behind, whatever happened
+    rc = run_doit(tasks, out, recorder, jobs)
     if recorder.runtime_errors:
         result.errors.append(("doit", "\n".join(recorder.runtime_errors)))
     published = _publish(out, robots, tasks, result, recorder)
     if result.failed and not keep_going:
-        lines = []
-        for _, msg in result.failed:
-            for line in msg.splitlines():
-                if line not in lines:
-                    lines.append(line)
-        error = RobotkitError([Problem(line) for line in lines])
-        error.exit_status = result.exit_status or 2
-        raise error
+        raise _failure(result)
     if rc not in (0,) and not result.errors and not result.failed:
         result.errors.append(("doit", f"doit exited with status {rc}"))
     warnings = build_warnings(robots, out)  # (text, file:line: key: warning: text) pairs
@@ -212,13 +182,44 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     return result
 
 
+def run_doit(tasks: list[dict], out: Path, recorder: "_Recorder", jobs: int = 1) -> int:
+    """Run the task dicts through doit's API (its database in ``out``); doit's exit status."""
+    class Loader(TaskLoader2):
+        def setup(self, opt_values):
+            pass
+
+        def load_doit_config(self):
+            return doit_config(out, recorder)
+
+        def load_tasks(self, cmd, pos_args):
+            return [dict_to_task(dict(t)) for t in tasks]
+
+    args = ["run"]
+    if jobs > 1:
+        args += ["-n", str(jobs), "-P", "process"]
+    try:
+        return DoitMain(Loader(), config_filenames=()).run(args)
+    finally:
+        recorder.progress.clear()  # no progress line left behind, whatever happened
+
+
+def _failure(result: BuildResult) -> RobotkitError:
+    """The failed tasks' user errors as one error (each line once), with their exit status."""
+    lines = []
+    for _, msg in result.failed:
+        for line in msg.splitlines():
+            if line not in lines:
+                lines.append(line)
+    error = RobotkitError([Problem(line) for line in lines])
+    error.exit_status = result.exit_status or 2
+    return error
+
+
 def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder) -> list[str]:
     """Publish each robot whose tasks all succeeded (robotkit.pipeline.publish): a failed robot keeps its
     previous complete output.  A file a consumer would refuse (exit 1: the MJCF of a chain too
     deep for MuJoCo) is left out of an otherwise complete output, as the build says.
     Returns the published files."""
-    from robotkit.pipeline.publish import publish, staged_files
-
     if recorder.runtime_errors:
         return []
     owner = {f"world:{w.name}": robot.name for _, robot in robots for w in robot.worlds}
@@ -239,9 +240,6 @@ def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder
 
 def _input_stats(robots, tasks) -> dict:
     """Every file the build reads that no task writes, with its (size, mtime) now."""
-    from robotkit.pipeline import stamp
-    from robotkit.emit.env import template_dirs
-
     targets = {str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])}
     files = {str(Path(f).absolute()) for loaded, _ in robots for f in loaded.files}
     files |= {str(Path(f).absolute()) for task in tasks for f in task.get("file_dep", [])}

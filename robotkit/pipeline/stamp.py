@@ -26,6 +26,9 @@ import os
 import sys
 import zlib
 
+from robotkit import __version__
+from robotkit.pipeline.publish import STATE  # standard library only, as this module
+
 FORMAT = 1
 
 
@@ -44,12 +47,10 @@ def options(recipes, out_dir, extra: dict | None = None) -> dict:
 
 
 def path(out_dir, opts: dict) -> str:
-    return os.path.join(os.path.abspath(os.fspath(out_dir)), ".robotkit", f"stamp-{_key(opts)}.json")
+    return os.path.join(os.path.abspath(os.fspath(out_dir)), STATE, f"stamp-{_key(opts)}.json")
 
 
 def _versions() -> dict:
-    from robotkit import __version__
-
     return {"format": FORMAT, "robotkit": __version__, "python": sys.version}
 
 

@@ -2,68 +2,89 @@
 
 - ``<robot>:mesh:<key>``: load one mesh (file, scale, open-mesh policy), repair,
   record its unit-density mass properties as JSON (state folder);
-- ``<robot>:copy:<file>``: the visual mesh file into ``meshes/visual/``;
+- ``<robot>:collision:<key>``: the collision pieces of one proxy (hull, CoACD, primitives);
+- ``<robot>:visual:<file>``, ``<robot>:copy:<file>``, ``<robot>:convert:<file>``: the mesh files
+  below ``meshes/`` (processed, copied with their textures, converted for a format);
 - ``<robot>:inertial:<link>``: one link's inertial from its mesh facts;
-- ``<robot>:<output>``: one output file per registered emitter.
+- ``<robot>:<format>``: one output file per registered format (:data:`robotkit.emit.FORMATS`);
+- ``<robot>:report-html``, ``world:<world>``, ``<robot>:world:<world>``: the picture report, the worlds.
 
 Every task names its inputs (``file_dep``), outputs (``targets``) and the
 recipe values that matter (``config_changed``), so doit reruns exactly what
 an edit affects.  The same task list serves ``robotkit build`` and ``doit``
-(dodo.py).
+(dodo.py).  Every path comes from :mod:`robotkit.emit.layout`.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
-from dataclasses import asdict, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
+from typing import NamedTuple
 
+import yaml
 from doit.tools import config_changed
 
-from robotkit.pipeline import actions
-from robotkit.emit import TEMPLATES, ros
+from robotkit.emit import FORMATS, layout
 from robotkit.emit.env import template_dirs
+from robotkit.emit.formats import Format
+from robotkit.emit.meshfiles import conversions
+from robotkit.geometry import rpy_quat
+from robotkit.mesh.io import companions
 from robotkit.model.load import load_robots, mesh_locations
 from robotkit.model.robot import Robot
 from robotkit.paths import file_stem, out_join
+from robotkit.picture import VERSION as PICTURE_VERSION
+from robotkit.picture.page import TEMPLATE as PICTURE_TEMPLATE
+from robotkit.pipeline import actions
 from robotkit.pipeline.publish import STATE, stage_dir  # STATE: below the output folder, doit's database and JSON
+from robotkit.recipe.load import MAX_YAML_BYTES, yaml_limits
 
 
+@dataclass(frozen=True)
+class Place:
+    """Where one robot's tasks write: its staged folder (``root``, published by
+    :mod:`robotkit.pipeline.publish`) and its records (``state``); ``where`` maps a mesh key, and
+    ``link:<name>``, to the recipe location naming it (for messages)."""
 
-# emitter -> path below the robot folder
-OUTPUTS = {
-    "urdf": lambda r: f"urdf/{r.name}.urdf",
-    "xacro": lambda r: f"urdf/{r.name}.urdf.xacro",
-    "sdf": lambda r: "model.sdf",
-    "mjcf": lambda r: f"mjcf/{r.name}.xml",
-    "mjcf-scene": lambda r: "mjcf/scene.xml",
-    "report": lambda r: "report.json",
-    "model.config": lambda r: "model.config",
-    "package.xml": lambda r: "package.xml",
-    "CMakeLists.txt": lambda r: "CMakeLists.txt",
-    "env-hook": lambda r: ros.env_hook_path(r),
-    "display-launch": lambda r: ros.launch_path(r, "display"),
-    "gazebo-launch": lambda r: ros.launch_path(r, "gazebo"),
-    "rviz": lambda r: f"rviz/{r.name}.rviz",
-    "controllers": lambda r: "config/controllers.yaml",
-}
-# emitters that read only the robot's name and metadata (no geometry, no inertials)
-METADATA_ONLY = {"model.config", "mjcf-scene"}
-# emitters that read the robot's structure but no inertial or mesh fact
-STRUCTURE_ONLY = {"controllers"}
-# the ROS package files: the unfinalized robot (which folders, sensors, actuators, worlds, metadata)
-ROS_PACKAGE = {"package.xml", "CMakeLists.txt", "env-hook", "display-launch", "gazebo-launch"}
+    robot: Robot
+    root: Path
+    state: Path
+    where: dict
 
+    @classmethod
+    def of(cls, robot: Robot, out_dir: str | os.PathLike, where: dict | None = None) -> "Place":
+        out_dir = Path(out_dir).absolute()
+        return cls(robot, out_join(stage_dir(out_dir), robot.name, key="robot"), out_dir / STATE / robot.name,
+                   where or {})
 
-def _template_files(emitter: str) -> list[str]:
-    out = []
-    for name in TEMPLATES[emitter]:
-        for d in template_dirs():
-            p = Path(d) / name
-            if p.is_file():
-                out.append(str(p))
-                break
-    return out
+    def record(self, kind: str, key: str) -> str:
+        return str(self.state / layout.RECORDS[kind].format(key=key))
+
+    def out(self, template: str | dict) -> str:
+        """A file of the robot's folder (a template of robotkit.emit.layout)."""
+        return str(self.root / layout.output_path(template, self.robot.name, self.robot.ros))
+
+    def mesh(self, rel: str, folder: str = layout.MESHES) -> str:
+        """A mesh file ``rel`` below ``folder`` of the robot's folder."""
+        return str(self.root / folder / rel)
+
+    @property
+    def facts(self) -> dict[str, str]:
+        """Mesh key -> its mesh facts."""
+        return {key: self.record("mesh", key) for key in self.robot.meshes()}
+
+    @property
+    def proxies(self) -> dict[str, str]:
+        """Proxy key -> the record of its collision pieces."""
+        return {key: self.record("collision", key) for key in self.robot.proxies()}
+
+    @property
+    def inertials(self) -> dict[str, str]:
+        """Link -> its inertial, for the links whose inertial a task computes."""
+        return {link.name: self.record("inertial", file_stem(link.name)) for link in self.robot.links
+                if link.inertial_spec.mode in ("density", "mass", "estimate")}
 
 
 def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None,
@@ -73,53 +94,51 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     ``where`` maps a mesh key, and ``link:<name>``, to the recipe location naming it (for messages);
     ``report`` adds the picture report (``report/report.html``).
     """
-    where = where or {}
-    out_dir = Path(out_dir).absolute()
-    root = out_join(stage_dir(out_dir), robot.name, key="robot")  # published by robotkit.pipeline.publish
-    state = out_dir / STATE / robot.name
-    where = where or {}
-    tasks: list[dict] = []
+    place = Place.of(robot, out_dir, where)
+    meshes = mesh_tasks(place)
+    # collision pieces before the other mesh work: CoACD is the longest, and doit -j N hands
+    # out tasks in list order, so the slow ones start first and the quick ones fill in around them
+    collisions = collision_tasks(place)
+    files = visual_tasks(place) + copy_tasks(place) + convert_tasks(place)  # the mesh files below meshes/
+    textures = texture_tasks(place)
+    outputs = output_tasks(place, [t["targets"][0] for t in files])
+    tasks = meshes + collisions + files + textures + inertial_tasks(place) + outputs
+    if report:
+        tasks.append(report_task(place, collisions + files + textures, meshes))
+    return tasks + world_tasks(robot, out_dir)
 
-    facts: dict[str, str] = {}
+
+def mesh_tasks(place: Place) -> list[dict]:
+    """``<robot>:mesh:<key>``: a mesh's facts (mass properties, extent, repairs, warnings)."""
+    robot, tasks = place.robot, []
     for key, mesh in robot.meshes().items():
-        target = str(state / "mesh" / f"{key}.json")
-        facts[key] = target
+        target = place.record("mesh", key)
         tasks.append({
             "name": f"{robot.name}:mesh:{key}",
             "doc": f"mass properties of {os.path.basename(mesh.source)}",
             "actions": [(actions.mesh_facts, [mesh.source, list(mesh.scale), mesh.open_mesh,
-                                              where.get(key, {}), target])],
+                                              place.where.get(key, {}), target])],
             "file_dep": [mesh.source],
             "targets": [target],
             "uptodate": [config_changed({"scale": list(mesh.scale), "policy": mesh.open_mesh,
                                          "version": actions.FACTS_VERSION})],
             "clean": True,
         })
+    return tasks
 
-    mesh_outputs: list[str] = []  # mesh files written below meshes/ (the MJCF measures them)
-    copies: dict[str, tuple[str, list[str]]] = {}
-    processed: dict[str, object] = {}
-    shown = {g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link) if g.shape.kind == "mesh"}
-    for key, mesh in robot.meshes().items():
-        if key not in shown:  # only the source of collision pieces
-            continue
-        if mesh.processed:
-            processed.setdefault(mesh.path, mesh)
-            continue
-        copies.setdefault(mesh.file_name, (mesh.source, []))[1].append(facts[key])
-    # collision pieces before the other mesh work: CoACD is the longest, and doit -j N hands
-    # out tasks in list order, so the slow ones start first and the quick ones fill in around them
-    proxies: dict[str, str] = {}
+
+def collision_tasks(place: Place) -> list[dict]:
+    """``<robot>:collision:<key>``: one proxy's collision pieces, below ``meshes/collision/``."""
+    robot, facts, tasks = place.robot, place.facts, []
     for key, shape in robot.proxies().items():
         m = shape.mesh
-        target = str(state / "collision" / f"{key}.json")
-        proxies[key] = target
+        target = place.record("collision", key)
         stem = os.path.splitext(m.file_name)[0]
         tasks.append({
             "name": f"{robot.name}:collision:{key[len('proxy-'):]}",
             "doc": f"{shape.strategy.kind} collision of {os.path.basename(m.source)}",
             "actions": [(actions.collision_proxy, [m.source, list(m.scale), shape.strategy.params(), stem,
-                                                   str(root / "meshes" / "collision"), where.get(m.key, {}),
+                                                   place.out(layout.COLLISION_MESHES), place.where.get(m.key, {}),
                                                    target])],
             "file_dep": [m.source, facts[m.key]],
             "targets": [target],
@@ -127,32 +146,56 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
                                          "version": actions.FACTS_VERSION})],
             "clean": True,
         })
+    return tasks
+
+
+def shown_meshes(robot: Robot) -> set[str]:
+    """The keys of the meshes some geometry draws or collides with (not only a proxy's source)."""
+    return {g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link) if g.shape.kind == "mesh"}
+
+
+def visual_tasks(place: Place) -> list[dict]:
+    """``<robot>:visual:<file>``: a processed (decimated, repaired, mirrored) visual mesh."""
+    robot, facts, shown = place.robot, place.facts, shown_meshes(place.robot)
+    processed: dict[str, object] = {}
+    for key, mesh in robot.meshes().items():
+        if key in shown and mesh.processed:
+            processed.setdefault(mesh.path, mesh)
+    tasks = []
     for rel, mesh in sorted(processed.items()):
-        target = str(root / "meshes" / rel)
-        mesh_outputs.append(target)
-        visual_report = str(state / "visual" / f"{mesh.key}.json")
+        target = place.mesh(rel)
+        visual_report = place.record("visual", mesh.key)
         tasks.append({
             "name": f"{robot.name}:visual:{mesh.file_name}",
             "doc": f"processed visual mesh {mesh.file_name}",
             "actions": [(actions.process_visual, [mesh.source, list(mesh.scale), list(mesh.decimate), mesh.repair,
-                                                  where.get(mesh.key, {}), target, visual_report])],
+                                                  place.where.get(mesh.key, {}), target, visual_report])],
             "file_dep": [mesh.source, facts[mesh.key]],
             "targets": [target, visual_report],
             "uptodate": [config_changed({"scale": list(mesh.scale), "decimate": list(mesh.decimate),
                                          "repair": mesh.repair, "version": actions.FACTS_VERSION})],
             "clean": True,
         })
+    return tasks
 
-    from robotkit.mesh.io import companions
 
-    extras: dict[str, str] = {}  # textures and material files the copied meshes reference
-    for file_name, (source, checked) in sorted(copies.items()):
-        target = str(root / "meshes" / "visual" / file_name)
-        mesh_outputs.append(target)
-        for rel in companions(source):
-            extras.setdefault(rel, os.path.join(os.path.dirname(source), rel))
+def copied_meshes(place: Place) -> dict[str, tuple[str, list[str]]]:
+    """The visual mesh files copied verbatim: file name -> (source, the facts of its mesh tasks)."""
+    robot, facts, shown = place.robot, place.facts, shown_meshes(place.robot)
+    copies: dict[str, tuple[str, list[str]]] = {}
+    for key, mesh in robot.meshes().items():
+        if key in shown and not mesh.processed:
+            copies.setdefault(mesh.file_name, (mesh.source, []))[1].append(facts[key])
+    return copies
+
+
+def copy_tasks(place: Place) -> list[dict]:
+    """``<robot>:copy:<file>``: a visual mesh file copied verbatim into ``meshes/visual/``."""
+    tasks = []
+    for file_name, (source, checked) in sorted(copied_meshes(place).items()):
+        target = place.mesh(file_name, layout.VISUAL_MESHES)
         tasks.append({
-            "name": f"{robot.name}:copy:{file_name}",
+            "name": f"{place.robot.name}:copy:{file_name}",
             "doc": f"visual mesh {file_name}",
             "actions": [(actions.copy_file, [source, target])],
             # after its mesh tasks: a file that cannot be used is never copied
@@ -160,22 +203,34 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "targets": [target],
             "clean": True,
         })
+    return tasks
 
+
+def texture_tasks(place: Place) -> list[dict]:
+    """``<robot>:copy:<file>``: the textures and material files the copied meshes reference."""
+    extras: dict[str, str] = {}
+    for _, (source, _) in sorted(copied_meshes(place).items()):
+        for rel in companions(source):
+            extras.setdefault(rel, os.path.join(os.path.dirname(source), rel))
+    tasks = []
     for rel, source in sorted(extras.items()):
+        target = place.mesh(rel, layout.VISUAL_MESHES)
         tasks.append({
-            "name": f"{robot.name}:copy:{rel}",
+            "name": f"{place.robot.name}:copy:{rel}",
             "doc": f"texture or material file {rel}",
-            "actions": [(actions.copy_file, [source, str(root / "meshes" / "visual" / rel)])],
+            "actions": [(actions.copy_file, [source, target])],
             "file_dep": [source],
-            "targets": [str(root / "meshes" / "visual" / rel)],
+            "targets": [target],
             "clean": True,
         })
+    return tasks
 
-    from robotkit.emit.meshfiles import conversions
 
+def convert_tasks(place: Place) -> list[dict]:
+    """``<robot>:convert:<file>``: a mesh in the format an output needs (robotkit.emit.meshfiles)."""
+    robot, facts, tasks = place.robot, place.facts, []
     for rel, (source, scale) in conversions(robot).items():
-        target = str(root / "meshes" / rel)
-        mesh_outputs.append(target)
+        target = place.mesh(rel)
         checked = [facts[k] for k, m in robot.meshes().items() if m.source == source]
         tasks.append({
             "name": f"{robot.name}:convert:{rel}",
@@ -184,17 +239,20 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "targets": [target],
             "uptodate": [config_changed({"version": actions.FACTS_VERSION, "scale": list(scale)})],
             "clean": True,
-            "doc": f"meshes/{rel}",
+            "doc": f"{layout.MESHES}/{rel}",
         })
+    return tasks
 
-    inertials: dict[str, str] = {}
+
+def inertial_tasks(place: Place) -> list[dict]:
+    """``<robot>:inertial:<link>``: one link's inertial from the facts of its source geometry."""
+    robot, facts, tasks = place.robot, place.facts, []
     for link in robot.links:
-        if link.inertial_spec.mode not in ("density", "mass", "estimate"):
+        if link.name not in place.inertials:
             continue
         keys = sorted({g.shape.mesh.key for g in link.source_geoms() if g.shape.mesh is not None})
         deps = {k: facts[k] for k in keys}
-        target = str(state / "inertial" / f"{file_stem(link.name)}.json")
-        inertials[link.name] = target
+        target = place.inertials[link.name]
         tasks.append({
             "name": f"{robot.name}:inertial:{link.name}",
             "doc": f"inertial of link {link.name}",
@@ -204,131 +262,145 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
             "uptodate": [config_changed({"link": asdict(link), "version": actions.FACTS_VERSION})],
             "clean": True,
         })
+    return tasks
 
-    # outputs need the facts of recentered meshes (their offsets) and every inertial
+
+class Reading(NamedTuple):
+    """What an output's task gives its action and hashes, for one kind of ``reads``
+    (:data:`robotkit.emit.formats.READS`)."""
+
+    robot: Robot  # the robot its action renders (finalized there unless ``raw``)
+    config: dict  # the robot's values the output depends on (config_changed)
+    facts: dict[str, str]  # the mesh and collision records it reads
+    inertials: dict[str, str]  # the inertials it reads
+    raw: bool = False  # rendered from the resolved robot, not the finalized one
+    with_facts: bool = False  # the render gets the mesh facts (keyword facts)
+
+
+def readings(place: Place) -> dict[str, Reading]:
+    """Every kind of ``reads``, for this robot."""
+    robot, facts, proxies, inertials = place.robot, place.facts, place.proxies, place.inertials
+    structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
+    # the finalized robot needs the facts of recentered meshes (their offsets) and every inertial
     recentered = sorted({g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link)
                          if g.shape.mesh is not None and g.recenter != "none"})
-    out_facts = {**{k: facts[k] for k in recentered}, **proxies}
-    structure = {k: v for k, v in robot.to_dict().items() if k != "worlds"}
-    options = {"model.config": {"sdf": "model.sdf"}, "report": {"facts": True}, "controllers": {"raw": True},
-               "mjcf": {"meshes": True}, "rviz": {"raw": True, "facts": True},
-               **{e: {"raw": True} for e in ROS_PACKAGE}}
-    for emitter, rel in OUTPUTS.items():
-        if emitter == "controllers" and not robot.actuators:
-            continue
-        target = str(root / rel(robot))
-        opts = options.get(emitter, {})
-        if emitter == "report":
-            subject, reads, facts_in, inertials_in = robot, structure, {**facts, **proxies}, inertials
-        elif emitter == "rviz":  # the visual geometry's extent, the sensors' topics: no inertial
-            subject, facts_in, inertials_in = robot, {k: facts[k] for k in shown if k in facts}, {}
-            reads = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
-                                            for link in structure["links"]]}
-        elif emitter in ROS_PACKAGE:
-            subject, facts_in, inertials_in = robot, {}, {}
-            reads = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators")}
-            reads.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds],
-                         meshes=bool(robot.meshes()))
-        elif emitter in STRUCTURE_ONLY:
-            subject, facts_in, inertials_in = robot, {}, {}
-            reads = {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,
-                     "actuators": [asdict(a) for a in robot.actuators]}
-        elif emitter in METADATA_ONLY:
-            subject = replace(robot, links=(), joints=(), materials=())
-            reads: dict = {"name": robot.name, "metadata": asdict(robot.metadata)}
-            facts_in, inertials_in = {}, {}
-        else:
-            subject, reads, facts_in, inertials_in = robot, structure, out_facts, inertials
-        tasks.append({
-            "name": f"{robot.name}:{emitter}",
-            "doc": f"{rel(robot)}",
-            "actions": [(actions.emit, [emitter, subject, facts_in, inertials_in, target, opts,
-                                        {k[5:]: v for k, v in where.items() if k.startswith("link:")}])],
-            "file_dep": list(facts_in.values()) + list(inertials_in.values()) + _template_files(emitter)
-            + (mesh_outputs if opts.get("meshes") else []),
-            "targets": [target],
-            "uptodate": [config_changed({"robot": reads, "options": opts})],
-            # no output is written while any mesh of the robot fails
-            "task_dep": [f"{robot.name}:mesh:{k}" for k in facts],
-            "clean": True,
-        })
-    if report:
-        tasks.append(report_task(robot, root, tasks))
-    return tasks + world_tasks(robot, out_dir)
-
-
-REPORT = "report/report.html"  # the picture report, below the robot folder
-
-
-def report_task(robot: Robot, root: Path, tasks: list[dict]) -> dict:
-    """``<robot>:report-html``: report.html and its pictures, from the written URDF, MJCF,
-    report.json and every mesh file MuJoCo reads (rendering imports stay in the action)."""
-    from robotkit.picture import VERSION
-    from robotkit.picture.page import TEMPLATE
-
-    inputs = [str(root / OUTPUTS[e](robot)) for e in ("urdf", "mjcf", "report")]
-    for t in tasks:  # the meshes the MJCF draws, and the collision pieces' records
-        kind = t["name"].split(":")[1]
-        if kind in ("copy", "visual", "convert", "collision"):
-            inputs += t["targets"]
-    template = [p for d in template_dirs() if (p := Path(d) / TEMPLATE).is_file()][:1]
+    package = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators")}
+    package.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds], meshes=bool(robot.meshes()))
+    no_inertials = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
+                                           for link in structure["links"]]}
     return {
-        "name": f"{robot.name}:report-html",
-        "doc": REPORT,
-        "actions": [(actions.picture_report, [str(root), str(root / "report")])],
-        "file_dep": inputs + [str(p) for p in template],
-        "targets": [str(root / REPORT)],
-        "uptodate": [config_changed({"version": VERSION})],
-        "task_dep": [t["name"] for t in tasks if ":mesh:" in t["name"]],
+        "robot": Reading(robot, structure, {**{k: facts[k] for k in recentered}, **proxies}, inertials),
+        "summary": Reading(robot, structure, {**facts, **proxies}, inertials, with_facts=True),
+        # the visual geometry's extent, the sensors' topics: no inertial
+        "rviz": Reading(robot, no_inertials, {k: facts[k] for k in shown_meshes(robot) if k in facts}, {},
+                        raw=True, with_facts=True),
+        "ros-package": Reading(robot, package, {}, {}, raw=True),
+        "structure": Reading(robot, {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,
+                                     "actuators": [asdict(a) for a in robot.actuators]}, {}, {}, raw=True),
+        "metadata": Reading(replace(robot, links=(), joints=(), materials=()),
+                            {"name": robot.name, "metadata": asdict(robot.metadata)}, {}, {}),
+    }
+
+
+def output_tasks(place: Place, written: list[str]) -> list[dict]:
+    """``<robot>:<format>``: one output file per registered format the robot wants; ``written``:
+    the mesh files below ``meshes/`` (a format that measures them waits for them)."""
+    reads = readings(place)
+    return [output_task(place, fmt, reads[fmt.reads], written) for fmt in FORMATS.values() if fmt.wanted(place.robot)]
+
+
+def output_task(place: Place, fmt: Format, reading: Reading, written: list[str]) -> dict:
+    robot = place.robot
+    target = place.out(fmt.path)
+    how = {"raw": reading.raw, "facts": reading.with_facts,
+           "meshes": place.out(layout.MESHES) if fmt.points is not None else None}
+    options = {**fmt.options, **{k: True for k, v in how.items() if v}}  # hashed with the robot's values
+    return {
+        "name": f"{robot.name}:{fmt.name}",
+        "doc": layout.output_path(fmt.path, robot.name, robot.ros),
+        "actions": [(actions.emit, [fmt.name, reading.robot, reading.facts, reading.inertials, target, how,
+                                    {k[5:]: v for k, v in place.where.items() if k.startswith("link:")}])],
+        "file_dep": list(reading.facts.values()) + list(reading.inertials.values()) + template_files(fmt.templates)
+        + (written if fmt.points is not None else []),
+        "targets": [target],
+        "uptodate": [config_changed({"robot": reading.config, "options": options})],
+        # no output is written while any mesh of the robot fails
+        "task_dep": [f"{robot.name}:mesh:{k}" for k in place.facts],
+        "clean": True,
+    }
+
+
+def template_files(names) -> list[str]:
+    """The files of the templates ``names``, each where the template search path finds it first."""
+    out = []
+    for name in names:
+        for d in template_dirs():
+            p = Path(d) / name
+            if p.is_file():
+                out.append(str(p))
+                break
+    return out
+
+
+def report_task(place: Place, drawn: list[dict], meshes: list[dict]) -> dict:
+    """``<robot>:report-html``: report.html and its pictures, from the written URDF, MJCF,
+    report.json and every mesh file MuJoCo reads (the targets of ``drawn``: the meshes the MJCF
+    draws and the collision pieces' records), after the ``meshes`` tasks (rendering imports stay
+    in the action)."""
+    built = layout.RobotLayout(place.root)
+    inputs = [str(built.urdf), str(built.mjcf), str(built.report_json)]
+    inputs += [target for t in drawn for target in t["targets"]]
+    return {
+        "name": f"{place.robot.name}:report-html",
+        "doc": layout.REPORT_HTML,
+        "actions": [(actions.picture_report, [str(place.root), str(built.pictures)])],
+        "file_dep": inputs + template_files([PICTURE_TEMPLATE]),
+        "targets": [str(built.report_html)],
+        "uptodate": [config_changed({"version": PICTURE_VERSION})],
+        "task_dep": [t["name"] for t in meshes],
         "clean": True,
     }
 
 
 def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
-    """One task per world of the recipe: OUT/<world>/ with its five files."""
+    """Two tasks per world of the recipe: OUT/<world>/ with its five files (the robot placed at
+    its spawn pose), and the same world without the robot in the package's worlds/ (launch/gazebo
+    spawns it)."""
     out_dir = stage_dir(out_dir)  # published by robotkit.pipeline.publish with the robot
+    pkg = out_dir / robot.name / layout.WORLDS
     tasks = []
     for w in robot.worlds:
         root = out_join(out_dir, w.name, key=f"worlds.{w.name}")
-        targets = [root / "model.config", root / "model.sdf", root / "meshes" / f"{w.name}.stl",
-                   root / f"{w.name}.world", root / "scene.xml"]
+        targets = [root / f.format(name=w.name) for f in layout.WORLD_FILES]
         spawn = None
         if w.spawn is not None:
-            from robotkit.geometry import rpy_quat
-
             spawn = {"name": robot.name, "root": robot.root, "xyz": list(w.spawn.xyz), "rpy": list(w.spawn.rpy),
                      "quat": list(rpy_quat(w.spawn.rpy))}
+        deps = [w.map] + map_image(w.map)
+        config = {"height": w.height, "unknown_as_wall": w.unknown_as_wall}
         tasks.append({
             "name": f"world:{w.name}",
             "doc": f"world {w.name} from {os.path.basename(w.map)}",
             "actions": [(actions.world, [w.map, str(out_dir), w.name, w.height, w.unknown_as_wall, spawn])],
-            "file_dep": [w.map] + _map_image(w.map),
+            "file_dep": deps,
             "targets": [str(t) for t in targets],
-            "uptodate": [config_changed({"height": w.height, "unknown_as_wall": w.unknown_as_wall,
-                                         "spawn": spawn, "templates": _world_templates()})],
+            "uptodate": [config_changed({**config, "spawn": spawn, "templates": world_templates()})],
             "clean": True,
         })
-        # the same world, without the robot (launch/gazebo spawns it), in the ROS package's worlds/
-        pkg = out_dir / robot.name / "worlds"
         tasks.append({
             "name": f"{robot.name}:world:{w.name}",
-            "doc": f"worlds/{w.name}/ of package {robot.name}",
+            "doc": f"{layout.WORLDS}/{w.name}/ of package {robot.name}",
             "actions": [(actions.world, [w.map, str(pkg), w.name, w.height, w.unknown_as_wall, None])],
-            "file_dep": [w.map] + _map_image(w.map),
+            "file_dep": deps,
             "targets": [str(pkg / t.relative_to(root.parent)) for t in targets],
-            "uptodate": [config_changed({"height": w.height, "unknown_as_wall": w.unknown_as_wall,
-                                         "templates": _world_templates()})],
+            "uptodate": [config_changed({**config, "templates": world_templates()})],
             "clean": True,
         })
     return tasks
 
 
-def _map_image(map_yaml: str) -> list[str]:
+def map_image(map_yaml: str) -> list[str]:
     """The image a map YAML names (cheap: the YAML only), when it exists; the task reports the rest."""
-    import yaml
-
-    from robotkit.recipe.load import MAX_YAML_BYTES, yaml_limits
-
     try:
         if os.path.getsize(map_yaml) > MAX_YAML_BYTES:
             return []
@@ -343,15 +415,14 @@ def _map_image(map_yaml: str) -> list[str]:
     return [str(path)] if image and path.is_file() else []
 
 
-def _world_templates() -> list[str]:
+def world_templates() -> list[str]:
+    """A digest of the world templates (their edits rebuild the worlds)."""
     out = []
     for d in template_dirs():
         for p in sorted((Path(d) / "world").glob("*.j2")):
             out.append(p.read_text(encoding="utf-8"))
         if out:
             break
-    import hashlib
-
     return [hashlib.sha1("".join(out).encode()).hexdigest()]
 
 

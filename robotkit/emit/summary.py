@@ -1,4 +1,4 @@
-"""The build report (``report.json``): what each format could not express, what each program
+"""The build's summary (``report.json``): what each format could not express, what each program
 that loads the outputs will see, and the mesh facts.
 
 Nothing is lost silently: every loss is listed here per format and printed as a warning
@@ -7,12 +7,16 @@ on every build.
 
 from __future__ import annotations
 
+import json
+
+from robotkit.emit import layout, mjcf, ros, sdf
+from robotkit.emit.formats import Format
+from robotkit.emit.sensors import host_of
+from robotkit.emit.urdf import massless_mass, typed_transmissions
 from robotkit.model.robot import Robot
 
 
 def urdf_losses(robot: Robot) -> list[str]:
-    from robotkit.emit.urdf import typed_transmissions
-
     out = []
     for j in robot.joints:
         if j.dynamics is not None and j.dynamics.armature:
@@ -25,18 +29,12 @@ def urdf_losses(robot: Robot) -> list[str]:
 
 
 def losses(robot: Robot, facts: dict) -> dict[str, list[str]]:
-    from robotkit.emit import mjcf, ros, sdf
-
     return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts),
             "package": ros.losses(robot)}
 
 
 def consumers(robot: Robot) -> dict:
     """What each program will see, from the model alone (``robotkit check`` loads them all)."""
-    from robotkit.emit import sdf
-    from robotkit.emit.sensors import host_of
-    from robotkit.emit.urdf import massless_mass
-
     parent = {j.child: j for j in robot.joints}
 
     def lumped_into(name: str) -> str:  # libsdformat and Pinocchio merge fixed joints
@@ -61,7 +59,8 @@ def consumers(robot: Robot) -> dict:
     }
 
 
-def report(robot: Robot, facts: dict) -> dict:
+def summary(robot: Robot, facts: dict) -> dict:
+    """The content of ``report.json``: losses, consumers, mesh facts, inertials, collision pieces."""
     meshes = {}
     for key, f in sorted(facts.items()):
         meshes[key] = {k: f[k] for k in ("source", "faces", "volume", "used", "repairs", "convex") if k in f}
@@ -78,3 +77,10 @@ def report(robot: Robot, facts: dict) -> dict:
     meshes = {k: v for k, v in meshes.items() if k not in collision}
     return {"robot": robot.name, "losses": losses(robot, facts), "consumers": consumers(robot), "meshes": meshes,
             "inertials": links, "collision": collision}
+
+
+def render_summary(robot: Robot, facts: dict | None = None) -> str:
+    return json.dumps(summary(robot, facts or {}), indent=1, sort_keys=True) + "\n"
+
+
+FORMATS = [Format("report", render_summary, layout.SUMMARY, reads="summary")]
