@@ -1,6 +1,6 @@
 """Run by Debian's /usr/bin/python3 (rospy, tf2_ros) while `roslaunch <robot> display.launch` runs:
 prints, as JSON, /robot_description, one /joint_states message and every link's transform
-from the root link (tf2_ros.Buffer; Debian's `tf_echo` is broken, LIBRARIES.md section 10).
+from the root link (tf2_ros.Buffer; Debian's `tf_echo` is broken, docs/libraries.md, section 10).
 
     python3 ros1_probe.py ROOT LINK... > result.json
 """

@@ -43,7 +43,7 @@ def _assets():
 
 def xacro_reference(path: Path, packages: dict[str, str], args: dict[str, str], out: Path) -> Path:
     """The xacro package's own expansion (not robotkit's code), with the documented
-    $(find) patch (LIBRARIES.md section 2), as a URDF file."""
+    $(find) patch (docs/libraries.md, section 2), as a URDF file."""
     import xacro
     import xacro.substitution_args as sa
 

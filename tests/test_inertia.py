@@ -70,7 +70,7 @@ def test_off_centre_mesh_gives_parallel_axis_result():
     np.testing.assert_allclose(p.com, [5.0, -1.0, 2.0], rtol=1e-14)
     # about the centre of mass: unchanged by the translation
     np.testing.assert_allclose(p.inertia, box_props([1, 2, 3]).inertia, rtol=1e-12, atol=1e-12)
-    # about the origin: parallel-axis theorem (LIBRARIES.md: diag 6.5, 5, 2.5 for the unit-density box at x=5 is
+    # about the origin: parallel-axis theorem (docs/libraries.md: diag 6.5, 5, 2.5 for the unit-density box at x=5 is
     # about the COM; here we add m (|r|^2 I - r r^T))
     r = np.array([5.0, -1.0, 2.0])
     about_origin = p.inertia + p.volume * (r @ r * np.eye(3) - np.outer(r, r))

@@ -31,7 +31,7 @@ def check_urdf(path: str | Path) -> str:
     exe = require("check_urdf")
     proc = subprocess.run([exe, str(path)], capture_output=True, text=True)
     out = proc.stdout + proc.stderr
-    # check_urdf may print "Error" and still exit 0 (LIBRARIES.md section 8)
+    # check_urdf may print "Error" and still exit 0 (docs/libraries.md, section 8)
     assert proc.returncode == 0 and "Error" not in out, f"check_urdf rejected {path}:\n{out}"
     return out
 

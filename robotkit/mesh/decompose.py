@@ -4,7 +4,7 @@ CoACD (``coacd.run_coacd``) is called with its console output switched off
 (``coacd.set_log_level("off")``: its C++ logger writes about 2 KB per call
 to file descriptor 1, which ``contextlib.redirect_stdout`` cannot catch).
 The same input, parameters and ``seed`` give the same pieces, whatever the
-number of OpenMP threads (LIBRARIES.md section 5).
+number of OpenMP threads (docs/libraries.md, section 5).
 
 Each piece CoACD returns is replaced by its convex hull
 (:func:`robotkit.mesh.hull.convex_hull`: closed, outward, canonical order)

@@ -1,7 +1,7 @@
 """Byte-reproducible mesh files: binary STL and OBJ.
 
 Both writers are hand-written (trimesh's exporters also give identical bytes
-across runs today, LIBRARIES.md section 3, but their headers and number
+across runs today, docs/libraries.md, section 3, but their headers and number
 formatting belong to trimesh and can change with its version; these bytes
 depend only on the geometry):
 

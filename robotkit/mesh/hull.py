@@ -1,7 +1,7 @@
 """Convex hulls with an optional vertex budget.
 
 The exact hull is manifold3d's ``Manifold.hull_points`` of the mesh vertices
-(LIBRARIES.md section 4: 0.6-0.8 s on a 500k-face mesh, where
+(docs/libraries.md, section 4: 0.6-0.8 s on a 500k-face mesh, where
 ``trimesh.Trimesh.convex_hull`` takes 4.4 s in its post-processing).
 
 **Vertex budget.**  When the exact hull has more than ``max_vertices``

@@ -1,7 +1,7 @@
 """Loading mesh files, and making them closed volumes for mass properties.
 
 trimesh returns wrong mass properties without a warning for meshes that are
-not closed, consistently wound volumes (LIBRARIES.md section 3), so every mesh
+not closed, consistently wound volumes (docs/libraries.md, section 3), so every mesh
 used for an inertial goes through :func:`volume_mesh`: safe repairs first,
 then the recipe's policy (convex hull with a warning, or an error).
 """

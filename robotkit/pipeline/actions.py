@@ -1,6 +1,6 @@
 """doit task actions: module-level functions with picklable arguments.
 
-They run in worker processes under ``-j N`` (LIBRARIES.md section 6), so
+They run in worker processes under ``-j N`` (docs/libraries.md, section 6), so
 every input arrives as plain data and every output is written atomically.
 A user error becomes a failed task whose message is the problem lines; the
 build turns those into exit status 2.
