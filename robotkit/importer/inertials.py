@@ -6,10 +6,9 @@ the reason, for the recipe's comments), and the report of ``--recompute-inertial
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from robotkit.importer.parsing import _Problems, _float, _origin
+from robotkit.importer.parsing import Problems, read_float, read_origin
 from robotkit.importer.recipe_writer import fmt
 from robotkit.model import inertia_policy
 
@@ -29,17 +28,17 @@ def no_inertial_form():
     return None
 
 
-def _inertial(el: ET.Element, link: str, problems: _Problems) -> dict | None:
+def read_inertial(el, link: str, problems: Problems) -> dict | None:
     what = f"link '{link}' inertial"
     mass_el = el.find("mass")
-    mass = _float(mass_el.get("value") if mass_el is not None else None, f"{what} mass", problems, 0.0)
-    xyz, rpy = _origin(el.find("origin"), what, problems)
+    mass = read_float(mass_el.get("value") if mass_el is not None else None, f"{what} mass", problems, 0.0)
+    xyz, rpy = read_origin(el.find("origin"), what, problems)
     t = el.find("inertia")
     keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
     values = {k: 0.0 for k in keys}
     if t is not None:
         for k in keys:
-            v = _float(t.get(k), f"{what} {k}", problems, 0.0)
+            v = read_float(t.get(k), f"{what} {k}", problems, 0.0)
             values[k] = v if v is not None else 0.0
     if any(rpy):
         import numpy as np
@@ -123,7 +122,7 @@ POINT_MASS_FLOOR = 1e-5
 """kg: the least point mass import gives a link without one (libsdformat drops a link of 1e-6 kg)."""
 
 
-def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out) -> None:
+def give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out) -> None:
     """A link the build refuses or SDF misreads for having no mass (it moves, it is a root
     with moving joints below it and no mass welded to it, or it has moving joints or mass below
     it: libsdformat drops such a link with its subtree) gets one: computed from its geometry at the
@@ -234,7 +233,7 @@ def _facts(mesh) -> dict:
             "bbox_min": [float(v) for v in bbox_min], "bbox_max": [float(v) for v in bbox_max]}
 
 
-def _report_recomputed(recipe_file: Path, conv, result) -> None:
+def report_recomputed(recipe_file: Path, conv, result) -> None:
     import numpy as np
 
     from robotkit.model.resolve import finalize_link_inertial

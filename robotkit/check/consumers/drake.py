@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from robotkit import urdfxml
 from robotkit.check.consumers import Missing, Refused, Unreadable, View, listed, with_mesh_paths
 
 
@@ -58,14 +59,11 @@ def _load(build, path) -> View:
 
 def _unnamed(path) -> bool:
     """A URDF whose robot name is empty (checked before Drake, which aborts the process on it)."""
-    import xml.etree.ElementTree as ET
-
     try:
-        for _, el in ET.iterparse(str(path), events=("start",)):
-            return el.tag == "robot" and not el.get("name")
-    except ET.ParseError:
+        root = urdfxml.parse_file(path).getroot()
+    except urdfxml.MalformedXML:
         return False  # Drake's parser names the problem
-    return False
+    return root.tag == "robot" and not root.get("name")
 
 
 DRAKE_MESHES = (".obj", ".vtk", ".gltf")
