@@ -9,8 +9,9 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from robotkit.errors import display_path
+from robotkit.errors import MeshError, display_path
 from robotkit.importer.parsing import Problems
+from robotkit.mesh.io import load_mesh, volume_mesh
 
 MESH_FORMATS = (".stl", ".obj", ".dae")
 
@@ -90,9 +91,6 @@ _CLOSED: dict[tuple, bool] = {}
 
 def mesh_is_closed(source: str, scale) -> bool:
     """Whether robotkit's mesh task accepts the mesh without ``open_mesh: hull``."""
-    from robotkit.errors import MeshError
-    from robotkit.mesh.io import load_mesh, volume_mesh
-
     st = os.stat(source)
     key = (source, tuple(scale), st.st_mtime_ns, st.st_size)
     if key not in _CLOSED:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import re
 
-from robotkit.recipe.schema import FRAME_NAME_RE, NAME_RE
+from robotkit.recipe.schema import FRAME_NAME_HINT, FRAME_NAME_RE, NAME_RE
 
 
 def valid_name(name: str | None) -> bool:
@@ -29,6 +29,4 @@ def material_name(name: str, taken: set[str]) -> str:
 
 
 def name_hint() -> str:
-    from robotkit.recipe.schema import FRAME_NAME_HINT
-
     return FRAME_NAME_HINT
