@@ -1,8 +1,9 @@
 """The one reader of URDF XML: a file or a text into an lxml element tree with source lines.
 
-Hardened for descriptions from anywhere: no entity is expanded (no "billion laughs"), nothing
-is fetched from the network, no DTD is loaded, and libxml2's size and depth limits stay on
-(``huge_tree`` off).  Any declared XML version is accepted, as urdfdom (TinyXML2) accepts it:
+Hardened for descriptions from anywhere: entities in text are not expanded (libxml2 expands
+them in attribute values only, under its amplification limit, which refuses a "billion laughs"),
+nothing is fetched from the network, no DTD is loaded, and libxml2's size and depth limits stay
+on (``huge_tree`` off).  Any declared XML version is accepted, as urdfdom (TinyXML2) accepts it:
 PyBullet's humanoid says ``version="0.0"``, which libxml2 alone refuses.
 
 A text is read as text (its declared encoding is ignored, as Python's own XML readers do for a
