@@ -24,7 +24,7 @@ import yaml
 from robotkit.pipeline.runner import build
 from robotkit.errors import RobotkitError
 from robotkit.importer import import_file
-from robotkit.importer.urdf_to_recipe import no_inertial_form
+from robotkit.importer.inertials import no_inertial_form
 from robotkit.check.kinematics import KModel, compare, read_urdf
 from tests.validators import check_urdf, mujoco
 

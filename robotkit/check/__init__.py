@@ -14,6 +14,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import replace
 from pathlib import Path
 
+from robotkit import urdfxml
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.equivalence import equivalence
 from robotkit.check.findings import Finding
@@ -93,13 +94,9 @@ def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, 
 
 def urdf_tree(path: Path) -> tuple[dict[str, int], list[Finding]]:
     """(subject -> line of each ``<link>`` and ``<joint>``, findings on the kinematic tree)."""
-    from lxml import etree
-
-    from robotkit.check.consumers import parse_urdf
-
     try:
-        root = parse_urdf(path).getroot()
-    except (etree.XMLSyntaxError, OSError) as exc:
+        root = urdfxml.parse_file(path).getroot()
+    except (urdfxml.MalformedXML, OSError) as exc:
         raise RobotkitError(Problem(f"not well-formed XML: {exc}", file=str(path))) from None
     lines = {f"{e.tag} '{e.get('name')}'": e.sourceline for e in root if e.tag in ("link", "joint")}
     links = {e.get("name") for e in root.iter("link") if e.getparent() is root}

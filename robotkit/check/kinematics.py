@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from robotkit import urdfxml
+
 WORLD = "world"
 NEGLIGIBLE = 1e-200  # kg: robotkit's URDF writes massless links as 1e-300 kg (see emit/urdf.py)
 
@@ -200,7 +202,7 @@ def read_urdf(path) -> KModel:
                  'inertiafromgeom="false"/></mujoco>')
     text = re.sub(r"(<robot[^>]*>)", r"\1" + extension, text, count=1)
     model = from_mujoco(mujoco.MjModel.from_xml_string(text), f"URDF {path} (MuJoCo)")
-    root = ET.fromstring(text)
+    root = urdfxml.parse_text(text).getroot()
     for j in root.iter("joint"):
         name = j.get("name")
         limit = j.find("limit")

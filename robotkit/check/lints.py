@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import math
 import os
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from robotkit import urdfxml
 from robotkit.check.findings import Finding
 from robotkit.check.kinematics import NEGLIGIBLE
 from robotkit.errors import Problem, RobotkitError
@@ -196,9 +196,9 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
                     text: str | None = None) -> tuple[list[LinkFacts], list[JointFacts], list[Finding]]:
     package_paths = package_paths or {}
     try:
-        root = ET.fromstring(text if text is not None else path.read_text(encoding="utf-8"))
-    except ET.ParseError as exc:
-        raise RobotkitError(Problem(f"not well-formed XML: {exc}", file=str(path))) from None
+        root = urdfxml.parse_text(text if text is not None else path.read_text(encoding="utf-8")).getroot()
+    except urdfxml.MalformedXML as exc:  # in the words of expat, which read it before lxml
+        raise RobotkitError(Problem(f"not well-formed XML: {exc.expat or exc}", file=str(path))) from None
     if root.tag != "robot":
         raise RobotkitError(Problem(f"not a URDF (the root element is <{root.tag}>, not <robot>)", file=str(path)))
     problems: list[Finding] = []

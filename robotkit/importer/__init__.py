@@ -11,12 +11,26 @@ input has problems (RobotkitError, one line each).
 
 from __future__ import annotations
 
+import filecmp
 import os
 import shutil
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from pydantic import ValidationError
+
+from robotkit import urdfxml
 from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.importer.defaults import factor_defaults
+from robotkit.importer.inertials import POLICIES, report_recomputed
+from robotkit.importer.meshes import mark_open_meshes
+from robotkit.importer.package_xml import package_metadata, with_own_package
+from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
+from robotkit.importer.urdf_to_recipe import Converted, urdf_to_recipe
+from robotkit.importer.xacro_expand import check_package_paths, expand
+from robotkit.model.load import load_robots
+from robotkit.paths import inside, recipe_policy, widened
+from robotkit.recipe.schema import Recipe
 
 XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro", "http://wiki.ros.org/xacro")
 
@@ -56,8 +70,6 @@ class Read:
 
 
 def _read_xacro(source: Path, raw: str, packages: dict[str, str], args: dict[str, str]) -> Read:
-    from robotkit.importer.xacro_expand import expand
-
     expanded = expand(source, packages, args)
     return Read(expanded.text, list(expanded.includes), list(expanded.warnings))
 
@@ -91,15 +103,6 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     ``copy_meshes`` copies the meshes below the recipe's folder (``meshes/``) instead of
     referencing them where they are.
     """
-    from robotkit.importer.defaults import factor_defaults
-    from robotkit.importer.meshes import _open_meshes
-    from robotkit.importer.package_xml import package_metadata, with_own_package
-    from robotkit.importer.recipe_writer import name_mesh_folders
-    from robotkit.importer.urdf_to_recipe import dump_recipe, urdf_to_recipe
-    from robotkit.importer.xacro_expand import check_package_paths
-
-    from robotkit.importer.inertials import POLICIES
-
     if inertia_policy not in POLICIES:
         raise RobotkitError(Problem(f"inertia policy '{inertia_policy}' is not one of {', '.join(POLICIES)}"))
     if density is not None and not density > 0:
@@ -107,24 +110,43 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     source = Path(path).absolute()
     out = Path(out_recipe).absolute()
     packages = with_own_package(source, check_package_paths(package_paths or {}))
+    raw = _read_input(source)
+    read = next(reader for accepts, reader in READERS.values() if accepts(source, raw))
+    got = read(source, raw, packages, args or {})
+    warnings, inputs = list(got.warnings), [str(source), *got.includes]
+    conv = urdf_to_recipe(got.urdf, source, out, packages, copy_meshes=copy_meshes,
+                          recompute_inertials=recompute_inertials, density=density, inertia_policy=inertia_policy)
+    warnings.extend(conv.warnings)
+    inputs.extend(sorted({m.source for m in conv.meshes.values()}))
+    recipe = _finished_recipe(conv, source, warnings, recompute_inertials)
+    copied = _copy_meshes(conv.copies, source, out)
+    header = _header(source, out, args, recompute_inertials, density, inertia_policy) + [
+        line for note in conv.left_out for line in wrap(note)]
+    text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
+    lines = _element_lines(got.urdf) if got.urdf is raw else {}
+    _write_checked(text_out, out, source, lines, [] if copy_meshes else [m.source for m in conv.meshes.values()],
+                   warnings)
+    result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
+                          repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes),
+                          left_out=list(conv.left_out))
+    if recompute_inertials:
+        report_recomputed(out, conv, result)
+    return result
+
+
+def _read_input(source: Path) -> str:
     try:
-        raw = source.read_text(encoding="utf-8")
+        return source.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise RobotkitError(Problem("file not found", file=str(source))) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise RobotkitError(Problem(f"cannot read file: {exc}", file=str(source))) from None
-    warnings: list[str] = []
-    inputs = [str(source)]
-    read = next(reader for accepts, reader in READERS.values() if accepts(source, raw))
-    got = read(source, raw, packages, args or {})
-    text = got.urdf
-    warnings.extend(got.warnings)
-    inputs.extend(got.includes)
 
-    conv = urdf_to_recipe(text, source, out, packages, copy_meshes=copy_meshes,
-                          recompute_inertials=recompute_inertials, density=density, inertia_policy=inertia_policy)
-    warnings.extend(conv.warnings)
-    inputs.extend(sorted({m.source for m in conv.meshes.values()}))
+
+def _finished_recipe(conv: Converted, source: Path, warnings: list[str], recompute_inertials: bool) -> dict:
+    """The converted recipe with the source package's metadata, ``open_mesh`` where inertials
+    are computed from open meshes and mesh folder values; schema-checked, then with the values
+    most links and joints share moved to ``defaults:``."""
     recipe = conv.recipe
     metadata, ros, md_warnings = package_metadata(source)
     warnings.extend(md_warnings)
@@ -132,25 +154,33 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         recipe["metadata"] = metadata
     if ros == "ros1":  # ros2 is the default
         recipe["ros"] = ros
-    _open_meshes(conv, recipe, warnings, recompute_inertials)
+    mark_open_meshes(conv, recipe, warnings, recompute_inertials)
     name_mesh_folders(recipe)
     _validate(recipe, source)
     factor_defaults(recipe)  # after the check: the schema reads links and joints with their defaults merged
+    return recipe
 
-    from robotkit.paths import inside
 
+def _copy_meshes(copies: dict[str, str], source: Path, out: Path) -> list[str]:
+    """Copy the meshes (destination -> source) below the recipe's folder; nothing is copied when
+    one would land outside it (a package:// path climbing out with ../)."""
     outside = [Problem(f"mesh '{display_path(src)}' would be copied to {display_path(dest)}, outside the "
                        f"recipe's folder {display_path(out.parent)}", file=str(source))
-               for dest, src in sorted(conv.copies.items()) if not inside(dest, out.parent)]
-    if outside:  # a package:// path climbing out with ../: nothing is written
+               for dest, src in sorted(copies.items()) if not inside(dest, out.parent)]
+    if outside:
         raise RobotkitError(outside)
     copied = []
-    for dest, src in sorted(conv.copies.items()):
-        if not (os.path.isfile(dest) and _same_bytes(src, dest)):
+    for dest, src in sorted(copies.items()):
+        if not (os.path.isfile(dest) and filecmp.cmp(src, dest, shallow=False)):
             os.makedirs(os.path.dirname(dest), exist_ok=True)
             shutil.copyfile(src, dest)
         copied.append(dest)
+    return copied
 
+
+def _header(source: Path, out: Path, args: dict[str, str] | None, recompute_inertials: bool,
+            density: float | None, inertia_policy: str) -> list[str]:
+    """The recipe's header comment: where it came from and how its inertials were decided."""
     header = [f"Imported by robotkit from {Path(os.path.relpath(source, out.parent)).as_posix()}"]
     if args:
         header.append("xacro arguments: " + " ".join(f"{k}:={v}" for k, v in args.items()))
@@ -160,16 +190,15 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     else:
         header.append("inertials as given in the original (explicit); those no real body has: "
                       f"{inertia_policy} (--inertia-policy)")
-    from robotkit.importer.recipe_writer import _wrap
+    return header
 
-    header += [line for note in conv.left_out for line in _wrap(note)]
-    text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
+
+def _write_checked(text: str, out: Path, source: Path, lines: dict, read: list[str], warnings: list[str]) -> None:
+    """Write the recipe ``out`` atomically once it loads and resolves as the build will (``read``:
+    the mesh files a build of it reads, whose folders outside its project it may read)."""
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(text_out, encoding="utf-8")
-    from robotkit.paths import recipe_policy, widened
-
-    read = [] if copy_meshes else [m.source for m in conv.meshes.values()]  # what a build of the recipe reads
+    tmp.write_text(text, encoding="utf-8")
     outside = sorted({os.path.dirname(p) for p in read if not recipe_policy(out).allows(p)})
     if outside:
         common = os.path.commonpath(outside)
@@ -177,35 +206,16 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
                         f"build it with --root {display_path(common)}")
     try:
         with widened(outside):  # the package paths the user declared
-            _check_resolves(tmp, source, _element_lines(text) if text is raw else {})
+            _check_resolves(tmp, source, lines)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
     os.replace(tmp, out)
 
-    from robotkit.importer.inertials import _report_recomputed
-
-    result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
-                          repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes),
-                          left_out=list(conv.left_out))
-    if recompute_inertials:
-        _report_recomputed(out, conv, result)
-    return result
-
-
-def _same_bytes(a: str, b: str) -> bool:
-    import filecmp
-
-    return filecmp.cmp(a, b, shallow=False)
-
 
 def _validate(recipe: dict, source: Path) -> None:
     """Schema check before anything is written (a failure here is an input the recipe
     cannot express, reported by key)."""
-    from pydantic import ValidationError
-
-    from robotkit.recipe.schema import Recipe
-
     try:
         Recipe.model_validate(recipe)
     except ValidationError as exc:
@@ -221,10 +231,6 @@ def _check_resolves(recipe_file: Path, source: Path, lines: dict) -> None:
     has were repaired by the import, each stated in the recipe).  Problems name the imported
     file and, for a URDF, the line of the link or joint (the recipe is not written when there
     are any)."""
-    from dataclasses import replace
-
-    from robotkit.model.load import load_robots
-
     try:
         load_robots([recipe_file])
     except RobotkitError as exc:
@@ -239,12 +245,9 @@ def _check_resolves(recipe_file: Path, source: Path, lines: dict) -> None:
 
 def _element_lines(urdf_text: str) -> dict[tuple[str, str], int]:
     """(``links`` or ``joints``, name) -> line of that element in a URDF's text."""
-    from lxml import etree
-
     try:
-        root = etree.fromstring(urdf_text.encode("utf-8"), etree.XMLParser(resolve_entities=False, no_network=True,
-                                                                           huge_tree=False))
-    except etree.XMLSyntaxError:
+        root = urdfxml.parse_text(urdf_text).getroot()
+    except urdfxml.MalformedXML:
         return {}
     return {(tag + "s", e.get("name")): e.sourceline for tag in ("link", "joint") for e in root.iter(tag)
             if e.get("name")}

@@ -15,6 +15,10 @@ from __future__ import annotations
 import copy
 import json
 
+from robotkit.importer.recipe_writer import section_text
+from robotkit.recipe import schema
+from robotkit.recipe.load import default_applies
+
 CANDIDATES = {
     "joints": (("type",), ("axis",), ("limit", "effort"), ("limit", "velocity"), ("dynamics", "damping"),
                ("dynamics", "friction")),
@@ -30,8 +34,6 @@ MIN_SHARED = 3
 def factor_defaults(recipe: dict) -> dict:
     """Move the values the recipe's joints and links share into ``recipe["defaults"]`` (in
     place); returns the defaults written (empty when none shortens the recipe)."""
-    from robotkit.importer.recipe_writer import section_text
-
     written: dict = {}
     for section, paths in CANDIDATES.items():
         items = recipe.get(section)
@@ -66,8 +68,6 @@ _NONE = object()
 
 
 def _applies(path: tuple, item: dict, kind: str, base: dict) -> bool:
-    from robotkit.recipe.load import default_applies
-
     return default_applies(kind, path[0], item, base)
 
 
@@ -110,8 +110,6 @@ def _without(item, path: tuple, value, kind: str, base: dict):
 def _say_absent(item: dict, path: tuple, kind: str) -> None:
     """Write what an absent value at ``path`` means, so the default does not fill it: the
     schema's default for the field, else null (at the first level that is absent)."""
-    from robotkit.recipe import schema
-
     model = schema.Joint if kind == "joint" else schema.Link
     node = item
     for i, key in enumerate(path):

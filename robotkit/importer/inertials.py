@@ -6,20 +6,24 @@ the reason, for the recipe's comments), and the report of ``--recompute-inertial
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from robotkit.importer.parsing import _Problems, _float, _origin
+import numpy as np
+from pydantic import ValidationError
+
+from robotkit.importer.parsing import Problems, read_float, read_origin
 from robotkit.importer.recipe_writer import fmt
+from robotkit.mesh.inertia import mesh_mass_properties
+from robotkit.mesh.io import load_mesh, volume_mesh
 from robotkit.model import inertia_policy
+from robotkit.model.load import load_robots
+from robotkit.model.resolve import finalize_link_inertial
+from robotkit.geometry import rpy_matrix
+from robotkit.recipe.schema import Link
 
 
 def no_inertial_form():
     """The recipe value that says "this link has no inertial", if the schema has one."""
-    from pydantic import ValidationError
-
-    from robotkit.recipe.schema import Link
-
     for value in ("none",):
         try:
             Link.model_validate({"visual": {"box": {"size": [1, 1, 1]}}, "inertial": value})
@@ -29,23 +33,19 @@ def no_inertial_form():
     return None
 
 
-def _inertial(el: ET.Element, link: str, problems: _Problems) -> dict | None:
+def read_inertial(el, link: str, problems: Problems) -> dict | None:
     what = f"link '{link}' inertial"
     mass_el = el.find("mass")
-    mass = _float(mass_el.get("value") if mass_el is not None else None, f"{what} mass", problems, 0.0)
-    xyz, rpy = _origin(el.find("origin"), what, problems)
+    mass = read_float(mass_el.get("value") if mass_el is not None else None, f"{what} mass", problems, 0.0)
+    xyz, rpy = read_origin(el.find("origin"), what, problems)
     t = el.find("inertia")
     keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
     values = {k: 0.0 for k in keys}
     if t is not None:
         for k in keys:
-            v = _float(t.get(k), f"{what} {k}", problems, 0.0)
+            v = read_float(t.get(k), f"{what} {k}", problems, 0.0)
             values[k] = v if v is not None else 0.0
     if any(rpy):
-        import numpy as np
-
-        from robotkit.geometry import rpy_matrix
-
         I = np.array([[values["ixx"], values["ixy"], values["ixz"]],
                       [values["ixy"], values["iyy"], values["iyz"]],
                       [values["ixz"], values["iyz"], values["izz"]]])
@@ -123,73 +123,106 @@ POINT_MASS_FLOOR = 1e-5
 """kg: the least point mass import gives a link without one (libsdformat drops a link of 1e-6 kg)."""
 
 
-def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out) -> None:
+MOVING = frozenset({"revolute", "continuous", "prismatic", "planar", "floating"})
+
+
+def give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out) -> None:
     """A link the build refuses or SDF misreads for having no mass (it moves, it is a root
     with moving joints below it and no mass welded to it, or it has moving joints or mass below
     it: libsdformat drops such a link with its subtree) gets one: computed from its geometry at the
     recipe's density, or a point mass when it has none.  Each is recorded in ``out.repairs``."""
-    moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
-    children: dict[str, list[dict]] = {}
-    for j in joints.values():
-        children.setdefault(j["parent"], []).append(j)
+    tree = _Tree(links, joints)
+    refused: dict[str, str] = {}  # link -> why it needs a mass
+    _moving_without_mass(tree, refused)
+    _massless_roots(tree, refused)
+    _massless_inside(tree, refused)
+    _give_mass(links, refused, out)
 
-    def body_mass(name: str) -> bool:
+
+class _Tree:
+    """The joints of an imported robot as a tree: which links carry mass, and where."""
+
+    def __init__(self, links: dict[str, dict], joints: dict[str, dict]):
+        self.links, self.joints = links, joints
+        self.children: dict[str, list[dict]] = {}
+        for j in joints.values():
+            self.children.setdefault(j["parent"], []).append(j)
+        self.parent_joint = {j["child"]: j for j in joints.values()}
+        self.named = {id(j): n for n, j in joints.items()}
+
+    def body_mass(self, name: str) -> bool:
+        """Whether ``name`` or a link welded below it has mass."""
         todo, seen = [name], set()
         while todo:
             n = todo.pop()
-            if n in seen or n not in links:
+            if n in seen or n not in self.links:
                 continue
             seen.add(n)
-            if _has_mass(links[n]):
+            if _has_mass(self.links[n]):
                 return True
-            todo += [j["child"] for j in children.get(n, []) if j["type"] == "fixed"]
+            todo += [j["child"] for j in self.children.get(n, []) if j["type"] == "fixed"]
         return False
 
-    refused: dict[str, str] = {}
-    for jname, j in joints.items():
-        if j["type"] in moving and j["child"] in links and not body_mass(j["child"]):
-            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): MuJoCo "
-                                           "refuses a moving body without mass and Gazebo drops it")
-        elif j["type"] in moving and j["child"] in links and not _has_mass(links[j["child"]]):
-            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): SDF keeps "
-                                           "it a link, which Gazebo and Drake give 1 kg without an inertial")
-    def bearer(name: str) -> str:
+    def welded_below(self, name: str) -> list[str]:
+        return _welded_below(name, self.children)
+
+    def bearer(self, name: str) -> str:
         """The first link with geometry welded below ``name`` (or ``name``): where its mass goes."""
-        return next((n for n in _welded_below(name, children)
-                     if links[n].get("visual") or isinstance(links[n].get("collision"), (dict, list))), name)
+        return next((n for n in self.welded_below(name)
+                     if self.links[n].get("visual") or isinstance(self.links[n].get("collision"), (dict, list))),
+                    name)
 
-    parent_joint = {j["child"]: j for j in joints.values()}
-    for name in links:
-        if name != "world" and name not in parent_joint and children.get(name) and not body_mass(name):
-            refused.setdefault(bearer(name), "no mass in the original (nor on the links welded to it), and it is (or "
-                                             "is welded to) the root with moving joints below it: Gazebo's URDF "
-                                             "conversion drops it and everything below it")
-    for name in links:  # libsdformat weighs a welded link with the links welded below it only
-        jname = next((n for n, j in joints.items() if j["parent"] == name and j["type"] in moving), None)
-        if (jname is not None and name in parent_joint and parent_joint[name]["type"] == "fixed"
-                and not body_mass(name) and not any(n in refused for n in _welded_below(name, children))):
-            refused.setdefault(bearer(name), f"no mass in the original (nor on the links welded below it), and "
-                                             f"joint '{jname}' moves below it: Gazebo's URDF conversion drops "
-                                             "everything that moves below it, though it is welded to a link with mass")
-
-    named = {id(j): n for n, j in joints.items()}
-
-    def carries(name: str, seen: frozenset = frozenset()) -> str | None:
+    def carries(self, name: str, seen: frozenset = frozenset()) -> str | None:
         """The first joint below ``name`` that moves or holds mass (libsdformat drops it)."""
-        for j in children.get(name, []):
-            if j["child"] in seen or j["child"] not in links:
+        for j in self.children.get(name, []):
+            if j["child"] in seen or j["child"] not in self.links:
                 continue
-            if j["type"] in moving or _has_mass(links[j["child"]]) or carries(j["child"], seen | {name}):
-                return named[id(j)]
+            if j["type"] in MOVING or _has_mass(self.links[j["child"]]) or self.carries(j["child"], seen | {name}):
+                return self.named[id(j)]
         return None
 
-    for name in sorted(set(parent_joint) & set(links)):  # a massless link inside the tree: iCub's l_hip_3
-        if body_mass(name) or any(n in refused for n in _welded_below(name, children)):
+
+def _moving_without_mass(tree: _Tree, refused: dict[str, str]) -> None:
+    """A moving link with no mass (nor any welded to it), or with mass only welded to it."""
+    for jname, j in tree.joints.items():
+        if j["type"] in MOVING and j["child"] in tree.links and not tree.body_mass(j["child"]):
+            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): MuJoCo "
+                                           "refuses a moving body without mass and Gazebo drops it")
+        elif j["type"] in MOVING and j["child"] in tree.links and not _has_mass(tree.links[j["child"]]):
+            refused.setdefault(j["child"], f"no mass in the original, and it moves (joint '{jname}'): SDF keeps "
+                                           "it a link, which Gazebo and Drake give 1 kg without an inertial")
+
+
+def _massless_roots(tree: _Tree, refused: dict[str, str]) -> None:
+    """A massless root with joints below it, and a massless welded link with a moving joint below."""
+    for name in tree.links:
+        if name != "world" and name not in tree.parent_joint and tree.children.get(name) and not tree.body_mass(name):
+            refused.setdefault(tree.bearer(name), "no mass in the original (nor on the links welded to it), and it is "
+                                                  "(or is welded to) the root with moving joints below it: Gazebo's "
+                                                  "URDF conversion drops it and everything below it")
+    for name in tree.links:  # libsdformat weighs a welded link with the links welded below it only
+        jname = next((n for n, j in tree.joints.items() if j["parent"] == name and j["type"] in MOVING), None)
+        if (jname is not None and name in tree.parent_joint and tree.parent_joint[name]["type"] == "fixed"
+                and not tree.body_mass(name) and not any(n in refused for n in tree.welded_below(name))):
+            refused.setdefault(tree.bearer(name), f"no mass in the original (nor on the links welded below it), and "
+                                                  f"joint '{jname}' moves below it: Gazebo's URDF conversion drops "
+                                                  "everything that moves below it, though it is welded to a link "
+                                                  "with mass")
+
+
+def _massless_inside(tree: _Tree, refused: dict[str, str]) -> None:
+    """A massless link inside the tree with a joint below it that moves or holds mass: iCub's l_hip_3."""
+    for name in sorted(set(tree.parent_joint) & set(tree.links)):
+        if tree.body_mass(name) or any(n in refused for n in tree.welded_below(name)):
             continue
-        below = carries(name)
+        below = tree.carries(name)
         if below:
             refused.setdefault(name, f"no mass in the original, with joint '{below}' below it: Gazebo's URDF "
                                      "conversion drops it and everything below it, even welded to a link with mass")
+
+
+def _give_mass(links: dict[str, dict], refused: dict[str, str], out) -> None:
+    """Each refused link's mass: from its geometry at the recipe's density, else a point mass."""
     given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
     point = 1e-3 * min(given) if given else 1e-3
     # libsdformat reads a mass up to 1e-6 kg as none and drops the link (iCub weighs a link 1e-6 kg)
@@ -212,19 +245,12 @@ def _give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out
 
 
 def _tensor(t: dict):
-    import numpy as np
-
     return np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]], [t["ixz"], t["iyz"], t["izz"]]])
 
 
 
 def _facts(mesh) -> dict:
     """Unit-density mass properties of one mesh, as robotkit's mesh task records them."""
-    import numpy as np
-
-    from robotkit.mesh.inertia import mesh_mass_properties
-    from robotkit.mesh.io import load_mesh, volume_mesh
-
     m = load_mesh(mesh.source, mesh.scale)
     bbox_min, bbox_max = m.bounds
     vol, _, _, _ = volume_mesh(m, mesh.open_mesh, os.path.basename(mesh.source))
@@ -234,12 +260,7 @@ def _facts(mesh) -> dict:
             "bbox_min": [float(v) for v in bbox_min], "bbox_max": [float(v) for v in bbox_max]}
 
 
-def _report_recomputed(recipe_file: Path, conv, result) -> None:
-    import numpy as np
-
-    from robotkit.model.resolve import finalize_link_inertial
-    from robotkit.model.load import load_robots
-
+def report_recomputed(recipe_file: Path, conv, result) -> None:
     (_, robot), = load_robots([recipe_file])
     facts: dict[str, dict] = {}
     for link in robot.links:

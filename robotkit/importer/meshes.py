@@ -9,8 +9,9 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from robotkit.errors import display_path
-from robotkit.importer.parsing import _Problems
+from robotkit.errors import MeshError, display_path
+from robotkit.importer.parsing import Problems
+from robotkit.mesh.io import load_mesh, volume_mesh
 
 MESH_FORMATS = (".stl", ".obj", ".dae")
 
@@ -33,7 +34,7 @@ class MeshResolver:
         self.copies: dict[str, str] = {}  # destination -> source
         self._dest_of: dict[str, str] = {}
 
-    def locate(self, uri: str, link: str, problems: _Problems) -> str | None:
+    def locate(self, uri: str, link: str, problems: Problems) -> str | None:
         """Absolute path of the file ``uri`` names, or None with a problem."""
         path = None
         m = re.match(r"^(package|model):///?([^/]+)/(.+)$", uri)  # package:///PKG/: Pinocchio's reading
@@ -90,9 +91,6 @@ _CLOSED: dict[tuple, bool] = {}
 
 def mesh_is_closed(source: str, scale) -> bool:
     """Whether robotkit's mesh task accepts the mesh without ``open_mesh: hull``."""
-    from robotkit.errors import MeshError
-    from robotkit.mesh.io import load_mesh, volume_mesh
-
     st = os.stat(source)
     key = (source, tuple(scale), st.st_mtime_ns, st.st_size)
     if key not in _CLOSED:
@@ -104,7 +102,7 @@ def mesh_is_closed(source: str, scale) -> bool:
     return _CLOSED[key]
 
 
-def _open_meshes(conv, recipe: dict, warnings: list[str], recompute: bool) -> None:
+def mark_open_meshes(conv, recipe: dict, warnings: list[str], recompute: bool) -> None:
     """A mesh that is not a closed volume needs ``open_mesh: hull`` only where an inertial is
     computed from it (robotkit accepts open meshes that are only drawn and collided)."""
     open_by_link: dict[str, list[tuple[str, str]]] = {}

@@ -6,19 +6,19 @@ from __future__ import annotations
 
 import re
 
-from robotkit.recipe.schema import FRAME_NAME_RE, NAME_RE
+from robotkit.recipe.schema import FRAME_NAME_HINT, FRAME_NAME_RE, NAME_RE
 
 
-def _valid_name(name: str | None) -> bool:
+def valid_name(name: str | None) -> bool:
     return bool(name) and bool(NAME_RE.match(name))
 
 
-def _valid_frame_name(name: str | None) -> bool:
+def valid_frame_name(name: str | None) -> bool:
     """Link and joint names may hold '/' between parts, as ROS frame names do."""
     return bool(name) and bool(FRAME_NAME_RE.match(name))
 
 
-def _material_name(name: str, taken: set[str]) -> str:
+def material_name(name: str, taken: set[str]) -> str:
     base = re.sub(r"[^A-Za-z0-9_.\-]", "_", name or "material")
     if not re.match(r"[A-Za-z_]", base):
         base = "_" + base
@@ -28,7 +28,5 @@ def _material_name(name: str, taken: set[str]) -> str:
     return out
 
 
-def _name_hint() -> str:
-    from robotkit.recipe.schema import FRAME_NAME_HINT
-
+def name_hint() -> str:
     return FRAME_NAME_HINT

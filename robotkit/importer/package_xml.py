@@ -8,6 +8,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from robotkit.errors import display_path
+from robotkit.recipe.schema import EMAIL_RE
 
 SEARCH_DEPTH = 4  # folders above the file: <pkg>/urdf/<robot>/x.urdf.xacro is three
 
@@ -48,8 +49,6 @@ def _text(el) -> str:
 def package_metadata(source: Path) -> tuple[dict, str | None, list[str]]:
     """(recipe ``metadata``, recipe ``ros`` or None, warnings) from the package around ``source``;
     an empty mapping when there is no package.xml."""
-    from robotkit.recipe.schema import EMAIL_RE
-
     path = find_package_xml(source)
     if path is None:
         return {}, None, []

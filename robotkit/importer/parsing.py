@@ -4,13 +4,12 @@ list of problems (one line each, naming the file) that an import collects before
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 
 from robotkit.errors import Problem, RobotkitError
 from robotkit.importer.recipe_writer import fmt
 
 
-class _Problems:
+class Problems:
     def __init__(self, file: str):
         self.file = file
         self.items: list[Problem] = []
@@ -23,7 +22,7 @@ class _Problems:
             raise RobotkitError(self.items)
 
 
-def _floats(text: str | None, n: int, what: str, problems: _Problems, default=None):
+def read_floats(text: str | None, n: int, what: str, problems: Problems, default=None):
     if text is None:
         return list(default) if default is not None else None
     parts = text.split()
@@ -37,21 +36,21 @@ def _floats(text: str | None, n: int, what: str, problems: _Problems, default=No
     return [v + 0.0 for v in values]  # no -0.0
 
 
-def _float(text, what, problems, default=None):
-    values = _floats(text, 1, what, problems, None if default is None else [default])
+def read_float(text, what, problems, default=None):
+    values = read_floats(text, 1, what, problems, None if default is None else [default])
     return None if values is None else values[0]
 
 
-def _origin(el: ET.Element | None, what: str, problems: _Problems):
+def read_origin(el, what: str, problems: Problems):
     """(xyz, rpy) of an <origin> child, zeros when absent."""
     if el is None:
         return [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
-    xyz = _floats(el.get("xyz"), 3, f"{what} origin xyz", problems, [0.0, 0.0, 0.0])
-    rpy = _floats(el.get("rpy"), 3, f"{what} origin rpy", problems, [0.0, 0.0, 0.0])
+    xyz = read_floats(el.get("xyz"), 3, f"{what} origin xyz", problems, [0.0, 0.0, 0.0])
+    rpy = read_floats(el.get("rpy"), 3, f"{what} origin rpy", problems, [0.0, 0.0, 0.0])
     return xyz, rpy
 
 
-def _origin_dict(xyz, rpy) -> dict | None:
+def origin_dict(xyz, rpy) -> dict | None:
     out = {}
     if any(xyz):
         out["xyz"] = list(xyz)
@@ -60,11 +59,11 @@ def _origin_dict(xyz, rpy) -> dict | None:
     return out or None
 
 
-def _local(tag) -> str:
+def local_name(tag) -> str:
     if not isinstance(tag, str):
         return "#comment"
     return tag.rsplit("}", 1)[-1]
 
 
-def _fmt_list(values) -> str:
+def fmt_list(values) -> str:
     return "[" + ", ".join(fmt(v) for v in values) + "]"

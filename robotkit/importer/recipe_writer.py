@@ -121,7 +121,7 @@ def section_text(key: str, value, notes: dict[str, str] | None = None) -> str:
         if notes:
             text = [f"{key}:\n"]
             for name, entry in value.items():
-                for line in _wrap(notes.get(name, "")):
+                for line in wrap(notes.get(name, "")):
                     text.append(f"  # {line}\n")
                 entry_text = yaml.dump({name: _styled_entry(entry)}, **opts)
                 text.append("".join(f"  {line}" if line.strip() else line
@@ -133,7 +133,7 @@ def section_text(key: str, value, notes: dict[str, str] | None = None) -> str:
     return yaml.dump({key: styled}, **opts)
 
 
-def _wrap(text: str, width: int = 96) -> list[str]:
+def wrap(text: str, width: int = 96) -> list[str]:
     import textwrap
 
     return textwrap.wrap(text, width, break_long_words=False, break_on_hyphens=False) if text else []

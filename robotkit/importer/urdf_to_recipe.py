@@ -21,30 +21,31 @@ Floats are kept as parsed and written with ``repr`` (shortest round trip).
 
 from __future__ import annotations
 
+import copy
 import math
 import os
 import re
-import xml.dom.minidom as minidom
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from robotkit.importer.inertials import (  # noqa: F401  (no_inertial_form: used by the tests)
-    _give_moving_links_mass, _inertial, chosen_inertial, no_inertial_form,
-)
-from robotkit.importer.meshes import MeshResolver, MeshUse
-from robotkit.importer.names import _material_name, _name_hint, _valid_frame_name, _valid_name
-from robotkit.importer.parsing import _Problems, _float, _floats, _fmt_list, _local, _origin, _origin_dict
-from robotkit.importer.recipe_writer import dump_recipe, fmt  # noqa: F401  (the import's writer)
-from robotkit.errors import Problem, RobotkitError
+import numpy as np
+
+from robotkit import urdfxml
+from robotkit.emit.sdf import names_apart
 from robotkit.emit.urdf import MASSLESS
-from robotkit.errors import short_number
-from robotkit.recipe.schema import MIN_MASS, UNITS
+from robotkit.errors import Problem, RobotkitError, short_number
+from robotkit.importer.inertials import chosen_inertial, give_moving_links_mass, no_inertial_form, read_inertial
+from robotkit.importer.meshes import MeshResolver, MeshUse
+from robotkit.importer.names import material_name, name_hint, valid_frame_name, valid_name
+from robotkit.importer.parsing import (Problems, fmt_list, local_name, origin_dict, read_float, read_floats,
+                                       read_origin)
+from robotkit.importer.recipe_writer import fmt
+from robotkit.geometry import rpy_matrix
+from robotkit.recipe.schema import JOINT_TYPES, MIN_MASS, UNITS
 
 GREY = [0.5, 0.5, 0.5, 1.0]
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
-
-
+is_element = urdfxml.is_element
 
 
 @dataclass
@@ -60,30 +61,28 @@ class Converted:
     left_out: list[str] = field(default_factory=list)  # elements of the original the recipe leaves out, and why
 
 
+@dataclass
+class _Reading:
+    """What the stages of one conversion share: where problems and warnings go, the mesh
+    resolver, the result being filled, and the inertial options."""
+
+    problems: Problems
+    warnings: list[str]
+    resolver: MeshResolver
+    out: Converted
+    recompute_inertials: bool = False
+    density: float | None = None
+    inertia_policy: str = "repair"
 
 
-# ---------------------------------------------------------------- parsing helpers
+@dataclass
+class _Links:
+    """The links read: recipe entries, the recipe materials of each link's visuals, and which
+    links have collision geometry (what the Gazebo blocks are mapped against)."""
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-# ---------------------------------------------------------------- mesh files
-
-
+    links: dict[str, dict] = field(default_factory=dict)
+    visual_materials: dict[str, list[str]] = field(default_factory=dict)
+    has_collision: dict[str, bool] = field(default_factory=dict)
 
 
 # ---------------------------------------------------------------- the conversion
@@ -101,108 +100,137 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
     """
     source = Path(source).absolute()
     recipe_dir = Path(recipe_path).absolute().parent
-    problems = _Problems(str(source))
-    warnings: list[str] = []
+    root = _robot_element(text, source)
+    children = [el for el in root if is_element(el)]
+    r = _Reading(Problems(str(source)), [], MeshResolver(source, recipe_dir, dict(package_paths or {}), copy_meshes),
+                 Converted(recipe={}), recompute_inertials, density, inertia_policy)
+    robot_name = _robot_name(root.get("name") or source.name.split(".")[0], r.warnings)
+    materials = _Materials(children, r.problems, r.warnings)
+    links = _links(children, materials, r)
+    joints = _joints(children, links.links, r)
+    extras = _extras(children, root, links, joints, materials.materials, r)
+    r.problems.raise_if_any()
+    give_moving_links_mass(links.links, joints, r.out)
+    for link, why in r.out.repairs.items():
+        r.warnings.append(f"link '{link}': {why}")
+    recipe: dict = {"robot": robot_name, "units": "m", "density": density if density is not None else 1000.0}
+    if materials.materials:
+        recipe["materials"] = materials.materials
+    recipe["links"] = links.links
+    if joints:
+        recipe["joints"] = joints
+    if extras:
+        recipe["urdf_extras"] = extras
+    r.out.recipe, r.out.warnings, r.out.copies = recipe, r.warnings, dict(r.resolver.copies)
+    return r.out
+
+
+def _robot_element(text: str, source: Path):
+    """The <robot> element of the URDF ``text`` (comments kept: verbatim elements keep theirs)."""
     try:
-        root = ET.fromstring(text)
-        dom = minidom.parseString(text)
-    except Exception as exc:  # ET.ParseError, or expat's errors from minidom
-        line = getattr(exc, "position", (None,))[0] if isinstance(exc, ET.ParseError) else getattr(exc, "lineno", None)
-        raise RobotkitError(Problem(f"not well-formed XML: {exc}", file=str(source), line=line)) from None
-    if _local(root.tag) != "robot":
-        raise RobotkitError(Problem(f"the root element is <{_local(root.tag)}>, not <robot>: not a URDF",
+        root = urdfxml.parse_text(text, comments=True).getroot()
+    except urdfxml.MalformedXML as exc:  # in the words of expat, which read it before lxml
+        raise RobotkitError(Problem(f"not well-formed XML: {exc.expat or exc}", file=str(source),
+                                    line=exc.expat_line if exc.expat else exc.line)) from None
+    if local_name(root.tag) != "robot":
+        raise RobotkitError(Problem(f"the root element is <{local_name(root.tag)}>, not <robot>: not a URDF",
                                     file=str(source)))
-    dom_children = [n for n in dom.documentElement.childNodes if n.nodeType == n.ELEMENT_NODE]
-    et_children = list(root)
-    resolver = MeshResolver(source, recipe_dir, dict(package_paths or {}), copy_meshes)
-    out = Converted(recipe={})
+    return root
 
-    robot_name = root.get("name") or source.name.split(".")[0]
-    if not _valid_name(robot_name):
-        fixed = _material_name(robot_name, set())
-        warnings.append(f"robot name '{robot_name}' is not a valid recipe name; using '{fixed}'")
-        robot_name = fixed
 
-    # global materials (first definition of a name wins, as in urdfdom; a definition inside a link's
-    # visual joins them for the name-only references of the links after it)
-    global_materials: dict[str, ET.Element] = {}
-    for el in et_children:
-        if _local(el.tag) == "material" and el.get("name") and el.get("name") not in global_materials:
-            global_materials[el.get("name")] = el
+def _robot_name(name: str, warnings: list[str]) -> str:
+    if valid_name(name):
+        return name
+    fixed = material_name(name, set())
+    warnings.append(f"robot name '{name}' is not a valid recipe name; using '{fixed}'")
+    return fixed
 
-    materials: dict[str, dict] = {}  # recipe name -> {"rgba": ...}
-    by_key: dict[tuple, str] = {}  # (urdf name, rgba) -> recipe name
-    texture_warned: set[str] = set()
 
-    def material_ref(vis_mat: ET.Element, link: str) -> str:
+class _Materials:
+    """The recipe's materials, named as the links' visuals reference them: global ones (the first
+    definition of a name wins, as in urdfdom; a definition inside a link's visual joins them for
+    the name-only references of the links after it), deduplicated by name and colour."""
+
+    def __init__(self, children: list, problems: Problems, warnings: list[str]):
+        self.problems, self.warnings = problems, warnings
+        self.global_materials: dict = {}
+        for el in children:
+            if local_name(el.tag) == "material" and el.get("name") and el.get("name") not in self.global_materials:
+                self.global_materials[el.get("name")] = el
+        self.materials: dict[str, dict] = {}  # recipe name -> {"rgba": ...}
+        self.by_key: dict[tuple, str] = {}  # (urdf name, rgba) -> recipe name
+        self.texture_warned: set[str] = set()
+
+    def ref(self, vis_mat, link: str) -> str:
+        """The recipe name of a visual's <material>."""
         name = vis_mat.get("name") or ""
-        rgba = _rgba(vis_mat, f"link '{link}': material '{name}'", problems, warnings)
+        rgba = _rgba(vis_mat, f"link '{link}': material '{name}'", self.problems, self.warnings)
         texture = vis_mat.find("texture")
         if (rgba is not None or texture is not None) and name:  # urdfdom: a link's definition serves later links
-            global_materials.setdefault(name, vis_mat)
-        if rgba is None and name in global_materials:
-            g = global_materials[name]
-            rgba = _rgba(g, f"material '{name}'", problems, warnings)
+            self.global_materials.setdefault(name, vis_mat)
+        if rgba is None and name in self.global_materials:
+            g = self.global_materials[name]
+            rgba = _rgba(g, f"material '{name}'", self.problems, self.warnings)
             texture = texture if texture is not None else g.find("texture")
-        if texture is not None and name not in texture_warned:
-            texture_warned.add(name)
-            if rgba is None:
-                warnings.append(f"material '{name}' has a texture ({texture.get('filename')}) and no colour; "
-                                "the recipe keeps the name with a grey colour (textures of DAE meshes are kept)")
-            else:
-                warnings.append(f"material '{name}': its texture ({texture.get('filename')}) is dropped; "
-                                "the colour is kept")
-        elif rgba is None and name not in texture_warned:
-            texture_warned.add(name)
-            warnings.append(f"material '{name}' (link '{link}') has no colour; using grey")
+        self._warn_colour(name, link, rgba, texture)
         rgba = rgba or list(GREY)
         key = (name, tuple(rgba))
-        if key not in by_key:
-            recipe_name = _material_name(name, set(materials))
-            if recipe_name != name:
-                if any(k[0] == name for k in by_key):
-                    warnings.append(f"material '{name}' is defined with different colours; "
-                                    f"the colour {_fmt_list(rgba)} is named '{recipe_name}'")
-                else:
-                    warnings.append(f"material name '{name}' is not a valid recipe name; using '{recipe_name}'")
-            by_key[key] = recipe_name
-            materials[recipe_name] = {"rgba": rgba}
-        return by_key[key]
+        if key not in self.by_key:
+            self.by_key[key] = self._new_name(name, rgba)
+            self.materials[self.by_key[key]] = {"rgba": rgba}
+        return self.by_key[key]
 
-    # ---- links
-    links: dict[str, dict] = {}
-    link_visual_materials: dict[str, list[str]] = {}
-    link_has_collision: dict[str, bool] = {}
+    def _warn_colour(self, name: str, link: str, rgba, texture) -> None:
+        """Once per material name: a dropped texture, or no colour at all."""
+        if name in self.texture_warned:
+            return
+        if texture is not None:
+            self.texture_warned.add(name)
+            if rgba is None:
+                self.warnings.append(f"material '{name}' has a texture ({texture.get('filename')}) and no colour; "
+                                     "the recipe keeps the name with a grey colour (textures of DAE meshes are kept)")
+            else:
+                self.warnings.append(f"material '{name}': its texture ({texture.get('filename')}) is dropped; "
+                                     "the colour is kept")
+        elif rgba is None:
+            self.texture_warned.add(name)
+            self.warnings.append(f"material '{name}' (link '{link}') has no colour; using grey")
+
+    def _new_name(self, name: str, rgba: list[float]) -> str:
+        recipe_name = material_name(name, set(self.materials))
+        if recipe_name != name:
+            if any(k[0] == name for k in self.by_key):
+                self.warnings.append(f"material '{name}' is defined with different colours; "
+                                     f"the colour {fmt_list(rgba)} is named '{recipe_name}'")
+            else:
+                self.warnings.append(f"material name '{name}' is not a valid recipe name; using '{recipe_name}'")
+        return recipe_name
+
+
+# ---------------------------------------------------------------- links
+
+
+def _links(children: list, materials: _Materials, r: _Reading) -> _Links:
+    """Every <link>: its geometry, materials and inertial as recipe entries."""
+    found = _Links()
     no_inertial = no_inertial_form()
-    for el in et_children:
-        if _local(el.tag) != "link":
+    for el in children:
+        if local_name(el.tag) != "link":
             continue
         name = el.get("name")
-        if not _valid_frame_name(name):
-            problems.add(f"link name '{name}' is not a valid recipe name ({_name_hint()})")
+        if not valid_frame_name(name):
+            r.problems.add(f"link name '{name}' is not a valid recipe name ({name_hint()})")
             continue
-        if name in links:
-            problems.add(f"link '{name}' is defined twice")
+        if name in found.links:
+            r.problems.add(f"link '{name}' is defined twice")
             continue
-        link: dict = {}
-        visuals, collisions, vis_materials = [], [], []
-        for kind, items in (("visual", visuals), ("collision", collisions)):
-            for i, g_el in enumerate(el.findall(kind)):
-                made = _geometry(g_el, name, kind, len(items), resolver, problems, warnings, out)
-                if made is None:
-                    continue
-                for geom in made if isinstance(made, list) else [made]:
-                    if kind == "visual":
-                        mat = g_el.find("material")
-                        if mat is not None:
-                            geom["material"] = material_ref(mat, name)
-                            vis_materials.append(geom["material"])
-                    items.append(geom)
+        visuals, collisions, vis_materials = _link_geometry(el, name, materials, r)
         for child in el:
-            if _local(child.tag) not in ("visual", "collision", "inertial"):
-                warnings.append(f"link '{name}': <{_local(child.tag)}> is dropped (the recipe has no place for it)")
-        link_visual_materials[name] = vis_materials
-        link_has_collision[name] = bool(collisions)
+            if is_element(child) and local_name(child.tag) not in ("visual", "collision", "inertial"):
+                r.warnings.append(f"link '{name}': <{local_name(child.tag)}> is dropped (the recipe has no place for it)")
+        found.visual_materials[name] = vis_materials
+        found.has_collision[name] = bool(collisions)
+        link: dict = {}
         if visuals:
             link["visual"] = visuals[0] if len(visuals) == 1 else visuals
         if _same_shapes(visuals, collisions):
@@ -212,157 +240,80 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
                 link["collision"] = "none"
         else:
             link["collision"] = collisions[0] if len(collisions) == 1 else collisions
-
-        inertial_el = el.find("inertial")
-        given = _inertial(inertial_el, name, problems) if inertial_el is not None else None
-        if given is not None and 0 < given["mass"] < MIN_MASS and not any(given["inertia"].values()):
-            # robotkit's own URDF writes a massless link as 1e-300 kg with no inertia: read back as massless
-            if given["mass"] != MASSLESS:
-                warnings.append(f"link '{name}': mass {given['mass']!r} kg with no inertia, below the smallest mass "
-                                f"a recipe takes ({short_number(MIN_MASS)} kg): read as a massless link")
-            given = dict(given, mass=0.0)
-        if given is not None and given["mass"] > 0:
-            out.explicit[name] = given
-            geometry = visuals or collisions
-            if recompute_inertials and geometry:
-                spec: dict = {}  # at the recipe's density, or keeping the given mass
-                if collisions and not _same_shapes(visuals, collisions):
-                    spec["source"] = "collision"
-                if density is None:
-                    spec["mass"] = given["mass"]
-                if spec:
-                    link["inertial"] = spec
-            else:
-                if recompute_inertials:
-                    warnings.append(f"link '{name}' has no geometry to compute an inertial from; "
-                                    "its inertial is kept as given")
-                source = ("collision" if collisions and not (visuals and _same_shapes(visuals, collisions))
-                          else "visual" if visuals else None)
-                link["inertial"] = chosen_inertial(name, given, source, inertia_policy, out.repairs)
-        else:
-            if given is not None and given["mass"] < 0:
-                problems.add(f"link '{name}': negative mass {given['mass']!r}")
-            if visuals:  # robotkit would compute an inertial from the visual geometry
-                if no_inertial is not None:
-                    link["inertial"] = no_inertial
-                else:
-                    why = "a zero mass" if given is not None else "no inertial"
-                    warnings.append(f"link '{name}' has {why} in the URDF, but the recipe cannot say 'no inertial' "
-                                    "for a link with visual geometry: the build computes one from its geometry, "
-                                    "which adds mass the original does not have")
-        links[name] = link
-
-    # ---- joints
-    joints: dict[str, dict] = {}
-    joint_types: dict[str, str] = {}
-    for el in et_children:
-        if _local(el.tag) != "joint":
-            continue
-        name = el.get("name")
-        if not _valid_frame_name(name):
-            problems.add(f"joint name '{name}' is not a valid recipe name ({_name_hint()})")
-            continue
-        if name in joints:
-            problems.add(f"joint '{name}' is defined twice")
-            continue
-        joint = _joint(el, name, problems, warnings)
-        if joint is None:
-            continue
-        for end in ("parent", "child"):
-            if joint[end] not in links and _valid_frame_name(joint[end]):
-                problems.add(f"joint '{name}': {end} link '{joint[end]}' is not defined")
-        joints[name] = joint
-        joint_types[name] = joint["type"]
-    for name, joint in joints.items():
-        note = joint.pop("__note", None)
-        if note:
-            out.joint_notes[name] = note
-    from robotkit.emit.sdf import names_apart
-
-    for name, sdf_name in names_apart(links, joints).items():
-        if sdf_name != name:  # ROS accepts it; an SDF model has one namespace for links and joints
-            note = f"named like a link in the original: SDF, where links and joints share names, calls it '{sdf_name}'"
-            out.joint_notes[name] = "; ".join(filter(None, (out.joint_notes.get(name), note)))
-            warnings.append(f"joint '{name}': {note}")
-    for name, joint in joints.items():
-        mimic = joint.get("mimic")
-        if mimic and mimic["joint"] not in joints:  # check_urdf accepts it (Alex's hands: 'index_q1')
-            note = (f"mimicked joint '{mimic['joint']}' in the original, which the robot does not have (Drake "
-                    "refuses such a URDF): the mimic is dropped and the joint moves on its own")
-        elif mimic and joints[mimic["joint"]]["type"] == "fixed":
-            note = (f"mimicked fixed joint '{mimic['joint']}' in the original: a fixed joint has no position to "
-                    "follow, so the mimic is dropped and the joint moves on its own")
-        else:
-            continue
-        del joint["mimic"]
-        out.joint_notes[name] = "; ".join(filter(None, (out.joint_notes.get(name), note)))
-        warnings.append(f"joint '{name}': {note}")
-
-    # ---- everything else: gazebo blocks (partly mapped), transmissions, ... verbatim
-    extras: list[str] = []
-    gazebo_links: dict[str, list[tuple[int, ET.Element]]] = {}
-    for idx, el in enumerate(et_children):
-        if _local(el.tag) == "gazebo" and el.get("reference") in links:
-            gazebo_links.setdefault(el.get("reference"), []).append((idx, el))
-    remove: dict[int, set[str]] = {}  # element index -> child tags handled by the recipe
-    _map_gazebo_materials(gazebo_links, link_visual_materials, materials, remove)
-    _map_contacts(gazebo_links, link_has_collision, links, remove)
-    for idx, el in enumerate(et_children):
-        tag = _local(el.tag)
-        if tag in ("link", "joint", "material"):
-            continue
-        drop = set(remove.get(idx, ()))
-        if tag == "gazebo" and joint_types.get(el.get("reference")) == "fixed":
-            pes = el.find("preserveFixedJoint")
-            if pes is not None and (pes.text or "").strip().lower() in ("true", "1"):
-                drop.add("preserveFixedJoint")  # robotkit writes it for every fixed joint
-        missing = [j.get("name") for j in el.findall("joint") if j.get("name") not in joints] \
-            if tag == "transmission" else []
-        if missing:  # the Jackal's transmissions name joint 'front_left_wheel' for 'front_left_wheel_joint'
-            note = (f"transmission '{el.get('name')}' is left out: it names joint '{missing[0]}', which the robot "
-                    "does not have (Drake refuses the URDF, ros_control the transmission)")
-            out.left_out.append(note)
-            warnings.append(note)
-            continue
-        xml_text = _verbatim(dom_children[idx], drop, dom.documentElement)
-        if xml_text is None:
-            continue
-        extras.append(xml_text)
-        out.extras.append(_label(el))
-    if out.extras:
-        warnings.append(f"{len(out.extras)} element{'s' if len(out.extras) > 1 else ''} the recipe cannot "
-                        f"express yet {'are' if len(out.extras) > 1 else 'is'} carried through verbatim in "
-                        f"urdf_extras: {', '.join(out.extras)}")
-
-    problems.raise_if_any()
-    _give_moving_links_mass(links, joints, out)
-    for link, why in out.repairs.items():
-        warnings.append(f"link '{link}': {why}")
-    recipe: dict = {"robot": robot_name, "units": "m", "density": density if density is not None else 1000.0}
-    if materials:
-        recipe["materials"] = materials
-    recipe["links"] = links
-    if joints:
-        recipe["joints"] = joints
-    if extras:
-        recipe["urdf_extras"] = extras
-    out.recipe = recipe
-    out.warnings = warnings
-    out.copies = dict(resolver.copies)
-    return out
+        inertial = _link_inertial(el, name, visuals, collisions, no_inertial, r)
+        if inertial is not None:
+            link["inertial"] = inertial
+        found.links[name] = link
+    return found
 
 
+def _link_geometry(el, name: str, materials: _Materials, r: _Reading) -> tuple[list, list, list]:
+    """(visual shapes, collision shapes, recipe materials of the visuals) of a <link>."""
+    visuals, collisions, vis_materials = [], [], []
+    for kind, items in (("visual", visuals), ("collision", collisions)):
+        for g_el in el.findall(kind):
+            made = _geometry(g_el, name, kind, len(items), r)
+            if made is None:
+                continue
+            for geom in made if isinstance(made, list) else [made]:
+                if kind == "visual":
+                    mat = g_el.find("material")
+                    if mat is not None:
+                        geom["material"] = materials.ref(mat, name)
+                        vis_materials.append(geom["material"])
+                items.append(geom)
+    return visuals, collisions, vis_materials
 
 
+def _link_inertial(el, name: str, visuals: list, collisions: list, no_inertial, r: _Reading):
+    """The recipe's ``inertial`` of a link, or None when the recipe's default (computed from its
+    geometry) says it; the given inertial goes to ``r.out.explicit``."""
+    inertial_el = el.find("inertial")
+    given = read_inertial(inertial_el, name, r.problems) if inertial_el is not None else None
+    if given is not None and 0 < given["mass"] < MIN_MASS and not any(given["inertia"].values()):
+        # robotkit's own URDF writes a massless link as 1e-300 kg with no inertia: read back as massless
+        if given["mass"] != MASSLESS:
+            r.warnings.append(f"link '{name}': mass {given['mass']!r} kg with no inertia, below the smallest mass "
+                              f"a recipe takes ({short_number(MIN_MASS)} kg): read as a massless link")
+        given = dict(given, mass=0.0)
+    if given is not None and given["mass"] > 0:
+        r.out.explicit[name] = given
+        return _given_inertial(name, given, visuals, collisions, r)
+    if given is not None and given["mass"] < 0:
+        r.problems.add(f"link '{name}': negative mass {given['mass']!r}")
+    if visuals:  # robotkit would compute an inertial from the visual geometry
+        if no_inertial is not None:
+            return no_inertial
+        why = "a zero mass" if given is not None else "no inertial"
+        r.warnings.append(f"link '{name}' has {why} in the URDF, but the recipe cannot say 'no inertial' "
+                          "for a link with visual geometry: the build computes one from its geometry, "
+                          "which adds mass the original does not have")
+    return None
 
 
+def _given_inertial(name: str, given: dict, visuals: list, collisions: list, r: _Reading):
+    """The recipe's inertial of a link whose original gives a positive mass: recomputed from its
+    geometry (``--recompute-inertials``), else as given or by the inertia policy."""
+    if r.recompute_inertials and (visuals or collisions):
+        spec: dict = {}  # at the recipe's density, or keeping the given mass
+        if collisions and not _same_shapes(visuals, collisions):
+            spec["source"] = "collision"
+        if r.density is None:
+            spec["mass"] = given["mass"]
+        return spec or None
+    if r.recompute_inertials:
+        r.warnings.append(f"link '{name}' has no geometry to compute an inertial from; "
+                          "its inertial is kept as given")
+    source = ("collision" if collisions and not (visuals and _same_shapes(visuals, collisions))
+              else "visual" if visuals else None)
+    return chosen_inertial(name, given, source, r.inertia_policy, r.out.repairs)
 
 
-def _rgba(el: ET.Element, what: str, problems: _Problems, warnings: list[str]):
+def _rgba(el, what: str, problems: Problems, warnings: list[str]):
     color = el.find("color")
     if color is None or color.get("rgba") is None:
         return None
-    rgba = _floats(color.get("rgba"), 4, f"{what} colour", problems)
+    rgba = read_floats(color.get("rgba"), 4, f"{what} colour", problems)
     if rgba is None:
         return None
     clamped = [min(1.0, max(0.0, v)) for v in rgba]
@@ -371,109 +322,132 @@ def _rgba(el: ET.Element, what: str, problems: _Problems, warnings: list[str]):
     return clamped
 
 
-def _geometry(el: ET.Element, link: str, kind: str, index: int, resolver: MeshResolver,
-              problems: _Problems, warnings: list[str], out: Converted) -> dict | None:
+# ---------------------------------------------------------------- geometry
+
+
+def _geometry(el, link: str, kind: str, index: int, r: _Reading) -> dict | list[dict] | None:
+    """The recipe shape (a list of them for a capsule) of a <visual> or <collision>, with its
+    origin; None, with a problem or a warning, when it has none the recipe can take."""
     what = f"link '{link}' {kind}"
     geometry = el.find("geometry")
-    shapes = [c for c in geometry] if geometry is not None else []
+    shapes = [c for c in geometry if is_element(c)] if geometry is not None else []
     if not shapes:
-        problems.add(f"{what}: <geometry> holds no shape")
+        r.problems.add(f"{what}: <geometry> holds no shape")
         return None
     shape = shapes[0]  # urdfdom reads the first element and ignores the rest
-    tag = _local(shape.tag)
+    tag = local_name(shape.tag)
     if len(shapes) > 1:
-        rest = ", ".join(f"<{_local(c.tag)}>" for c in shapes[1:])
-        warnings.append(f"{what}: <geometry> holds more than one element; the first (<{tag}>) is used, as "
-                        f"urdfdom does, and {rest} ignored")
-    geom: dict = {}
+        rest = ", ".join(f"<{local_name(c.tag)}>" for c in shapes[1:])
+        r.warnings.append(f"{what}: <geometry> holds more than one element; the first (<{tag}>) is used, as "
+                          f"urdfdom does, and {rest} ignored")
+    if tag == "capsule":  # PyBullet's extension: a cylinder along z with hemispherical ends
+        return _capsule_shapes(shape, el, what, r)
     if tag == "mesh":
-        uri = (shape.get("filename") or "").strip()
-        if not uri:
-            problems.add(f"{what}: <mesh> has no filename")
-            return None
-        path = resolver.locate(uri, link, problems)
-        scale = _floats(shape.get("scale"), 3, f"{what} mesh scale", problems, [1.0, 1.0, 1.0])
-        if path is None:
-            return None
-        if any(s == 0 for s in scale):
-            problems.add(f"{what}: mesh '{uri}' has a zero scale ({shape.get('scale')})")
-            return None
-        dest = resolver.destination(path, uri)
-        geom["mesh"] = resolver.recipe_text(dest)
-        if scale[0] == scale[1] == scale[2]:
-            s = scale[0]
-            unit = next((u for u, f in UNITS.items() if f == s), None)
-            if unit is not None and unit != "m":
-                geom["units"] = unit
-            elif unit is None:
-                geom["scale"] = s
-        else:
-            geom["scale"] = list(scale)
-        out.meshes[(link, kind, index)] = MeshUse(path, dest, tuple(scale))
-    elif tag == "box":
-        size = _floats(shape.get("size"), 3, f"{what} box size", problems)
-        if size is None:
-            return None
-        if min(size) <= 0:
-            warnings.append(f"{what}: box of size {shape.get('size')} has no volume; dropped")
-            return None
-        geom["box"] = {"size": size}
-    elif tag == "cylinder":
-        radius = _float(shape.get("radius"), f"{what} cylinder radius", problems)
-        length = _float(shape.get("length"), f"{what} cylinder length", problems)
-        if radius is None or length is None:
-            return None
-        if radius <= 0 or length <= 0:
-            warnings.append(f"{what}: cylinder of radius {radius!r} and length {length!r} has no volume; dropped")
-            return None
-        geom["cylinder"] = {"radius": radius, "length": length}
-    elif tag == "sphere":
-        radius = _float(shape.get("radius"), f"{what} sphere radius", problems)
-        if radius is None:
-            return None
-        if radius <= 0:
-            warnings.append(f"{what}: sphere of radius {radius!r} has no volume; dropped")
-            return None
-        geom["sphere"] = {"radius": radius}
-    elif tag == "capsule":  # PyBullet's extension: a cylinder along z with hemispherical ends
-        radius = _float(shape.get("radius"), f"{what} capsule radius", problems)
-        length = _float(shape.get("length"), f"{what} capsule length", problems)
-        if radius is None or length is None:
-            return None
-        if radius <= 0 or length < 0:
-            warnings.append(f"{what}: capsule of radius {radius!r} and length {length!r} has no volume; dropped")
-            return None
-        xyz, rpy = _origin(el.find("origin"), what, problems)
-        warnings.append(f"{what}: <capsule> (PyBullet's, not in the URDF standard) is written as a cylinder "
-                        "and two spheres, the same solid")
-        return _capsule(radius, length, xyz, rpy)
+        geom = _mesh(shape, what, link, (link, kind, index), r)
+    elif tag in _SOLIDS:
+        geom = _SOLIDS[tag](shape, what, r)
     else:
-        problems.add(f"{what}: <{tag}> geometry is not supported (use mesh, box, cylinder or sphere)")
+        r.problems.add(f"{what}: <{tag}> geometry is not supported (use mesh, box, cylinder or sphere)")
         return None
-    origin = _origin_dict(*_origin(el.find("origin"), what, problems))
+    if geom is None:
+        return None
+    origin = origin_dict(*read_origin(el.find("origin"), what, r.problems))
     if origin:
         geom["origin"] = origin
     return geom
 
 
+def _mesh(shape, what: str, link: str, use: tuple[str, str, int], r: _Reading) -> dict | None:
+    """A <mesh>: the file where the recipe finds it, its scale as ``units`` or ``scale``."""
+    uri = (shape.get("filename") or "").strip()
+    if not uri:
+        r.problems.add(f"{what}: <mesh> has no filename")
+        return None
+    path = r.resolver.locate(uri, link, r.problems)
+    scale = read_floats(shape.get("scale"), 3, f"{what} mesh scale", r.problems, [1.0, 1.0, 1.0])
+    if path is None:
+        return None
+    if any(s == 0 for s in scale):
+        r.problems.add(f"{what}: mesh '{uri}' has a zero scale ({shape.get('scale')})")
+        return None
+    dest = r.resolver.destination(path, uri)
+    geom: dict = {"mesh": r.resolver.recipe_text(dest)}
+    if scale[0] == scale[1] == scale[2]:
+        s = scale[0]
+        unit = next((u for u, f in UNITS.items() if f == s), None)
+        if unit is not None and unit != "m":
+            geom["units"] = unit
+        elif unit is None:
+            geom["scale"] = s
+    else:
+        geom["scale"] = list(scale)
+    r.out.meshes[use] = MeshUse(path, dest, tuple(scale))
+    return geom
+
+
+def _box(shape, what: str, r: _Reading) -> dict | None:
+    size = read_floats(shape.get("size"), 3, f"{what} box size", r.problems)
+    if size is None:
+        return None
+    if min(size) <= 0:
+        r.warnings.append(f"{what}: box of size {shape.get('size')} has no volume; dropped")
+        return None
+    return {"box": {"size": size}}
+
+
+def _cylinder(shape, what: str, r: _Reading) -> dict | None:
+    radius = read_float(shape.get("radius"), f"{what} cylinder radius", r.problems)
+    length = read_float(shape.get("length"), f"{what} cylinder length", r.problems)
+    if radius is None or length is None:
+        return None
+    if radius <= 0 or length <= 0:
+        r.warnings.append(f"{what}: cylinder of radius {radius!r} and length {length!r} has no volume; dropped")
+        return None
+    return {"cylinder": {"radius": radius, "length": length}}
+
+
+def _sphere(shape, what: str, r: _Reading) -> dict | None:
+    radius = read_float(shape.get("radius"), f"{what} sphere radius", r.problems)
+    if radius is None:
+        return None
+    if radius <= 0:
+        r.warnings.append(f"{what}: sphere of radius {radius!r} has no volume; dropped")
+        return None
+    return {"sphere": {"radius": radius}}
+
+
+_SOLIDS = {"box": _box, "cylinder": _cylinder, "sphere": _sphere}
+
+
+def _capsule_shapes(shape, el, what: str, r: _Reading) -> list[dict] | None:
+    """PyBullet's <capsule> (not in the URDF standard) as the same solid: a cylinder and spheres."""
+    radius = read_float(shape.get("radius"), f"{what} capsule radius", r.problems)
+    length = read_float(shape.get("length"), f"{what} capsule length", r.problems)
+    if radius is None or length is None:
+        return None
+    if radius <= 0 or length < 0:
+        r.warnings.append(f"{what}: capsule of radius {radius!r} and length {length!r} has no volume; dropped")
+        return None
+    xyz, rpy = read_origin(el.find("origin"), what, r.problems)
+    r.warnings.append(f"{what}: <capsule> (PyBullet's, not in the URDF standard) is written as a cylinder "
+                      "and two spheres, the same solid")
+    return _capsule(radius, length, xyz, rpy)
+
+
 def _capsule(radius: float, length: float, xyz, rpy) -> list[dict]:
     """A capsule (the cylinder's ``length`` between the centres of its end spheres) as shapes."""
-    import numpy as np
-
-    from robotkit.geometry import rpy_matrix
-
     axis = rpy_matrix(rpy) @ np.array([0.0, 0.0, length / 2])
     out = []
     if length > 0:
         cyl: dict = {"cylinder": {"radius": radius, "length": length}}
-        origin = _origin_dict(xyz, rpy)
+        origin = origin_dict(xyz, rpy)
         if origin:
             cyl["origin"] = origin
         out.append(cyl)
     for sign in ((1.0, -1.0) if length > 0 else (1.0,)):
         centre = [float(c + sign * a) + 0.0 for c, a in zip(xyz, axis)]
         sph: dict = {"sphere": {"radius": radius}}
-        origin = _origin_dict(centre, (0.0, 0.0, 0.0))
+        origin = origin_dict(centre, (0.0, 0.0, 0.0))
         if origin:
             sph["origin"] = origin
         out.append(sph)
@@ -487,21 +461,67 @@ def _same_shapes(visuals: list[dict], collisions: list[dict]) -> bool:
     return all(strip(v) == strip(c) for v, c in zip(visuals, collisions))
 
 
+# ---------------------------------------------------------------- joints
 
 
+def _joints(children: list, links: dict[str, dict], r: _Reading) -> dict[str, dict]:
+    """Every <joint> as a recipe entry; what the recipe changes from the original goes to
+    ``r.out.joint_notes`` (and the warnings)."""
+    joints: dict[str, dict] = {}
+    for el in children:
+        if local_name(el.tag) != "joint":
+            continue
+        name = el.get("name")
+        if not valid_frame_name(name):
+            r.problems.add(f"joint name '{name}' is not a valid recipe name ({name_hint()})")
+            continue
+        if name in joints:
+            r.problems.add(f"joint '{name}' is defined twice")
+            continue
+        joint = _joint(el, name, r.problems, r.warnings)
+        if joint is None:
+            continue
+        for end in ("parent", "child"):
+            if joint[end] not in links and valid_frame_name(joint[end]):
+                r.problems.add(f"joint '{name}': {end} link '{joint[end]}' is not defined")
+        joints[name] = joint
+    for name, joint in joints.items():
+        note = joint.pop("__note", None)
+        if note:
+            r.out.joint_notes[name] = note
+    for name, sdf_name in names_apart(links, joints).items():
+        if sdf_name != name:  # ROS accepts it; an SDF model has one namespace for links and joints
+            _note(name, f"named like a link in the original: SDF, where links and joints share names, calls it "
+                        f"'{sdf_name}'", r)
+    _drop_dangling_mimics(joints, r)
+    return joints
 
 
+def _note(joint: str, note: str, r: _Reading) -> None:
+    """Record what the recipe changes on ``joint`` (its comment in the recipe) and warn."""
+    r.out.joint_notes[joint] = "; ".join(filter(None, (r.out.joint_notes.get(joint), note)))
+    r.warnings.append(f"joint '{joint}': {note}")
 
 
+def _drop_dangling_mimics(joints: dict[str, dict], r: _Reading) -> None:
+    """A mimic of a joint the robot does not have, or of a fixed joint, is dropped."""
+    for name, joint in joints.items():
+        mimic = joint.get("mimic")
+        if mimic and mimic["joint"] not in joints:  # check_urdf accepts it (Alex's hands: 'index_q1')
+            note = (f"mimicked joint '{mimic['joint']}' in the original, which the robot does not have (Drake "
+                    "refuses such a URDF): the mimic is dropped and the joint moves on its own")
+        elif mimic and joints[mimic["joint"]]["type"] == "fixed":
+            note = (f"mimicked fixed joint '{mimic['joint']}' in the original: a fixed joint has no position to "
+                    "follow, so the mimic is dropped and the joint moves on its own")
+        else:
+            continue
+        del joint["mimic"]
+        _note(name, note, r)
 
 
-
-
-
-
-def _joint(el: ET.Element, name: str, problems: _Problems, warnings: list[str]) -> dict | None:
-    from robotkit.recipe.schema import JOINT_TYPES
-
+def _joint(el, name: str, problems: Problems, warnings: list[str]) -> dict | None:
+    """One <joint> as a recipe entry (with ``__note`` when the recipe changes it), or None with a
+    problem."""
     what = f"joint '{name}'"
     jtype = el.get("type")
     if jtype not in JOINT_TYPES:
@@ -512,130 +532,156 @@ def _joint(el: ET.Element, name: str, problems: _Problems, warnings: list[str]) 
         problems.add(f"{what}: needs <parent link=...> and <child link=...>")
         return None
     joint: dict = {"type": jtype, "parent": parent.get("link"), "child": child.get("link")}
-    origin = _origin_dict(*_origin(el.find("origin"), what, problems))
+    origin = origin_dict(*read_origin(el.find("origin"), what, problems))
     if origin:
         joint["origin"] = origin
     if jtype not in ("fixed", "floating"):
-        axis_el = el.find("axis")
-        axis = _floats(axis_el.get("xyz") if axis_el is not None else None, 3, f"{what} axis", problems,
-                       [1.0, 0.0, 0.0])
-        if axis is not None and sum(a * a for a in axis) == 0:
-            problems.add(f"{what}: axis must not be zero")
-        elif axis is not None and axis != [1.0, 0.0, 0.0]:
-            joint["axis"] = axis
+        _axis(el, joint, what, problems)
     limit_el = el.find("limit")
     if limit_el is not None:
-        if jtype in ("revolute", "prismatic"):
-            limit = {}
-            for key, default in (("lower", 0.0), ("upper", 0.0), ("effort", None), ("velocity", None)):
-                v = _float(limit_el.get(key), f"{what} limit {key}", problems, default)
-                if v is None:
-                    problems.add(f"{what}: <limit> needs {key} (URDF requires effort and velocity)")
-                    return None
-                limit[key] = v
-            if limit["lower"] == limit["upper"] and jtype == "revolute":
-                # urdfdom's default limits are lower = upper = 0: files that mean "free" write that
-                note = (f"limit lower == upper ({limit['lower']!r}) in the original: read as no position limit "
-                        "(lower and upper default to 0 in URDF), the joint is continuous")
-                warnings.append(f"{what}: {note}")
-                joint["type"] = "continuous"
-                joint["__note"] = note
-                kept = {k: abs(limit[k]) for k in ("effort", "velocity")}
-                joint["limit"] = kept
-            elif limit["lower"] == limit["upper"]:  # prismatic
-                # it can only be at that position: consumers that keep limits (Gazebo, Drake,
-                # Pinocchio) hold it there; MuJoCo ignores equal limits and lets it slide away
-                at = limit["lower"]
-                note = (f"limit lower == upper ({at!r}) in the original: the joint can only be at that position, "
-                        f"so it is fixed there{_moved(at)}; MuJoCo would ignore the equal limits and let it slide "
-                        "freely")
-                warnings.append(f"{what}: {note}")
-                axis = joint.pop("axis", [1.0, 0.0, 0.0])
-                if at != 0:
-                    joint.pop("origin", None)
-                    origin = _slid(el, what, problems, axis, at)
-                    if origin:
-                        joint["origin"] = origin
-                joint["type"] = "fixed"
-                joint["__note"] = note
-                el = _without_mimic(el, joint, what, warnings)
-            elif limit["lower"] >= limit["upper"]:
-                problems.add(f"{what}: limit lower ({limit['lower']!r}) is not below upper ({limit['upper']!r}); "
-                             "a recipe cannot express a locked revolute or prismatic joint (make it fixed)")
-                return None
-            else:
-                for key in ("effort", "velocity"):
-                    if limit[key] < 0:
-                        warnings.append(f"{what}: negative {key} limit {limit[key]!r}; using its magnitude")
-                        limit[key] = -limit[key]
-                joint["limit"] = limit
-        elif jtype == "continuous":
-            limit = {}
-            for key in ("effort", "velocity"):
-                v = _float(limit_el.get(key), f"{what} limit {key}", problems)
-                if v is not None:
-                    limit[key] = abs(v)
-            if limit_el.get("lower") is not None or limit_el.get("upper") is not None:
-                warnings.append(f"{what}: a continuous joint has no position limits; "
-                                "its lower and upper are dropped (URDF ignores them too)")
-            if limit:
-                joint["limit"] = limit
-        else:
-            warnings.append(f"{what}: a {jtype} joint takes no <limit>; dropped (URDF ignores it too)")
+        el = _limit(el, limit_el, joint, what, problems, warnings)
+        if el is None:
+            return None
     elif jtype in ("revolute", "prismatic"):
         problems.add(f"{what}: a {jtype} joint needs <limit> (lower, upper, effort, velocity)")
         return None
-    dyn_el = el.find("dynamics")
-    if dyn_el is not None:
-        dyn = {}
-        for key in ("damping", "friction"):
-            v = _float(dyn_el.get(key), f"{what} dynamics {key}", problems)
-            if v is not None:
-                if v < 0:
-                    problems.add(f"{what}: dynamics {key} must not be negative ({v!r})")
-                else:
-                    dyn[key] = v
-        if dyn:
-            joint["dynamics"] = dyn
-    mimic_el = el.find("mimic")
-    if mimic_el is not None:
-        if not mimic_el.get("joint"):
-            problems.add(f"{what}: <mimic> needs a joint")
-        else:
-            mimic: dict = {"joint": mimic_el.get("joint")}
-            for key in ("multiplier", "offset"):
-                v = _float(mimic_el.get(key), f"{what} mimic {key}", problems)
-                if v is not None:
-                    mimic[key] = v
-            joint["mimic"] = mimic
+    _dynamics(el.find("dynamics"), joint, what, problems)
+    _mimic(el.find("mimic"), joint, what, problems)
     for child_el in el:
-        tag = _local(child_el.tag)
-        if tag not in ("parent", "child", "origin", "axis", "limit", "dynamics", "mimic"):
+        tag = local_name(child_el.tag)
+        if is_element(child_el) and tag not in ("parent", "child", "origin", "axis", "limit", "dynamics", "mimic"):
             warnings.append(f"{what}: <{tag}> is dropped (the recipe has no place for it)")
     return joint
+
+
+def _axis(el, joint: dict, what: str, problems: Problems) -> None:
+    axis_el = el.find("axis")
+    axis = read_floats(axis_el.get("xyz") if axis_el is not None else None, 3, f"{what} axis", problems,
+                       [1.0, 0.0, 0.0])
+    if axis is not None and sum(a * a for a in axis) == 0:
+        problems.add(f"{what}: axis must not be zero")
+    elif axis is not None and axis != [1.0, 0.0, 0.0]:
+        joint["axis"] = axis
+
+
+def _limit(el, limit_el, joint: dict, what: str, problems: Problems, warnings: list[str]):
+    """The joint's <limit> into ``joint``.  Returns the joint element the rest is read from (a
+    copy without <mimic> when the joint became fixed), None with a problem."""
+    jtype = joint["type"]
+    if jtype == "continuous":
+        limit = {}
+        for key in ("effort", "velocity"):
+            v = read_float(limit_el.get(key), f"{what} limit {key}", problems)
+            if v is not None:
+                limit[key] = abs(v)
+        if limit_el.get("lower") is not None or limit_el.get("upper") is not None:
+            warnings.append(f"{what}: a continuous joint has no position limits; "
+                            "its lower and upper are dropped (URDF ignores them too)")
+        if limit:
+            joint["limit"] = limit
+    elif jtype not in ("revolute", "prismatic"):
+        warnings.append(f"{what}: a {jtype} joint takes no <limit>; dropped (URDF ignores it too)")
+    else:
+        return _bounded_limit(el, limit_el, joint, what, problems, warnings)
+    return el
+
+
+def _bounded_limit(el, limit_el, joint: dict, what: str, problems: Problems, warnings: list[str]):
+    """A revolute or prismatic joint's limit.  lower == upper: a revolute joint is read as
+    continuous (urdfdom's default limits are lower = upper = 0: files that mean "free" write
+    that), a prismatic one as fixed at that position.  Returns as :func:`_limit` does."""
+    limit = {}
+    for key, default in (("lower", 0.0), ("upper", 0.0), ("effort", None), ("velocity", None)):
+        v = read_float(limit_el.get(key), f"{what} limit {key}", problems, default)
+        if v is None:
+            problems.add(f"{what}: <limit> needs {key} (URDF requires effort and velocity)")
+            return None
+        limit[key] = v
+    if limit["lower"] == limit["upper"] and joint["type"] == "revolute":
+        note = (f"limit lower == upper ({limit['lower']!r}) in the original: read as no position limit "
+                "(lower and upper default to 0 in URDF), the joint is continuous")
+        warnings.append(f"{what}: {note}")
+        joint["type"] = "continuous"
+        joint["__note"] = note
+        joint["limit"] = {k: abs(limit[k]) for k in ("effort", "velocity")}
+    elif limit["lower"] == limit["upper"]:  # prismatic
+        return _fixed_at(el, joint, limit["lower"], what, problems, warnings)
+    elif limit["lower"] >= limit["upper"]:
+        problems.add(f"{what}: limit lower ({limit['lower']!r}) is not below upper ({limit['upper']!r}); "
+                     "a recipe cannot express a locked revolute or prismatic joint (make it fixed)")
+        return None
+    else:
+        for key in ("effort", "velocity"):
+            if limit[key] < 0:
+                warnings.append(f"{what}: negative {key} limit {limit[key]!r}; using its magnitude")
+                limit[key] = -limit[key]
+        joint["limit"] = limit
+    return el
+
+
+def _fixed_at(el, joint: dict, at: float, what: str, problems: Problems, warnings: list[str]):
+    """A prismatic joint with lower == upper can only be at that position: consumers that keep
+    limits (Gazebo, Drake, Pinocchio) hold it there; MuJoCo ignores equal limits and lets it
+    slide away.  The recipe makes it fixed there."""
+    note = (f"limit lower == upper ({at!r}) in the original: the joint can only be at that position, "
+            f"so it is fixed there{_moved(at)}; MuJoCo would ignore the equal limits and let it slide "
+            "freely")
+    warnings.append(f"{what}: {note}")
+    axis = joint.pop("axis", [1.0, 0.0, 0.0])
+    if at != 0:
+        joint.pop("origin", None)
+        origin = _slid(el, what, problems, axis, at)
+        if origin:
+            joint["origin"] = origin
+    joint["type"] = "fixed"
+    joint["__note"] = note
+    return _without_mimic(el, joint, what, warnings)
+
+
+def _dynamics(dyn_el, joint: dict, what: str, problems: Problems) -> None:
+    if dyn_el is None:
+        return
+    dyn = {}
+    for key in ("damping", "friction"):
+        v = read_float(dyn_el.get(key), f"{what} dynamics {key}", problems)
+        if v is not None:
+            if v < 0:
+                problems.add(f"{what}: dynamics {key} must not be negative ({v!r})")
+            else:
+                dyn[key] = v
+    if dyn:
+        joint["dynamics"] = dyn
+
+
+def _mimic(mimic_el, joint: dict, what: str, problems: Problems) -> None:
+    if mimic_el is None:
+        return
+    if not mimic_el.get("joint"):
+        problems.add(f"{what}: <mimic> needs a joint")
+        return
+    mimic: dict = {"joint": mimic_el.get("joint")}
+    for key in ("multiplier", "offset"):
+        v = read_float(mimic_el.get(key), f"{what} mimic {key}", problems)
+        if v is not None:
+            mimic[key] = v
+    joint["mimic"] = mimic
 
 
 def _moved(at: float) -> str:
     return "" if at == 0 else f", its origin moved {fmt(at)} along the axis"
 
 
-def _slid(el: ET.Element, what: str, problems: _Problems, axis: list[float], at: float) -> dict | None:
+def _slid(el, what: str, problems: Problems, axis: list[float], at: float) -> dict | None:
     """The joint's origin with the child slid ``at`` along the (unit) axis: where the prismatic
     joint puts it at position ``at``."""
-    import numpy as np
-
-    from robotkit.geometry import rpy_matrix
-
-    xyz, rpy = _origin(el.find("origin"), what, problems)
+    xyz, rpy = read_origin(el.find("origin"), what, problems)
     a = np.asarray(axis, dtype=float)
     moved = np.asarray(xyz, dtype=float) + rpy_matrix(rpy) @ (a / np.linalg.norm(a)) * at
-    return _origin_dict([float(v) + 0.0 for v in moved], rpy)
+    return origin_dict([float(v) + 0.0 for v in moved], rpy)
 
 
-def _without_mimic(el: ET.Element, joint: dict, what: str, warnings: list[str]) -> ET.Element:
+def _without_mimic(el, joint: dict, what: str, warnings: list[str]):
     """A copy of the joint element without <mimic> when it has one (a fixed joint follows no joint)."""
-    import copy
-
     mimic = el.find("mimic")
     if mimic is None:
         return el
@@ -646,13 +692,69 @@ def _without_mimic(el: ET.Element, joint: dict, what: str, warnings: list[str]) 
     return el
 
 
+# ---------------------------------------------------------------- everything else
+
+
+def _extras(children: list, root, links: _Links, joints: dict[str, dict], materials: dict[str, dict],
+            r: _Reading) -> list[str]:
+    """Every other top-level element as XML text for ``urdf_extras``: gazebo blocks without what
+    the recipe now says (materials, contacts, ``preserveFixedJoint``), transmissions, ... verbatim.
+    A transmission naming a joint the robot does not have is left out."""
+    extras: list[str] = []
+    gazebo_links: dict[str, list[tuple[int, object]]] = {}
+    for idx, el in enumerate(children):
+        if local_name(el.tag) == "gazebo" and el.get("reference") in links.links:
+            gazebo_links.setdefault(el.get("reference"), []).append((idx, el))
+    remove: dict[int, set[str]] = {}  # element index -> child tags handled by the recipe
+    _map_gazebo_materials(gazebo_links, links.visual_materials, materials, remove)
+    _map_contacts(gazebo_links, links.has_collision, links.links, remove)
+    for idx, el in enumerate(children):
+        tag = local_name(el.tag)
+        if tag in ("link", "joint", "material"):
+            continue
+        drop = set(remove.get(idx, ()))
+        if tag == "gazebo" and joints.get(el.get("reference"), {}).get("type") == "fixed":
+            pes = el.find("preserveFixedJoint")
+            if pes is not None and _text(pes).strip().lower() in ("true", "1"):
+                drop.add("preserveFixedJoint")  # robotkit writes it for every fixed joint
+        missing = [j.get("name") for j in el.findall("joint") if j.get("name") not in joints] \
+            if tag == "transmission" else []
+        if missing:  # the Jackal's transmissions name joint 'front_left_wheel' for 'front_left_wheel_joint'
+            note = (f"transmission '{el.get('name')}' is left out: it names joint '{missing[0]}', which the robot "
+                    "does not have (Drake refuses the URDF, ros_control the transmission)")
+            r.out.left_out.append(note)
+            r.warnings.append(note)
+            continue
+        xml_text = _verbatim(el, drop, root)
+        if xml_text is None:
+            continue
+        extras.append(xml_text)
+        r.out.extras.append(_label(el))
+    if r.out.extras:
+        n = len(r.out.extras)
+        r.warnings.append(f"{n} element{'s' if n > 1 else ''} the recipe cannot express yet "
+                          f"{'are' if n > 1 else 'is'} carried through verbatim in urdf_extras: "
+                          f"{', '.join(r.out.extras)}")
+    return extras
+
+
 # ---------------------------------------------------------------- gazebo blocks
 
 
-def _simple_text(el: ET.Element) -> str | None:
-    if len(el) or el.attrib:
+def _text(el) -> str:
+    """The element's text as ElementTree gives it: up to its first child element, comments skipped."""
+    parts = [el.text or ""]
+    for child in el:
+        if is_element(child):
+            break
+        parts.append(child.tail or "")
+    return "".join(parts)
+
+
+def _simple_text(el) -> str | None:
+    if any(is_element(c) for c in el) or el.attrib:
         return None
-    return (el.text or "").strip()
+    return _text(el).strip()
 
 
 def _map_gazebo_materials(gazebo_links, link_visual_materials, materials, remove):
@@ -738,8 +840,8 @@ def _map_contacts(gazebo_links, link_has_collision, links, remove):
 # ---------------------------------------------------------------- verbatim elements
 
 
-def _label(el: ET.Element) -> str:
-    tag = _local(el.tag)
+def _label(el) -> str:
+    tag = local_name(el.tag)
     for attr in ("reference", "name"):
         if el.get(attr):
             return f"<{tag} {attr}=\"{el.get(attr)}\">"
@@ -749,107 +851,129 @@ def _label(el: ET.Element) -> str:
     return f"<{tag}>"
 
 
-def _verbatim(node, drop: set[str], root) -> str | None:
+# The writer below sees an element as the source wrote it: its child nodes are its text runs
+# (str), child elements and comments, in order, as a DOM has them; qualified names keep their
+# prefixes, and an element's own namespace declarations come first among its attributes.
+
+
+def _verbatim(el, drop: set[str], root) -> str | None:
     """The element's XML text as in the source, without the child elements named in
     ``drop``; None when nothing but whitespace and comments would remain."""
-    node = node.cloneNode(True)
+    kids = _nodes(el)
     if drop:
-        for child in list(node.childNodes):
-            if child.nodeType == child.ELEMENT_NODE and child.tagName in drop:
-                prev = child.previousSibling
-                if prev is not None and prev.nodeType == prev.TEXT_NODE and not prev.data.strip():
-                    node.removeChild(prev)
-                node.removeChild(child)
-        if not any(c.nodeType == c.ELEMENT_NODE or (c.nodeType == c.TEXT_NODE and c.data.strip())
-                   for c in node.childNodes):
+        kept: list = []
+        for kid in kids:
+            if not isinstance(kid, str) and is_element(kid) and _qname(kid) in drop:
+                if kept and isinstance(kept[-1], str) and not kept[-1].strip():
+                    kept.pop()  # the whitespace before it
+                continue
+            kept.append(kid)
+        kids = kept
+        if not any((isinstance(k, str) and k.strip()) or (not isinstance(k, str) and is_element(k)) for k in kids):
             return None
     # namespace prefixes declared on <robot> (e.g. xmlns:xacro) that the element uses
-    used = set(re.findall(r"</?([A-Za-z_][\w.\-]*):", _xml(node))) | {
-        a.split(":")[0] for a in _all_attr_names(node) if ":" in a and not a.startswith("xmlns")}
-    for prefix in sorted(used):
-        decl = f"xmlns:{prefix}"
-        if root.hasAttribute(decl) and not node.hasAttribute(decl):
-            node.setAttribute(decl, root.getAttribute(decl))
-    text = _xml(node, "" if _unformatted(node) else None)  # xacro drops the whitespace between elements:
-    # indent for reading
+    used = set(re.findall(r"</?([A-Za-z_][\w.\-]*):", _xml(el, kids=kids))) | {
+        a.split(":")[0] for a in _all_attr_names(el, kids) if ":" in a and not a.startswith("xmlns")}
+    own = _declarations(el)
+    added = [(f"xmlns:{prefix}", root.nsmap[prefix]) for prefix in sorted(used)
+             if prefix in root.nsmap and f"xmlns:{prefix}" not in own]
+    text = _xml(el, "" if _unformatted(kids) else None, kids, added)  # xacro drops the whitespace between
+    # elements: indent for reading
     lines = [line.rstrip() for line in text.split("\n")]
     rest = [line for line in lines[1:] if line.strip()]
     if rest:
         indent = min(len(line) - len(line.lstrip(" ")) for line in rest)
         lines = [lines[0]] + [line[indent:] if line[:indent].strip() == "" else line for line in lines[1:]]
     text = "\n".join(lines)
-    ET.fromstring(text)  # well-formed (the schema checks it too)
+    urdfxml.parse_text(text)  # well-formed (the schema checks it too)
     return text
 
 
-def _xml(node, indent: str | None = None) -> str:
-    """The XML text of a minidom node, attributes in document order; with ``indent``, one element a
-    line (for elements holding elements only).  minidom's own writer is not used: importing xacro
-    replaces it for the whole process (sorted attributes, whitespace dropped), so the recipe
-    would depend on whether a xacro file was read before."""
-    def esc(text: str) -> str:
-        return text.replace("&", "&amp;").replace("<", "&lt;").replace('"', "&quot;").replace(">", "&gt;")
-
-    if node.nodeType == node.TEXT_NODE:
-        return esc(node.data)
-    if node.nodeType == node.COMMENT_NODE:
-        return f"<!--{node.data}-->"
-    if node.nodeType == node.CDATA_SECTION_NODE:
-        return f"<![CDATA[{node.data}]]>"
-    if node.nodeType != node.ELEMENT_NODE:
-        return ""
-    head = node.tagName + "".join(f' {a.name}="{esc(a.value)}"' for a in node.attributes.values())
-    kids = list(node.childNodes)
-    if not kids:
-        return f"<{head}/>"
-    if indent is None or (len(kids) == 1 and kids[0].nodeType == node.TEXT_NODE):
-        return f"<{head}>" + "".join(_xml(k) for k in kids) + f"</{node.tagName}>"
-    inner = [_xml(k, indent + "  ") for k in kids if not (k.nodeType == k.TEXT_NODE and not k.data.strip())]
-    return f"<{head}>\n" + "".join(f"{indent}  {x}\n" for x in inner) + f"{indent}</{node.tagName}>"
-
-
-def _unformatted(node) -> bool:
-    """True when the element has child elements, no whitespace between them, and no text
-    mixed with elements anywhere (so indenting it changes no text)."""
-    elements = [c for c in node.childNodes if c.nodeType == c.ELEMENT_NODE]
-    if not elements:
-        return False
-
-    def plain(n) -> bool:
-        kids = [c for c in n.childNodes if c.nodeType == c.ELEMENT_NODE]
-        texts = [c for c in n.childNodes if c.nodeType in (c.TEXT_NODE, c.CDATA_SECTION_NODE)]
-        if kids and texts:
-            return False
-        return all(plain(c) for c in kids)
-
-    return plain(node)
-
-
-def _all_attr_names(node):
-    out = []
-    if node.nodeType == node.ELEMENT_NODE:
-        out.extend(node.attributes.keys())
-        for c in node.childNodes:
-            out.extend(_all_attr_names(c))
+def _nodes(el) -> list:
+    """The element's child nodes: text runs (str), elements, comments."""
+    out = [el.text] if el.text else []
+    for child in el:
+        out.append(child)
+        if child.tail:
+            out.append(child.tail)
     return out
 
 
-# ---------------------------------------------------------------- YAML
+def _qname(el) -> str:
+    """The element's name as written (``prefix:local``)."""
+    local = el.tag.rsplit("}", 1)[-1]
+    return f"{el.prefix}:{local}" if el.prefix else local
 
 
+_XML_NS = "http://www.w3.org/XML/1998/namespace"
 
 
+def _attributes(el) -> list[tuple[str, str]]:
+    """(name as written, value) of the element's attributes, in document order."""
+    prefixes = {uri: prefix for prefix, uri in reversed(list(el.nsmap.items())) if prefix}
+    prefixes[_XML_NS] = "xml"
+    out = []
+    for name, value in el.attrib.items():
+        if name.startswith("{"):
+            uri, local = name[1:].split("}", 1)
+            name = f"{prefixes.get(uri, '')}:{local}"
+        out.append((name, value))
+    return out
 
 
+def _declarations(el) -> dict[str, str]:
+    """The namespace declarations written on the element (``xmlns:p`` -> URI), in order."""
+    parent = el.getparent()
+    inherited = parent.nsmap if parent is not None else {}
+    return {(f"xmlns:{p}" if p else "xmlns"): uri for p, uri in el.nsmap.items() if inherited.get(p) != uri}
 
 
+def _xml(node, indent: str | None = None, kids: list | None = None, added=()) -> str:
+    """The XML text of a node, attributes in document order; with ``indent``, one element a
+    line (for elements holding elements only).  ``kids`` replaces an element's child nodes,
+    ``added`` are attributes written after its own."""
+    def esc(text: str) -> str:
+        return text.replace("&", "&amp;").replace("<", "&lt;").replace('"', "&quot;").replace(">", "&gt;")
+
+    if isinstance(node, str):
+        return esc(node)
+    if not is_element(node):
+        return f"<!--{node.text or ''}-->" if node.tag is _comment_tag() else ""  # a processing instruction: nothing
+    name = _qname(node)
+    attributes = [*_declarations(node).items(), *_attributes(node), *added]
+    head = name + "".join(f' {a}="{esc(v)}"' for a, v in attributes)
+    kids = _nodes(node) if kids is None else kids
+    if not kids:
+        return f"<{head}/>"
+    if indent is None or (len(kids) == 1 and isinstance(kids[0], str)):
+        return f"<{head}>" + "".join(_xml(k) for k in kids) + f"</{name}>"
+    inner = [_xml(k, indent + "  ") for k in kids if not (isinstance(k, str) and not k.strip())]
+    return f"<{head}>\n" + "".join(f"{indent}  {x}\n" for x in inner) + f"{indent}</{name}>"
 
 
+def _comment_tag():
+    from lxml import etree  # heavy (urdfxml loads it when it reads a URDF)
+
+    return etree.Comment
 
 
+def _unformatted(kids: list) -> bool:
+    """True when the element (child nodes ``kids``) has child elements, no whitespace between
+    them, and no text mixed with elements anywhere (so indenting it changes no text)."""
+    def elements(nodes):
+        return [c for c in nodes if not isinstance(c, str) and is_element(c)]
+
+    def plain(nodes) -> bool:
+        if elements(nodes) and any(isinstance(c, str) for c in nodes):
+            return False
+        return all(plain(_nodes(c)) for c in elements(nodes))
+
+    return bool(elements(kids)) and plain(kids)
 
 
-
-
-
-
+def _all_attr_names(el, kids: list) -> list[str]:
+    out = [name for name, _ in _attributes(el)]
+    for child in kids:
+        if not isinstance(child, str) and is_element(child):
+            out.extend(_all_attr_names(child, _nodes(child)))
+    return out

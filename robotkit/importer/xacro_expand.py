@@ -1,6 +1,6 @@
 """Expand a xacro file in-process, sandboxed for untrusted input.
 
-xacro (2.1.1, the ROS 2 flavour from PyPI) is used as a library (LIBRARIES.md section 2):
+xacro (2.1.1, the ROS 2 flavour from PyPI) is used as a library (docs/libraries.md, section 2):
 ``process_file``, never ``process()``; its state is module-global, so one expansion runs
 at a time (a lock) and every patch is undone afterwards.
 
@@ -42,7 +42,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from robotkit.errors import Problem, RobotkitError
+from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.paths import ReadPolicy
 
 _LOCK = threading.Lock()
 
@@ -283,58 +284,85 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
     and line) for a missing package, a missing argument, an unsafe expression, a blocked read,
     a limit, or any other xacro error.
     """
-    import xml.parsers.expat
-
-    import xacro
-    import xacro.substitution_args as sa
-    import yaml
-
-    from robotkit.paths import ReadPolicy
+    import xacro  # heavy, and it replaces minidom's writer for the whole process: only when expanding
 
     path = Path(path).absolute()
     if not path.is_file():
         raise RobotkitError(Problem("file not found", file=str(path)))
-    packages = dict(package_paths)
-    args = dict(args or {})
-    state = _State()
-    policy = ReadPolicy.for_file(path, extra_roots=roots, packages=packages)
-    limits = _Limits(TIME_LIMIT if time_limit is None else time_limit)
-    guards = _guard_symbols(limits)
+    sandbox = _Sandbox(path, dict(package_paths), dict(args or {}), roots,
+                       _Limits(TIME_LIMIT if time_limit is None else time_limit))
+    stderr = io.StringIO()
+    with _LOCK, sandbox.installed():
+        with contextlib.redirect_stderr(stderr):
+            doc = sandbox.process()
+        includes = sorted({os.path.abspath(f) for f in xacro.all_includes})
+    warnings = [f"{_show(path)}: xacro: {line.strip()}" for line in stderr.getvalue().splitlines()
+                if line.strip() and not line.startswith(" ") and "when processing file" not in line]
+    return Expanded(_document_text(doc), includes, warnings)
 
-    def find(pkg):
+
+def _document_text(doc) -> str:
+    """The expanded document as URDF text, without xacro's banner comments."""
+    root = doc.documentElement
+    for el in [root, *root.getElementsByTagName("*")]:  # xacro:attribute leaves its value a number, on which
+        for attr in el.attributes.values():  # xacro's writer fails; every other attribute is str() of its value
+            if not isinstance(attr.value, str):
+                attr.value = str(attr.value)
+    return '<?xml version="1.0"?>\n' + root.toxml() + "\n"
+
+
+class _Sandbox:
+    """One expansion's replacements for xacro's functions (reads, substitutions, evaluation)
+    and what they found (:class:`_State`).  :meth:`installed` puts them in place and restores
+    xacro's own afterwards."""
+
+    def __init__(self, path: Path, packages: dict[str, str], args: dict[str, str], roots, limits: _Limits):
+        import xacro
+        import xacro.substitution_args as sa
+
+        self.path, self.packages, self.args, self.limits = path, packages, args, limits
+        self.state = _State()
+        self.policy = ReadPolicy.for_file(path, extra_roots=roots, packages=packages)
+        self.guards = _guard_symbols(limits)
+        self.original_abs = xacro.abs_filename_spec
+        self.original_parse = xacro.parse
+        self.original_resolve = sa.resolve_args
+        self.original_eval_all = xacro.eval_all
+
+    # ---- substitutions and reads
+
+    def find(self, pkg):
         try:
-            return packages[pkg]
+            return self.packages[pkg]
         except KeyError:
-            state.missing = pkg
+            self.state.missing = pkg
             raise _MissingPackage(pkg) from None
 
-    def env(name):
-        state.blocked = (f"$(env {name}) is blocked: an imported file does not read the environment "
-                         f"(give the value as an argument, or use $(optenv {name} DEFAULT))")
+    def env(self, name):
+        self.state.blocked = (f"$(env {name}) is blocked: an imported file does not read the environment "
+                              f"(give the value as an argument, or use $(optenv {name} DEFAULT))")
         raise _Blocked(name)
 
+    @staticmethod
     def optenv(name, default=""):
         return default
 
-    def allowed(file: str) -> str:
-        problem = policy.problem(os.path.normpath(file))
+    def allowed(self, file: str) -> str:
+        problem = self.policy.problem(os.path.normpath(file))
         if problem is not None:
-            state.blocked = f"reading {problem.message}"
+            self.state.blocked = f"reading {problem.message}"
             raise _Blocked(file)
         return file
 
-    original_abs = xacro.abs_filename_spec
-    original_parse = xacro.parse
-    original_resolve = sa.resolve_args
-    original_eval_all = xacro.eval_all
+    def abs_filename_spec(self, spec):
+        return self.allowed(self.original_abs(spec))
 
-    def guarded_abs(spec):
-        return allowed(original_abs(spec))
+    def parse(self, inp, filename=None):
+        import xacro
 
-    def guarded_parse(inp, filename=None):
         if inp is None:
             full = os.path.join(xacro.root_dir or "", filename) if not os.path.isabs(filename) else filename
-            allowed(full)
+            self.allowed(full)
             try:
                 f = open(full, "rb")
             except OSError as e:
@@ -343,34 +371,40 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
             with f:
                 return _parse_with_lines(f, full)
         if isinstance(inp, str):
-            return _parse_with_lines(inp, xacro.filestack[-1] if xacro.filestack else str(path))
-        return original_parse(inp, filename)
+            return _parse_with_lines(inp, xacro.filestack[-1] if xacro.filestack else str(self.path))
+        return self.original_parse(inp, filename)
 
-    def guarded_resolve(arg_str, context=None, filename=None):
+    def resolve_args(self, arg_str, context=None, filename=None):
+        import xacro
+
         if arg_str and "$(find-pkg-share " in arg_str:
             arg_str = arg_str.replace("$(find-pkg-share ", "$(find ")
         if context is not None and xacro.filestack:  # xacro 2.1 never tells $(dirname) the file
             context["filename"] = xacro.filestack[-1]
-        return original_resolve(arg_str, context, filename)
+        return self.original_resolve(arg_str, context, filename)
 
-    def guarded_eval_all(node, macros, symbols):
-        limits.tick()
-        return original_eval_all(node, macros, symbols)
+    # ---- evaluation
 
-    def guarded_safe_eval(expr, globals, locals=None):
-        limits.tick()
+    def eval_all(self, node, macros, symbols):
+        self.limits.tick()
+        return self.original_eval_all(node, macros, symbols)
+
+    def safe_eval(self, expr, globals, locals=None):
+        self.limits.tick()
         try:
             check_expression(expr, lambda name: name in globals)
         except UnsafeExpression as exc:
-            state.unsafe = (expr.strip(), str(exc))
+            self.state.unsafe = (expr.strip(), str(exc))
             raise
         code = _compile_guarded(expr)
-        dict.update(globals, __builtins__={}, **guards)  # disable default builtins (as xacro does)
+        dict.update(globals, __builtins__={}, **self.guards)  # disable default builtins (as xacro does)
         return eval(code, globals, locals)
 
-    def guarded_eval(s, context):
-        # xacro's own version evaluates with Python's full builtins (see the module docstring)
-        limits.tick()
+    def eval(self, s, context):
+        """``$(eval ...)``: xacro's own version evaluates with Python's full builtins (see the module docstring)."""
+        import xacro.substitution_args as sa
+
+        self.limits.tick()
         if "arg" not in context:
             context["arg"] = {}
 
@@ -382,68 +416,57 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
 
         functions = {"arg": arg, "dirname": dirname}
         functions.update({k: v for k, v in sa._eval_dict.items() if not k.startswith("_")})
-        functions.update(find=find, env=env, optenv=optenv)
+        functions.update(find=self.find, env=self.env, optenv=self.optenv)
         names = sa._DictWrapper(context["arg"], functions)
         try:
             check_expression(s, lambda name: name in context["arg"] or name in functions)
         except UnsafeExpression as exc:
-            state.unsafe = (s.strip(), str(exc))
+            self.state.unsafe = (s.strip(), str(exc))
             raise
-        builtins = dict(SAFE_BUILTINS, range=limits.range)
-        return str(eval(_compile_guarded(s), {"__builtins__": builtins, **guards}, names))
+        builtins = dict(SAFE_BUILTINS, range=self.limits.range)
+        return str(eval(_compile_guarded(s), {"__builtins__": builtins, **self.guards}, names))
 
-    symbols = xacro.create_global_symbols()
-    python_ns = symbols.get("python")
-    if python_ns is not None:
-        for name in ("vars", "type"):
-            dict.pop(python_ns, name, None)
-        if "range" in python_ns:
-            dict.__setitem__(python_ns, "range", limits.range)
-    if "range" in symbols:
-        symbols["range"] = limits.range
+    def symbols(self):
+        """xacro's global symbols without ``python.type`` and ``python.vars``, with a bounded range."""
+        import xacro
 
-    saved = {
-        (xacro, "safe_eval"): xacro.safe_eval,
-        (xacro, "_global_symbols"): xacro._global_symbols,
-        (xacro, "abs_filename_spec"): original_abs,
-        (xacro, "parse"): original_parse,
-        (xacro, "eval_all"): original_eval_all,
-        (sa, "_eval"): sa._eval,
-        (sa, "_eval_find"): sa._eval_find,
-        (sa, "_eval_env"): sa._eval_env,
-        (sa, "_eval_optenv"): sa._eval_optenv,
-        (sa, "resolve_args"): original_resolve,
-    }
-    saved_dict = {k: sa._eval_dict.get(k) for k in ("find", "env", "optenv")}
-    # xacro.load_yaml registers its unit tags (!degrees...) on yaml.SafeLoader, in place
-    own = yaml.SafeLoader.__dict__.get("yaml_constructors")
-    saved_constructors = dict(own) if own is not None else None
-    stderr = io.StringIO()
-    with _LOCK:
+        symbols = xacro.create_global_symbols()
+        python_ns = symbols.get("python")
+        if python_ns is not None:
+            for name in ("vars", "type"):
+                dict.pop(python_ns, name, None)
+            if "range" in python_ns:
+                dict.__setitem__(python_ns, "range", self.limits.range)
+        if "range" in symbols:
+            symbols["range"] = self.limits.range
+        return symbols
+
+    # ---- installing and running
+
+    @contextlib.contextmanager
+    def installed(self):
+        """xacro with this sandbox's functions in place; everything restored afterwards."""
+        import xacro
+        import xacro.substitution_args as sa
+        import yaml
+
+        replacements = {
+            (xacro, "safe_eval"): self.safe_eval, (xacro, "_global_symbols"): self.symbols(),
+            (xacro, "abs_filename_spec"): self.abs_filename_spec, (xacro, "parse"): self.parse,
+            (xacro, "eval_all"): self.eval_all, (sa, "_eval"): self.eval, (sa, "_eval_find"): self.find,
+            (sa, "_eval_env"): self.env, (sa, "_eval_optenv"): self.optenv, (sa, "resolve_args"): self.resolve_args,
+        }
+        saved = {key: getattr(*key) for key in replacements}
+        saved_dict = {k: sa._eval_dict.get(k) for k in ("find", "env", "optenv")}
+        # xacro.load_yaml registers its unit tags (!degrees...) on yaml.SafeLoader, in place
+        own = yaml.SafeLoader.__dict__.get("yaml_constructors")
+        saved_constructors = dict(own) if own is not None else None
         try:
-            xacro.safe_eval = guarded_safe_eval
-            xacro._global_symbols = symbols
-            xacro.abs_filename_spec = guarded_abs
-            xacro.parse = guarded_parse
-            xacro.eval_all = guarded_eval_all
-            sa._eval = guarded_eval
-            sa._eval_find = find
-            sa._eval_env = env
-            sa._eval_optenv = optenv
-            sa.resolve_args = guarded_resolve
-            sa._eval_dict.update(find=find, env=env, optenv=optenv)
+            for (module, name), value in replacements.items():
+                setattr(module, name, value)
+            sa._eval_dict.update(find=self.find, env=self.env, optenv=self.optenv)
             xacro.all_includes.clear()
-            with contextlib.redirect_stderr(stderr):
-                try:
-                    doc = xacro.process_file(str(path), mappings=args)
-                except (xacro.XacroException, sa.SubstitutionException, _MissingPackage, UnsafeExpression,
-                        _Blocked, ExpansionLimit, xml.parsers.expat.ExpatError, OSError, NameError, KeyError,
-                        TypeError, ValueError, SyntaxError, AttributeError, ZeroDivisionError, IndexError,
-                        OverflowError, MemoryError, yaml.YAMLError, RecursionError) as exc:
-                    where = xacro.filestack[-1] if xacro.filestack and xacro.filestack[-1] else str(path)
-                    state.location = _failing_location(exc.__traceback__, original_eval_all.__code__)
-                    raise RobotkitError(_problem(exc, state, where, path)) from None
-            includes = sorted({os.path.abspath(f) for f in xacro.all_includes})
+            yield
         finally:
             for (module, name), value in saved.items():
                 setattr(module, name, value)
@@ -459,21 +482,27 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
                 yaml.SafeLoader.yaml_constructors = saved_constructors
             xacro.all_includes.clear()
             xacro.init_stacks(None)
-    # the document without xacro's banner comments
-    root = doc.documentElement
-    for el in [root, *root.getElementsByTagName("*")]:  # xacro:attribute leaves its value a number, on which
-        for attr in el.attributes.values():  # xacro's writer fails; every other attribute is str() of its value
-            if not isinstance(attr.value, str):
-                attr.value = str(attr.value)
-    text = '<?xml version="1.0"?>\n' + root.toxml() + "\n"
-    warnings = [f"{_show(path)}: xacro: {line.strip()}" for line in stderr.getvalue().splitlines()
-                if line.strip() and not line.startswith(" ") and "when processing file" not in line]
-    return Expanded(text, includes, warnings)
+
+    def process(self):
+        """xacro's expansion of the file (the sandbox installed); its errors as RobotkitError."""
+        import xml.parsers.expat
+
+        import xacro
+        import xacro.substitution_args as sa
+        import yaml
+
+        try:
+            return xacro.process_file(str(self.path), mappings=self.args)
+        except (xacro.XacroException, sa.SubstitutionException, _MissingPackage, UnsafeExpression,
+                _Blocked, ExpansionLimit, xml.parsers.expat.ExpatError, OSError, NameError, KeyError,
+                TypeError, ValueError, SyntaxError, AttributeError, ZeroDivisionError, IndexError,
+                OverflowError, MemoryError, yaml.YAMLError, RecursionError) as exc:
+            where = xacro.filestack[-1] if xacro.filestack and xacro.filestack[-1] else str(self.path)
+            self.state.location = _failing_location(exc.__traceback__, self.original_eval_all.__code__)
+            raise RobotkitError(_problem(exc, self.state, where, self.path)) from None
 
 
 def _show(path) -> str:
-    from robotkit.errors import display_path
-
     return display_path(str(path))
 
 

@@ -6,12 +6,12 @@ lints that fired on it, what each format lost), rendered through the one Jinja e
 from __future__ import annotations
 
 import json
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from robotkit import urdfxml
 from robotkit.check.findings import Finding
 from robotkit.check.lints import equivalent_box, link_volume
 from robotkit.emit.env import environment
@@ -90,7 +90,7 @@ def _fidelity(entry: dict) -> str:
 def joint_rows(urdf_text: str | None, joints, findings: list[Finding], losses: dict[str, list[str]]) -> list[JointRow]:
     structure = {}
     if urdf_text:
-        for el in ET.fromstring(urdf_text).findall("joint"):
+        for el in urdfxml.parse_text(urdf_text).getroot().findall("joint"):
             axis = el.find("axis")
             structure[el.get("name")] = (
                 (el.find("parent").get("link") if el.find("parent") is not None else ""),

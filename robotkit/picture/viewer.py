@@ -16,12 +16,12 @@ import threading
 import time
 import warnings
 import webbrowser
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from robotkit import urdfxml
 from robotkit.check.lints import equivalent_box, resolve_uri
 from robotkit.errors import RobotkitError
 
@@ -51,7 +51,7 @@ def load_urdf(built: Built):
 def sensors_of(urdf_file: Path) -> list[tuple[str, str, str, float, float]]:
     """(name, type, link, horizontal fov, aspect) of each <gazebo reference><sensor> block."""
     out = []
-    root = ET.parse(urdf_file).getroot()
+    root = urdfxml.parse_file(urdf_file).getroot()
     for g in root.findall("gazebo"):
         for s in g.findall("sensor"):
             link = g.get("reference")

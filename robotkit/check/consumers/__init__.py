@@ -22,6 +22,7 @@ from typing import Callable
 
 import numpy as np
 
+from robotkit import urdfxml
 from robotkit.check.findings import Finding
 from robotkit.check.kinematics import lump, read_urdf, real_mass
 from robotkit.check.lints import resolve_uri
@@ -86,18 +87,6 @@ def listed(names) -> str:
     return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
 
 
-def parse_urdf(path):
-    """A URDF's lxml tree, read as urdfdom (TinyXML2) reads it: any declared XML version (PyBullet's
-    humanoid says "0.0"; libxml2 takes only 1.x).  Raises lxml's XMLSyntaxError or OSError."""
-    import re
-
-    from lxml import etree
-
-    data = Path(path).read_bytes()
-    data = re.sub(rb'^(\s*<\?xml\s+version\s*=\s*["\'])(?!1\.)[^"\']*', rb"\g<1>1.0", data)
-    return etree.ElementTree(etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True)))
-
-
 @contextlib.contextmanager
 def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
     """A foreign URDF as a program that knows no ROS packages reads it: a copy whose mesh URIs are
@@ -108,7 +97,7 @@ def with_mesh_paths(build: Build, formats: tuple[str, ...] | None = None):
     if not build.foreign:
         yield build.urdf, []
         return
-    tree = parse_urdf(build.urdf)
+    tree = urdfxml.parse_file(build.urdf, comments=True)  # the copy keeps the comments
     for el in tree.getroot().iter():  # a line after each element: PyBullet loses characters of long lines
         el.tail = (el.tail or "") + "\n"  # (measured with 3.2.7: a xacro expansion on one line of 9 kB fails)
     converted = []

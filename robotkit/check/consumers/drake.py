@@ -4,10 +4,10 @@ SceneGraph (so collision geometry is loaded too: Drake takes convex meshes as OB
 from __future__ import annotations
 
 import logging
-import xml.etree.ElementTree as ET
 
 import numpy as np
 
+from robotkit import urdfxml
 from robotkit.check.consumers import Missing, Refused, Unreadable, View, listed, with_mesh_paths
 from robotkit.emit.urdf import typed_transmissions
 
@@ -61,11 +61,10 @@ def _load(build, path) -> View:
 def _unnamed(path) -> bool:
     """A URDF whose robot name is empty (checked before Drake, which aborts the process on it)."""
     try:
-        for _, el in ET.iterparse(str(path), events=("start",)):
-            return el.tag == "robot" and not el.get("name")
-    except ET.ParseError:
+        root = urdfxml.parse_file(path).getroot()
+    except urdfxml.MalformedXML:
         return False  # Drake's parser names the problem
-    return False
+    return root.tag == "robot" and not root.get("name")
 
 
 DRAKE_MESHES = (".obj", ".vtk", ".gltf")

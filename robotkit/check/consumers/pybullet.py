@@ -8,7 +8,8 @@ import os
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View, listed, parse_urdf, with_mesh_paths
+from robotkit import urdfxml
+from robotkit.check.consumers import Missing, Refused, View, listed, with_mesh_paths
 
 
 MAX_LINKS = 128
@@ -35,7 +36,7 @@ DEFAULT_MASS = 1.0  # what PyBullet gives a link without <inertial>
 
 
 def _without_inertial(urdf) -> set[str]:
-    root = parse_urdf(urdf).getroot()
+    root = urdfxml.parse_file(urdf).getroot()
     return {el.get("name") for el in root.iter("link") if el.find("inertial") is None}
 
 
