@@ -6,7 +6,7 @@ is shared by more than half of the items it applies to (the loader's rule,
 shorter for it.  The items holding that value drop it; the others keep their own value, and
 an item that has none says so: the schema's default where the field has one
 (``axis: [1, 0, 0]``, ``friction: 0``), ``null`` where it has none (``limit: null``).  So
-the merged recipe is the same recipe, value for value (tests/test_import.py checks it on
+the merged recipe is the same recipe, value for value (tests/importer/test_import.py checks it on
 every robot of the corpus).
 """
 

@@ -31,7 +31,7 @@ from robotkit.mesh.repair import repair
 from robotkit.mesh.transform import transform
 from robotkit.geometry import rpy_matrix
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def pose(rpy=(0.3, -0.7, 1.2), xyz=(0.1, -0.2, 0.3)) -> np.ndarray:

@@ -15,7 +15,7 @@ import robotkit.pipeline.runner
 from robotkit.pipeline import stamp
 from robotkit.cli import main
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 RECIPE = """robot: bot
 units: m

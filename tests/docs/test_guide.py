@@ -15,7 +15,7 @@ import pytest
 import yaml
 
 from conftest import REPO, RECIPES
-from test_ci_formats import SCHEMA, workflow_command
+from tests.check.test_render import SCHEMA, workflow_command
 
 GUIDE = REPO / "docs" / "guide.md"
 BLOCK = re.compile(r"(?:<!-- file: (?P<file>\S+) -->\n)?```(?P<lang>\w+)\n(?P<body>.*?)```", re.S)

@@ -13,9 +13,9 @@ from pathlib import Path
 import pytest
 
 from conftest import run_cli
-from test_check import arm_urdf, box_inertia, link_xml
+from tests.check.test_check import arm_urdf, box_inertia, link_xml
 
-SCHEMA = Path(__file__).parent / "data" / "schemas" / "junit-10.xsd"
+SCHEMA = Path(__file__).parents[1] / "data" / "schemas" / "junit-10.xsd"
 
 
 @pytest.fixture(scope="module")
@@ -191,7 +191,7 @@ def test_recipe_build_warnings_are_annotated_on_their_line(tmp_path):
     import trimesh
 
     from conftest import write_recipe
-    from test_build_warnings import RECIPE
+    from tests.pipeline.test_build_warnings import RECIPE
 
     write_recipe(tmp_path, RECIPE, "careless.yaml",
                  {"wheel.stl": trimesh.creation.cylinder(radius=66.0, height=26.0, sections=64)})

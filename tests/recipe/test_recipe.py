@@ -16,7 +16,7 @@ from conftest import RECIPES, write_recipe
 from robotkit.pipeline.runner import build
 from robotkit.model.massprops import box_props, cylinder_props
 from robotkit.geometry import rpy_matrix
-from test_turret_bot import urdf_inertials
+from tests.examples.test_turret_bot import urdf_inertials
 from validators import check_urdf
 
 
@@ -256,7 +256,7 @@ def test_reference_docs_are_current():
     """docs/recipe.md and docs/recipe.schema.json are generated from the schema (robotkit schema)."""
     from robotkit.recipe.reference import json_schema, markdown
 
-    docs = Path(__file__).resolve().parents[1] / "docs"
+    docs = Path(__file__).resolve().parents[2] / "docs"
     assert (docs / "recipe.schema.json").read_text() == json_schema(), "run: robotkit schema > docs/recipe.schema.json"
     assert (docs / "recipe.md").read_text() == markdown(), "run: robotkit schema --markdown > docs/recipe.md"
     assert (docs / "part.schema.json").read_text() == json_schema(part=True), \

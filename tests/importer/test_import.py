@@ -28,7 +28,7 @@ from robotkit.importer.inertials import no_inertial_form
 from robotkit.check.kinematics import KModel, compare, read_urdf
 from tests.validators import check_urdf, mujoco
 
-ASSETS = Path(__file__).resolve().parents[1].parent / "shared" / "assets"
+ASSETS = Path(__file__).resolve().parents[2].parent / "shared" / "assets"
 PACKAGES = {name: str(ASSETS / name) for name in
             ("turret_bot", "turtlebot3_description", "ur_description", "realsense2_description")}
 TOL = 1e-9

@@ -190,7 +190,7 @@ def test_doit_in_a_project_root_runs_the_same_tasks(tmp_path):
     import subprocess
     import sys
 
-    repo = Path(__file__).resolve().parents[1]
+    repo = Path(__file__).resolve().parents[2]
     shutil.copytree(repo / "recipes", tmp_path / "recipes")
     shutil.copyfile(repo / "dodo.py", tmp_path / "dodo.py")
     proc = subprocess.run([sys.executable, "-m", "doit"], cwd=tmp_path, capture_output=True, text=True)

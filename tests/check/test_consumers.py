@@ -20,7 +20,7 @@ from robotkit.check.simulation import smoke_test
 from validators import IN_CI, ign_sdf_check, require
 
 EXAMPLES = example_robots()
-CORPUS = Path(__file__).resolve().parents[2] / "shared" / "assets" / "robots"
+CORPUS = Path(__file__).resolve().parents[3] / "shared" / "assets" / "robots"
 
 
 def consumers_installed():

@@ -22,7 +22,7 @@ from conftest import RECIPES
 from validators import require
 
 EXAMPLES = ["turret_bot", "lidar_mast", "rover", "turtlebot3_burger", "ur5"]
-PROBE = Path(__file__).resolve().parent / "ros1_probe.py"
+PROBE = Path(__file__).resolve().parents[1] / "ros1_probe.py"
 # Debian's ROS 1 (docs/libraries.md, section 10): these three, and /usr/bin before any pyenv python3
 ROS_ENV = {"ROS_VERSION": "1", "ROS_DISTRO": "Debian", "ROS_PYTHON_VERSION": "3"}
 SCREENSHOT = "turret_bot"  # the robot whose RViz window is photographed

@@ -15,7 +15,7 @@ import pytest
 from PIL import Image
 
 from conftest import RECIPES
-from test_picture import chromium
+from tests.picture.test_report import chromium
 
 
 def free_port() -> int:

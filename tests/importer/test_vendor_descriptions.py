@@ -1,4 +1,5 @@
-"""Issue 14: traits of real robots outside the corpus, each in a small description written here.
+"""Vendor descriptions' traits (xacro packages, massless welds, materials, transmissions), each in a
+small description written here.
 
 Held-back robots of the kinds the issue names (UR, Franka, Robotiq, Allegro, ABB, KUKA, ANYmal,
 Husky, TIAGo, Kinova, Sawyer, Romeo) were rebuilt from their public sources and run through
@@ -37,7 +38,7 @@ from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.kinematics import compare, read_urdf
 from robotkit.importer import import_file
 from tests.conftest import run_cli
-from tests.test_import import xacro_reference
+from tests.importer.test_import import xacro_reference
 from tests.validators import check_urdf, mujoco
 
 TOL = 1e-9

@@ -1,4 +1,5 @@
-"""Issue 14: traits of public robots outside the corpus, each in a small robot written here.
+"""Vendor defects (tensors, mesh URIs, namespaced blocks, massless links, dangling transmissions and
+mimics) of public robots outside the corpus, each in a small robot written here.
 
 - A vendor tensor whose principal moments break the triangle inequality (the PR2's
   sensor_mount_link: 0.001, 0.001, 0.01 at 50 g): the repair must leave a + b above c, not on
@@ -25,7 +26,7 @@ from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.kinematics import compare, read_urdf
 from robotkit.importer import import_file
 from robotkit.model import inertia_policy as ip
-from tests.test_corpus import _with_stated_repairs
+from tests.importer.test_corpus import _with_stated_repairs
 from tests.validators import check_urdf, mujoco
 
 URDF = textwrap.dedent("""\

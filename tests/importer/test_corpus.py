@@ -1,4 +1,4 @@
-"""Issue 14: every real robot in ../shared/assets/robots imports, builds and loads.
+"""Every real robot in ../shared/assets/robots imports, builds and loads.
 
 The ten public descriptions of robots.tsv (arms, a dual arm, hands, a quadruped, mobile bases,
 a humanoid; URDF and xacro; STL, DAE and OBJ) are imported once per session, with their
@@ -29,7 +29,7 @@ from robotkit.importer import import_file
 from tests.conftest import run_cli
 from tests.validators import check_urdf, mujoco
 
-ROBOTS_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "assets" / "robots"
+ROBOTS_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "assets" / "robots"
 TOL = 1e-9
 
 
@@ -70,7 +70,7 @@ def _original(name: str, out: Path) -> Path:
     spec = CORPUS[name]
     if not spec["entry"].name.endswith(".xacro"):
         return spec["entry"]
-    from tests.test_import import xacro_reference
+    from tests.importer.test_import import xacro_reference
 
     return xacro_reference(spec["entry"], spec["packages"], spec["args"], out)
 
