@@ -13,6 +13,9 @@ import importlib
 import os
 import sys
 
+from robotkit import __version__
+from robotkit.commands.build import cores  # light: the no-op build's own module
+
 # verb -> module of robotkit.commands
 COMMANDS = {"build": "build", "world": "world", "schema": "schema", "check": "check", "import": "import_",
             "report": "report", "catalogue": "catalogue", "view": "view", "expand": "expand", "new": "new"}
@@ -224,8 +227,6 @@ def _widen_roots(roots: list[str]) -> None:
 
 
 def _add_build(sub) -> None:
-    from robotkit.commands.build import cores
-
     b = sub.add_parser("build", help="build recipes into URDF, Gazebo model folders and meshes",
                        description="Build each RECIPE into OUT/<robot>/ (incremental: only what changed reruns).")
     b.add_argument("recipes", nargs="+", metavar="RECIPE", help="recipe YAML file(s)")
@@ -257,8 +258,6 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = (_build_parser() if argv[:1] == ["build"] else _parser()).parse_args(argv)
     if args.version:
-        from robotkit import __version__
-
         print(f"robotkit {__version__}")
         return 0
     if args.command is None:

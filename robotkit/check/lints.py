@@ -19,6 +19,7 @@ from robotkit import urdfxml
 from robotkit.check.findings import Finding
 from robotkit.check.kinematics import NEGLIGIBLE
 from robotkit.errors import Problem, RobotkitError
+from robotkit.geometry import rpy_matrix
 from robotkit.mesh.inertia import mesh_mass_properties
 from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
@@ -91,8 +92,6 @@ def _floats(text: str | None, n: int, default: float = 0.0) -> list[float]:
 
 
 def _origin(el) -> np.ndarray:
-    from robotkit.geometry import rpy_matrix
-
     T = np.eye(4)
     o = el.find("origin") if el is not None else None
     if o is not None:
