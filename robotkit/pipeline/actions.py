@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from doit.exceptions import TaskFailed
 
-from robotkit.emit import FORMATS
+from robotkit.emit.registry import FORMATS
 from robotkit.emit.layout import robot_layout
 from robotkit.errors import ConsumerError, Problem, RobotkitError, display_path
 from robotkit.ioutil import write_if_changed
@@ -123,7 +123,7 @@ def _finalized(robot, fact_paths: dict[str, str], inertial_paths: dict[str, str]
 @_user_errors_fail
 def emit(name: str, robot, fact_paths: dict[str, str], inertial_paths: dict[str, str], target: str,
          how: dict, where: dict | None = None):
-    """Render one output file through the registered format ``name`` (robotkit.emit.FORMATS).
+    """Render one output file through the registered format ``name`` (robotkit.emit.registry.FORMATS).
 
     ``how``: ``raw`` renders the resolved robot (else the robot finalized with the facts and
     inertials), ``facts`` gives the render the mesh facts, ``meshes`` is the folder of the mesh files

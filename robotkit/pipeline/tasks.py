@@ -6,7 +6,7 @@
 - ``<robot>:visual:<file>``, ``<robot>:copy:<file>``, ``<robot>:convert:<file>``: the mesh files
   below ``meshes/`` (processed, copied with their textures, converted for a format);
 - ``<robot>:inertial:<link>``: one link's inertial from its mesh facts;
-- ``<robot>:<format>``: one output file per registered format (:data:`robotkit.emit.FORMATS`);
+- ``<robot>:<format>``: one output file per registered format (:data:`robotkit.emit.registry.FORMATS`);
 - ``<robot>:report-html``, ``world:<world>``, ``<robot>:world:<world>``: the picture report, the worlds.
 
 Every task names its inputs (``file_dep``), outputs (``targets``) and the
@@ -26,7 +26,8 @@ from typing import NamedTuple
 import yaml
 from doit.tools import config_changed
 
-from robotkit.emit import FORMATS, layout
+from robotkit.emit import layout
+from robotkit.emit.registry import FORMATS
 from robotkit.emit.env import template_dirs
 from robotkit.emit.formats import Format
 from robotkit.emit.meshfiles import conversions

@@ -1,5 +1,5 @@
 """The task dicts of a small robot, as data (robotkit.pipeline.tasks: no doit run), and every
-registered output format (robotkit.emit.FORMATS) rendered for a small finalized robot."""
+registered output format (robotkit.emit.registry.FORMATS) rendered for a small finalized robot."""
 
 from __future__ import annotations
 
@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from robotkit.emit import FORMATS, layout
+from robotkit.emit import layout
+from robotkit.emit.registry import FORMATS
 from robotkit.emit.env import template_dirs
 from robotkit.emit.formats import READS
 from robotkit.emit.meshfiles import conversions

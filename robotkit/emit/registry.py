@@ -1,0 +1,13 @@
+"""The registry of output formats: every emitter module's ``FORMATS`` merged, as trimesh's
+``exchange`` loaders are merged.  The doit tasks and the tests loop over it."""
+
+from __future__ import annotations
+
+from robotkit.emit import controllers, gazebo, mjcf, ros, sdf, summary, urdf, xacro_macro
+from robotkit.emit.formats import Format
+
+# in the order of their tasks
+FORMATS: dict[str, Format] = {
+    f.name: f for module in (urdf, xacro_macro, sdf, mjcf, summary, gazebo, ros, controllers)
+    for f in module.FORMATS
+}
