@@ -40,7 +40,7 @@ from robotkit.picture import VERSION as PICTURE_VERSION
 from robotkit.picture.page import TEMPLATE as PICTURE_TEMPLATE
 from robotkit.pipeline import actions
 from robotkit.pipeline.publish import STATE, stage_dir  # STATE: below the output folder, doit's database and JSON
-from robotkit.recipe.load import MAX_YAML_BYTES, yaml_limits
+from robotkit.recipe.yamlsafe import MAX_YAML_BYTES, yaml_limits
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,7 @@ import numpy as np
 from robotkit.errors import MapError, Problem, display_path, yaml_syntax_problem
 from robotkit.emit.env import fmt
 from robotkit.paths import ReadPolicy
-from robotkit.recipe.load import yaml_limits
+from robotkit.recipe.yamlsafe import yaml_limits
 
 MODES = ("trinary", "scale", "raw")
 REQUIRED = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh")

@@ -200,7 +200,7 @@ def test_malformed_recipe(project, case, capsys, monkeypatch):
 
 
 def test_oversized_yaml_is_refused_before_it_is_read(project, capsys, monkeypatch):
-    from robotkit.recipe.load import MAX_YAML_BYTES
+    from robotkit.recipe.yamlsafe import MAX_YAML_BYTES
 
     with open(project / "robot.yaml", "w") as f:
         f.write("robot: arm\nlinks: {base: {}}\n")
