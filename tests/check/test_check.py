@@ -58,6 +58,8 @@ def test_plausible_arm_is_clean(tmp_path):
     assert findings_for(tmp_path, arm_urdf()) == []
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_plausible_arm_exits_0(tmp_path):
     (tmp_path / "arm.urdf").write_text(arm_urdf())
     proc = run_cli("check", tmp_path / "arm.urdf")
@@ -167,6 +169,8 @@ def test_d435_xacro_tensor_is_flagged(assets, tmp_path):
     assert ("error", "inertia-box", "link 'camera_link'") in checks(found)
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_exit_codes_and_formats(tmp_path):
     bad = tmp_path / "bad.urdf"
     bad.write_text(arm_urdf(arm=link_xml("arm", inertia=(0.01, 0.01, 0.05))))
@@ -194,6 +198,8 @@ def test_exit_codes_and_formats(tmp_path):
     assert run_cli("check", tmp_path / "x.txt").returncode == 2
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_recipe_check_annotates_the_recipe_line(tmp_path):
     recipe = tmp_path / "r.yaml"
     recipe.write_text("robot: heavy\nmeasured_mass: 10\nlinks:\n  a:\n    visual: {box: {size: [0.1, 0.1, 0.1]}}\n"
@@ -205,6 +211,8 @@ def test_recipe_check_annotates_the_recipe_line(tmp_path):
                            "inertials; or update measured_mass)\n")
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(p.stem for p in RECIPES.glob("*.yaml")))
 def test_examples_check_clean(tmp_path, name):
     proc = run_cli("check", RECIPES / f"{name}.yaml", "--out", tmp_path, "--format", "json")

@@ -19,6 +19,8 @@ from robotkit.check.consumers import CONSUMERS, Build, consumer_findings, read
 from robotkit.check.simulation import smoke_test
 from validators import IN_CI, ign_sdf_check, require
 
+pytestmark = [pytest.mark.consumers, pytest.mark.slow]
+
 EXAMPLES = example_robots()
 CORPUS = Path(__file__).resolve().parents[3] / "shared" / "assets" / "robots"
 

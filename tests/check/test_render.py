@@ -72,6 +72,8 @@ def link_line(path: Path, name: str) -> int:
     return next(i for i, line in enumerate(path.read_text().splitlines(), 1) if f'<link name="{name}">' in line)
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_junit_counts_failures_at_each_fail_on(urdfs, junit_schema):
     warn = urdfs / "warn.urdf"
     proc = run_cli("check", warn, "--format", "junit")
@@ -97,6 +99,8 @@ def test_junit_counts_failures_at_each_fail_on(urdfs, junit_schema):
     assert failure.get("type") == "warning"
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_junit_error_is_a_failing_case(urdfs, junit_schema):
     proc = run_cli("check", urdfs / "bad.urdf", "--format", "junit")
     assert proc.returncode == 1
@@ -106,6 +110,8 @@ def test_junit_error_is_a_failing_case(urdfs, junit_schema):
     assert case.get("name") == "link 'arm'" and case.find("failure").get("type") == "error"
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_github_annotations_name_the_urdf_line(urdfs):
     bad, warn = urdfs / "bad.urdf", urdfs / "warn.urdf"
     proc = run_cli("check", bad, warn, "--format", "github", cwd=urdfs)
@@ -124,6 +130,8 @@ def test_github_annotations_name_the_urdf_line(urdfs):
         "error", {"file": "warn.urdf", "line": str(link_line(warn, "arm")), "title": "robotkit inertia-box (warning)"})
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_text_and_json_reflect_fail_on(urdfs):
     proc = run_cli("check", "warn.urdf", "--fail-on", "warning", cwd=urdfs)
     assert proc.stdout.splitlines()[-1] == "warn.urdf: 0 errors, 1 warning (they fail the check: --fail-on warning)"
@@ -136,6 +144,7 @@ BAD_LINES = ["bad.yaml:4: links.a.visual.box.size: must have 3 values (got 2)",
              "bad.yaml:5: links.a.inertial.denisty: unknown key (did you mean 'density'?)"]
 
 
+@pytest.mark.consumers
 @pytest.mark.parametrize("fmt", ["text", "junit", "github", "json"])
 def test_a_recipe_that_does_not_load_is_reported_in_every_format(tmp_path, junit_schema, fmt):
     (tmp_path / "bad.yaml").write_text(BAD_RECIPE)
@@ -166,6 +175,7 @@ def test_a_recipe_that_does_not_load_is_reported_in_every_format(tmp_path, junit
         assert [(f["check"], f["line"]) for f in data["findings"]] == [("input", 4), ("input", 5)]
 
 
+@pytest.mark.consumers
 def test_a_missing_path_is_a_failing_case(tmp_path, junit_schema):
     proc = run_cli("check", "nothing.urdf", "--format", "junit", cwd=tmp_path)
     assert proc.returncode == 2 and proc.stderr == "nothing.urdf: no such file or folder\n"
@@ -186,6 +196,8 @@ def test_annotation_escapes_properties_and_message():
     assert unescape(props["file"]) == "dir,x/r:1.yaml" and unescape(message) == "link 'a:b': 50% off\nsecond line"
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_recipe_build_warnings_are_annotated_on_their_line(tmp_path):
     """A build's warnings reach the CI formats on the line that causes them (not the robot's)."""
     import trimesh
@@ -210,6 +222,8 @@ def test_recipe_build_warnings_are_annotated_on_their_line(tmp_path):
     assert not (tmp_path / "build").exists()  # --temp-out
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_sdf_and_mjcf_findings_name_their_line(tmp_path):
     (tmp_path / "m.sdf").write_text(
         '<?xml version="1.0"?>\n<sdf version="1.9">\n  <model name="m">\n    <link name="a">\n'
@@ -235,6 +249,8 @@ def test_sdf_and_mjcf_findings_name_their_line(tmp_path):
         ("warning", {"file": "t.xml", "line": "3", "title": "robotkit tiny-mass"})]  # the <body name="b"> line
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_several_paths_one_missing(urdfs):
     """The paths that can be checked are, the bad one is named, and the exit status is 2."""
     proc = run_cli("check", "warn.urdf", "nothing.urdf", cwd=urdfs)

@@ -3,6 +3,8 @@ with no warning but what a format cannot express; no file is ever overwritten.""
 
 from __future__ import annotations
 
+import pytest
+
 import json
 
 import numpy as np
@@ -11,6 +13,7 @@ import trimesh
 from conftest import GOLDEN, assert_golden, run_cli
 
 
+@pytest.mark.slow
 def test_new_writes_a_starter_that_builds(tmp_path):
     proc = run_cli("new", "my_bot", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
@@ -35,6 +38,7 @@ def test_new_writes_a_starter_that_builds(tmp_path):
     assert np.allclose(arm["inertia"], [m * 0.0404 / 12, 0, 0, m * 0.0404 / 12, 0, m * 0.0008 / 12], atol=1e-15)
 
 
+@pytest.mark.slow
 def test_new_never_overwrites(tmp_path):
     assert run_cli("new", "my_bot", cwd=tmp_path).returncode == 0
     proc = run_cli("new", "my_bot", cwd=tmp_path)

@@ -18,6 +18,8 @@ import yaml
 
 from conftest import REPO
 
+pytestmark = [pytest.mark.slow]
+
 README = REPO / "README.md"
 
 

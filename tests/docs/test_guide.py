@@ -51,6 +51,7 @@ def guide_run(tmp_path_factory):
     return folder, runs
 
 
+@pytest.mark.slow
 def test_guide_commands_run(guide_run):
     folder, runs = guide_run
     for name, proc in runs.items():
@@ -68,6 +69,7 @@ def test_guide_commands_run(guide_run):
     assert imported["robot"] == "contacts_demo" and set(imported["links"]) == {"base", "slider"}
 
 
+@pytest.mark.slow
 def test_guide_inertials_are_the_known_answers(guide_run):
     folder, _ = guide_run
     report = json.loads((folder / "build" / "inertials_demo" / "report.json").read_text())["inertials"]
@@ -79,6 +81,7 @@ def test_guide_inertials_are_the_known_answers(guide_run):
     assert check["errors"] == 0  # 8.1 + 0.4 + 1.0 = 9.5 kg: the measured mass
 
 
+@pytest.mark.slow
 def test_guide_ci_outputs_are_what_ci_reads(guide_run):
     import xmlschema
 
@@ -93,6 +96,7 @@ def test_guide_ci_outputs_are_what_ci_reads(guide_run):
     assert not (folder / "build" / "rover_mini" / "report").exists()  # --temp-out: built elsewhere
 
 
+@pytest.mark.slow
 def test_guide_workflow_and_hook_name_what_exists(guide_run):
     folder, _ = guide_run
     action = yaml.safe_load((REPO / "action.yml").read_text())

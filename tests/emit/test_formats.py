@@ -30,6 +30,7 @@ def assert_equivalent(robot_dir: Path, configs: int = 100):
     assert result == {k: [] for k in result}, json.dumps(result, indent=1)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_example_outputs_pass_every_validator(examples, name):
     root = examples / name
@@ -42,17 +43,20 @@ def test_example_outputs_pass_every_validator(examples, name):
     assert model.nbody == len(ET.parse(root / "urdf" / f"{name}.urdf").getroot().findall("link")) + 1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_example_formats_agree(examples, name):
     assert_equivalent(examples / name)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_example_scene_comes_to_rest(examples, name):
     mujoco()
     assert smoke_test(examples / name / "mjcf" / "scene.xml") == []
 
 
+@pytest.mark.slow
 def test_model_config_points_at_model_sdf(examples):
     config = ET.parse(examples / "turret_bot" / "model.config").getroot()
     assert config.find("sdf").text == "model.sdf" and config.find("sdf").get("version") == "1.9"
@@ -60,6 +64,7 @@ def test_model_config_points_at_model_sdf(examples):
     assert config.find("author/name").text == "Aniruddh K B"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rel", ["model.sdf", "mjcf/turret_bot.xml", "mjcf/scene.xml"])
 def test_golden_files(examples, rel):
     assert_golden(examples / "turret_bot" / rel, GOLDEN / "turret_bot" / rel)
@@ -74,6 +79,7 @@ def _copy(examples: Path, tmp_path: Path) -> Path:
     return dst
 
 
+@pytest.mark.slow
 def test_equivalence_finds_a_changed_mass_in_the_sdf(examples, tmp_path):
     robot = _copy(examples, tmp_path)
     sdf = robot / "model.sdf"
@@ -85,6 +91,7 @@ def test_equivalence_finds_a_changed_mass_in_the_sdf(examples, tmp_path):
     assert result["URDF (MuJoCo) vs SDF"] and "link 'rotor': mass" in result["URDF (MuJoCo) vs SDF"][0]
 
 
+@pytest.mark.slow
 def test_equivalence_finds_a_rotated_inertia_in_the_mjcf(examples, tmp_path):
     robot = _copy(examples, tmp_path)
     path = robot / "mjcf" / "turret_bot.xml"
@@ -97,6 +104,7 @@ def test_equivalence_finds_a_rotated_inertia_in_the_mjcf(examples, tmp_path):
     assert diffs and diffs[0].startswith("link 'rotor': inertia tensor")
 
 
+@pytest.mark.slow
 def test_equivalence_finds_a_moved_joint_axis(examples, tmp_path):
     robot = _copy(examples, tmp_path)
     sdf = robot / "model.sdf"
@@ -105,6 +113,8 @@ def test_equivalence_finds_a_moved_joint_axis(examples, tmp_path):
     assert diffs and "pose differs" in diffs[0]
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_check_command_on_a_build_folder(examples, tmp_path):
     proc = run_cli("check", examples / "turret_bot")
     assert (proc.returncode, proc.stdout) == (0, f"{examples / 'turret_bot'}: ok, no problems found\n"), proc.stderr
@@ -202,6 +212,7 @@ def test_dae_visuals_are_converted_for_mujoco(tmp_path, assets):
     assert_equivalent(robot, configs=5)
 
 
+@pytest.mark.slow
 def test_continuous_joint_has_no_infinite_limits_in_sdf(examples):
     ign_sdf_check(examples / "lidar_mast" / "model.sdf")
     joint = ET.parse(examples / "lidar_mast" / "model.sdf").getroot().find("model/joint[@name='scan_joint']")
@@ -273,6 +284,7 @@ def random_recipe(rng: np.random.Generator, index: int) -> str:
     return "\n".join(lines) + "\n"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(8))
 def test_random_robots_agree_across_formats(tmp_path, seed):
     rng = np.random.default_rng(1000 + seed)

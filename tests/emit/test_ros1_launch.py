@@ -21,6 +21,8 @@ import pytest
 from conftest import RECIPES
 from validators import require
 
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
 EXAMPLES = ["turret_bot", "lidar_mast", "rover", "turtlebot3_burger", "ur5"]
 PROBE = Path(__file__).resolve().parents[1] / "ros1_probe.py"
 # Debian's ROS 1 (docs/libraries.md, section 10): these three, and /usr/bin before any pyenv python3

@@ -71,6 +71,7 @@ def _installed_folders(cmake: str) -> set[str]:
 # ---------------------------------------------------------------- ROS 2, statically
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_ros2_package_xml_is_valid(ros2_packages, name):
     pkg = _parse_package(ros2_packages / name)
@@ -80,6 +81,7 @@ def test_ros2_package_xml_is_valid(ros2_packages, name):
     assert pkg.maintainers and all(m.email for m in pkg.maintainers)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_ros2_launch_files_compile_and_depend(ros2_packages, name):
     folder = ros2_packages / name
@@ -94,6 +96,7 @@ def test_ros2_launch_files_compile_and_depend(ros2_packages, name):
     assert {"robot_state_publisher", "joint_state_publisher", "joint_state_publisher_gui", "rviz2"} <= display
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_cmakelists_installs_every_folder(ros2_packages, ros1_small, name):
     for folder in [ros2_packages / name] + ([ros1_small / name] if (ros1_small / name).is_dir() else []):
@@ -103,6 +106,7 @@ def test_cmakelists_installs_every_folder(ros2_packages, ros1_small, name):
         assert "install(FILES model.sdf model.config" in cmake
 
 
+@pytest.mark.slow
 def test_ros2_rover_sensors_in_rviz_and_bridge(ros2_packages):
     folder = ros2_packages / "rover"
     rviz = yaml.safe_load((folder / "rviz" / "rover.rviz").read_text())
@@ -131,6 +135,7 @@ def test_ros2_rover_sensors_in_rviz_and_bridge(ros2_packages):
 # ---------------------------------------------------------------- ROS 1 files
 
 
+@pytest.mark.slow
 def test_ros1_launch_files_use_only_exec_depends(ros1_small):
     for name in ("turret_bot", "rover"):
         folder = ros1_small / name
@@ -148,12 +153,14 @@ def test_ros1_launch_files_use_only_exec_depends(ros1_small):
     assert plugins["camera_depth"] == "libgazebo_ros_openni_kinect.so"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rel", ["package.xml", "CMakeLists.txt", "launch/display.launch", "launch/gazebo.launch",
                                  "rviz/turret_bot.rviz", "env-hooks/50.turret_bot.sh.in"])
 def test_golden_ros1(ros1_small, rel):
     assert_golden(ros1_small / "turret_bot" / rel, GOLDEN / "turret_bot" / rel)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rel", ["package.xml", "CMakeLists.txt", "launch/display.launch.py",
                                  "launch/gazebo.launch.py", "rviz/rover.rviz", "hooks/rover.dsv.in"])
 def test_golden_ros2(ros2_packages, rel):
@@ -165,6 +172,7 @@ def test_golden_ros2(ros2_packages, rel):
 BOX = "robot: {name}\nlinks:\n  base: {{visual: {{box: {{size: [0.2, 0.2, 0.1]}}}}}}\n"
 
 
+@pytest.mark.slow
 def test_metadata_fills_package_xml(tmp_path):
     recipe = write_recipe(tmp_path, BOX.format(name="meta") + textwrap.dedent("""
     metadata:
@@ -187,6 +195,7 @@ def test_metadata_fills_package_xml(tmp_path):
                                                     ("bugtracker", "https://example.org/meta/issues")]
 
 
+@pytest.mark.slow
 def test_no_maintainer_is_a_warning_not_an_invented_address(tmp_path):
     recipe = write_recipe(tmp_path, BOX.format(name="anon") + "metadata: {authors: [{name: Bob}], license: MIT}\n")
     proc = run_cli("build", recipe.name, "--out", tmp_path / "out", cwd=tmp_path)
@@ -199,6 +208,7 @@ def test_no_maintainer_is_a_warning_not_an_invented_address(tmp_path):
     assert "<maintainer" not in text and "example.com" not in text
 
 
+@pytest.mark.slow
 def test_world_goes_into_the_package(tmp_path, assets):
     shutil.copytree(assets / "maps" / "turtlebot3_world", tmp_path / "maps" / "room")
     map_yaml = "maps/room/map.yaml"
@@ -223,6 +233,7 @@ def test_world_goes_into_the_package(tmp_path, assets):
     assert '"$_walker_models/walker/worlds"' in hook
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("extra, args, line", [
     ("ros: ros1\ngazebo: sim\n", [],
      "robot.yaml:5: gazebo: ROS 1 has no Gazebo Sim plugins (gz_ros2_control, ros_gz): use gazebo: classic, "

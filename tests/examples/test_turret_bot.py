@@ -46,6 +46,7 @@ def built(tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_writes_the_promised_files(built):
     root = built / "turret_bot"
     for rel in ("urdf/turret_bot.urdf", "urdf/turret_bot.urdf.xacro", "model.sdf", "mjcf/turret_bot.xml", "mjcf/scene.xml", "report.json",
@@ -105,6 +106,7 @@ def test_golden_files(built, rel):
     assert_golden(built / "turret_bot" / rel, GOLDEN / "turret_bot" / rel)
 
 
+@pytest.mark.slow
 def test_two_builds_are_byte_identical(built, tmp_path):
     proc = run_cli("build", RECIPES / "turret_bot.yaml", "--out", tmp_path, "-j", "2")
     assert proc.returncode == 0, proc.stderr
@@ -185,6 +187,7 @@ def test_changing_one_mesh_file_reruns_only_what_depends_on_it(project):
         "turret_bot:mjcf", "turret_bot:report", "turret_bot:xacro", "turret_bot:rviz"])  # rviz: the robot's extent
 
 
+@pytest.mark.slow
 def test_doit_in_a_project_root_runs_the_same_tasks(tmp_path):
     """`doit` in the repository root builds recipes/ with the tasks `robotkit build` runs."""
     import subprocess

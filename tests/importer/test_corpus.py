@@ -29,6 +29,8 @@ from robotkit.importer import import_file
 from tests.conftest import run_cli
 from tests.validators import check_urdf, mujoco
 
+pytestmark = [pytest.mark.consumers, pytest.mark.slow]
+
 ROBOTS_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "assets" / "robots"
 TOL = 1e-9
 

@@ -84,6 +84,7 @@ ROUND_TRIPS = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(ROUND_TRIPS))
 def test_round_trip(tmp_path, case):
     rel, args = ROUND_TRIPS[case]
@@ -143,6 +144,7 @@ def _gazebo_content(urdf: Path) -> tuple[dict, list[str]]:
     return {k: sorted(v, key=repr) for k, v in refs.items()}, others
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", ["turret_bot", "turtlebot3_burger"])
 def test_gazebo_and_transmissions_survive(tmp_path, case):
     rel, args = ROUND_TRIPS[case]
@@ -206,6 +208,7 @@ VENDOR = """
 TRIANGLE = "the original's principal moments 0.01, 0.01, 0.05 violate the triangle inequality"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("policy", ["repair", "recompute", "estimate"])
 def test_import_inertia_policy(tmp_path, policy):
     """Physical inertials are kept; the arm's tensor breaks the triangle inequality and gets the
@@ -260,6 +263,7 @@ def test_import_inertia_policy_keep_stops_on_the_tensor(tmp_path):
     assert not (tmp_path / "recipe" / "robot.yaml").exists()
 
 
+@pytest.mark.slow
 def test_copy_meshes(tmp_path):
     source = ASSETS / "turtlebot3_description/urdf/turtlebot3_burger.urdf.xacro"
     result, urdf = import_and_build(tmp_path, source, copy_meshes=True)
@@ -655,6 +659,7 @@ def _sub_model(model: KModel, prefix: str) -> KModel:
     return KModel(f"{model.source} [{prefix}*]", links, joints)
 
 
+@pytest.mark.slow
 def test_xacro_macro_in_an_assembly(tmp_path, gripper_arm):
     import xacro
 
@@ -773,6 +778,7 @@ def test_untrusted_yaml_is_safe_loaded(tmp_path, monkeypatch):
     assert not (tmp_path / "PWNED").exists()
 
 
+@pytest.mark.slow
 def test_xacro_state_is_restored(tmp_path):
     """The import patches xacro's module state for its own expansion only."""
     import xacro
@@ -963,6 +969,7 @@ def test_prismatic_joint_with_equal_limits_is_fixed_where_it_can_be(tmp_path):
     assert data["joints"]["slide"] == {"type": "fixed", "parent": "b", "child": "c", "origin": {"xyz": [0.5, 0, 0]}}
 
 
+@pytest.mark.slow
 def test_a_build_imports_back_into_the_same_robot(examples, tmp_path):
     """build -> import -> build: the URDF of every example imports (its massless frame links,
     written as 1e-300 kg with no inertia, come back massless) and builds into the same robot:

@@ -110,6 +110,7 @@ def test_a_package_uri_with_an_empty_host_names_the_package(built):
     assert "mesh: ../tpkg/meshes/body.stl" in recipe
 
 
+@pytest.mark.consumers
 def test_every_consumer_reads_gazebo1_namespaced_blocks(built):
     _, _, result, robot_dir = built
     assert "<sensor:contact" in (robot_dir / "urdf" / "traits2.urdf").read_text(encoding="utf-8")
@@ -120,6 +121,7 @@ def test_every_consumer_reads_gazebo1_namespaced_blocks(built):
     assert all(s["loaded"] for s in summary.values()), summary
 
 
+@pytest.mark.consumers
 def test_check_on_the_original_reads_the_meshes_and_names_the_refusals(built):
     """The mesh is read (the box's inertia is compared with the given one), the consumers stage
     runs whatever libsdformat prints, and the errors are the robot's real defects (its package:/// URIs, once per geometry, and the tensor)."""
@@ -211,6 +213,8 @@ def test_a_rounding_noise_tensor_is_floored_as_a_zero_one():
     assert ip.moment_floor(1e-9) == ip.MIN_MOMENT == 1e-13  # 0.4 * 1e-9 kg * (1 mm)^2 is 4e-16
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_the_icub_traits_build_and_every_consumer_loads_them(built_icub):
     source, _, result, robot_dir = built_icub
     urdf = robot_dir / "urdf" / "traits2b.urdf"
@@ -236,6 +240,8 @@ def test_the_icub_traits_build_and_every_consumer_loads_them(built_icub):
     assert all(s["loaded"] for s in summary.values()), summary
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_check_names_the_massless_link_gazebo_drops(built_icub):
     from robotkit.commands.check import check
 
@@ -249,6 +255,7 @@ def test_check_names_the_massless_link_gazebo_drops(built_icub):
          "link with mass")]
 
 
+@pytest.mark.consumers
 def test_check_names_the_leg_gazebo_drops_when_mujoco_reads_the_original(tmp_path):
     """Without the ankle's tensor, MuJoCo reads the original and the consumers are compared."""
     from robotkit.commands.check import check
@@ -305,6 +312,8 @@ XACRO_JACKAL = textwrap.dedent("""\
     """)
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_a_transmission_naming_no_joint_is_left_out_and_stated(tmp_path):
     """The Jackal's wheel transmissions name joint 'front_left_wheel' where the joint is
     'front_left_wheel_joint' (and it includes a placeholder file twice, by $(arg) and by
@@ -362,6 +371,8 @@ URDF_ALEX = textwrap.dedent("""\
     """)
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_a_mimic_of_a_joint_the_robot_lacks_is_dropped_and_stated(tmp_path):
     """Alex's hands mimic 'index_q1' where the joint is 'Left_index_q1': check_urdf accepts it,
     Drake refuses it.  Import drops the mimic (the joint moves on its own, stated above it),
@@ -418,6 +429,8 @@ URDF_TALOS = textwrap.dedent("""\
     """)
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_frames_with_inertials_of_mass_0_welded_together(tmp_path):
     """Talos's camera frames each carry an <inertial> of mass 0, one welded to the next: Gazebo
     refuses the original ("Pose values must be finite"); the build, whose frames carry no

@@ -144,6 +144,7 @@ def arm_kit(tmp_path_factory):
     return root, entry, packages, result, root / "build" / result.robot, built.errors
 
 
+@pytest.mark.slow
 def test_a_yaml_driven_recursive_xacro_imports_and_equals_the_xacro_expansion(arm_kit, tmp_path):
     root, entry, packages, result, robot_dir, errors = arm_kit
     assert not errors, errors
@@ -155,6 +156,8 @@ def test_a_yaml_driven_recursive_xacro_imports_and_equals_the_xacro_expansion(ar
     assert compare(original, read_urdf(urdf), TOL, configs=20) == []
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_every_consumer_loads_the_build_of_the_yaml_driven_xacro(arm_kit):
     root, entry, packages, result, robot_dir, errors = arm_kit
     assert not errors
@@ -165,6 +168,8 @@ def test_every_consumer_loads_the_build_of_the_yaml_driven_xacro(arm_kit):
     assert all(s["loaded"] for s in summary.values()), summary
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_check_passes_a_clean_original_with_package_meshes_and_frames(arm_kit):
     """PyBullet and Drake read the original as a ROS user has it: nothing refuses it, and what
     each program does on its own (Drake reads no STL or DAE, PyBullet weighs frames 1 kg) is a
@@ -182,6 +187,8 @@ def test_check_passes_a_clean_original_with_package_meshes_and_frames(arm_kit):
     assert lines[-1].endswith(": 0 errors, 2 warnings"), lines[-1]
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_the_package_around_the_file_needs_no_package_path(arm_kit):
     """As ROS finds a package's own files, import and check find the package the file sits in
     (by its package.xml) for its ``$(find)`` and ``package://``."""
@@ -216,6 +223,7 @@ GRIPPER = """
 """
 
 
+@pytest.mark.consumers
 def test_gazebo_drops_what_moves_below_a_massless_welded_link(tmp_path):
     """The premise, measured with libsdformat: the finger below the massless 'mount' is gone
     from Gazebo's reading of the original, though 'mount' is welded to a link with mass."""
@@ -225,6 +233,7 @@ def test_gazebo_drops_what_moves_below_a_massless_welded_link(tmp_path):
         [str(f) for f in findings]
 
 
+@pytest.mark.consumers
 def test_import_gives_the_welded_link_mass_and_gazebo_keeps_the_finger(tmp_path):
     urdf = _write(tmp_path / "gripper.urdf", GRIPPER)
     result = import_file(urdf, tmp_path / "recipe" / "robot.yaml", {}, {})
@@ -243,6 +252,8 @@ def test_import_gives_the_welded_link_mass_and_gazebo_keeps_the_finger(tmp_path)
     assert summary["Gazebo (URDF)"]["links"] == 2  # arm (with mount and tcp lumped in) and finger
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_check_names_the_massless_welded_link_on_the_original(tmp_path):
     urdf = _write(tmp_path / "gripper.urdf", GRIPPER)
     proc = run_cli("check", urdf, cwd=tmp_path)
@@ -254,6 +265,7 @@ def test_check_names_the_massless_welded_link_on_the_original(tmp_path):
     assert not [line for line in proc.stdout.splitlines() if line.startswith("link 'tcp'")]  # a frame: fine
 
 
+@pytest.mark.slow
 def test_a_recipe_with_a_massless_welded_link_above_a_moving_joint_builds_no_urdf(tmp_path):
     recipe = _write(tmp_path / "robot.yaml", """
         robot: gripper
@@ -329,6 +341,8 @@ TRAITS_XACRO = """
 """
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_a_number_set_by_xacro_attribute_is_written_as_xacro_writes_attributes(tmp_path):
     """``<xacro:attribute value="${-pi/2}"/>`` leaves a number where xacro's writer wants text
     (xacro 2.1 fails with AttributeError on such a file); robotkit writes it as xacro writes every
@@ -359,6 +373,7 @@ def test_a_number_set_by_xacro_attribute_is_written_as_xacro_writes_attributes(t
     assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stdout + proc.stderr
 
 
+@pytest.mark.consumers
 def test_gazebo_s_reading_of_a_planar_joint_is_a_refusal_not_a_crash(tmp_path):
     """libsdformat's URDF conversion drops a planar joint and leaves its child posed relative to
     it: the model it prints cannot load, which check reports (it raised KeyError)."""
@@ -402,6 +417,8 @@ ROS2_TRANSMISSION = """
 """
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_a_transmission_in_ros2_control_s_form_loads_in_drake(tmp_path):
     """TIAGo's transmissions name their class in <plugin>, ros2_control's form, and have no
     <type>, without which Drake refuses the URDF: the build's URDF carries both (and says so),
@@ -480,6 +497,8 @@ def test_a_tensor_repaired_to_the_triangle_inequality_stays_inside_it_once_rotat
     mujoco().MjModel.from_xml_path(str(tmp_path / "build" / "arm" / "mjcf" / "arm.xml"))
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_check_finds_the_package_around_a_urdf_in_a_folder_named_otherwise(tmp_path):
     """A package checked out as 'kit-main' is package 'kit' by its package.xml: check reads its
     meshes without --package-path (it looked for a folder named 'kit')."""

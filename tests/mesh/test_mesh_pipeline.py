@@ -242,6 +242,7 @@ def test_surface_distance_is_exact():
     np.testing.assert_allclose(point_surface_distance(pts, b), brute, rtol=0, atol=1e-15)
 
 
+@pytest.mark.slow
 def test_decimate_sphere_volume_and_distance_against_the_sphere():
     sphere = trimesh.creation.icosphere(subdivisions=6, radius=1.0)  # 81,920 faces
     out, report = decimate(sphere, target_faces=5000)
@@ -283,6 +284,7 @@ REAL_VISUALS = sorted(str(p.relative_to(REPO)) for p in (REPO / "recipes" / "mes
                       if p.suffix.lower() in (".stl", ".dae") and "collision" not in p.parts)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("keep", [0.1, 0.3])
 def test_decimate_reaches_the_target_and_keeps_closed_meshes_closed_on_real_meshes(keep):
     """Every visual mesh of the examples (CAD tessellations: long thin triangles, several bodies):
@@ -360,6 +362,7 @@ def test_meshlib_runs_on_the_calling_thread_alone():
     assert len(os.listdir("/proc/self/task")) <= threads  # no TBB worker started
 
 
+@pytest.mark.slow
 def test_meshlib_fast_stage_where_the_first_pass_gives_up(monkeypatch):
     """Without the first pass, MeshLib goes to 3 times the target keeping vertices where they
     are, then to the target with its optimal positions: the target is reached, a closed mesh
@@ -532,6 +535,7 @@ def test_hull_errors():
 
 # --- CoACD -----------------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_decompose_l_shape(capfd):
     mesh = l_shape()
     t0 = time.perf_counter()
@@ -552,6 +556,7 @@ def test_decompose_l_shape(capfd):
     assert max(len(p.vertices) for p in tight) <= 8
 
 
+@pytest.mark.slow
 def test_coacd_gets_the_union_of_overlapping_bodies():
     from robotkit.mesh.decompose import coacd_input
 
@@ -930,6 +935,7 @@ def test_cache_two_processes_compute_the_same_key_once(tmp_path):
 
 # --- export ----------------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_stl_bytes_are_reproducible_across_processes():
     mesh = moved(trimesh.creation.icosphere(subdivisions=3, radius=0.1), pose())
     data = stl_bytes(mesh)

@@ -250,6 +250,7 @@ def test_the_bounding_primitive_is_the_smallest_enclosure():
     assert ip.defects(1.0, b.inertia(1.0)[1]) == []
 
 
+@pytest.mark.consumers
 def test_check_names_the_defect_and_the_policies_on_the_original(tmp_path):
     from robotkit.check import check_urdf_file
 

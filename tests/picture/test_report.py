@@ -59,6 +59,7 @@ def test_equivalent_box_known_answer():
     assert equivalent_box(1.0, (1.0, 0.1, 0.1)).tolist()[0] == 0.0
 
 
+@pytest.mark.slow
 def test_build_writes_the_report_and_a_noop_build_does_not_rerender(turret):
     robot_dir, recipe = turret
     report = robot_dir / "report"
@@ -72,6 +73,7 @@ def test_build_writes_the_report_and_a_noop_build_does_not_rerender(turret):
     assert {p.name: p.stat().st_mtime_ns for p in report.iterdir()} == before
 
 
+@pytest.mark.slow
 def test_report_task_reruns_on_a_recipe_edit_and_pictures_are_byte_identical(turret, tmp_path):
     robot_dir, recipe = turret
     edited = tmp_path / "turret_bot.yaml"
@@ -86,6 +88,7 @@ def test_report_task_reruns_on_a_recipe_edit_and_pictures_are_byte_identical(tur
     assert (new / "report.html").read_text() == (old / "report.html").read_text()
 
 
+@pytest.mark.slow
 def test_no_report_flag(tmp_path):
     recipe = write_recipe(tmp_path, """
         robot: cube
@@ -156,6 +159,7 @@ def row(html: str, kind: str, name: str) -> str:
     return match.group(1)
 
 
+@pytest.mark.slow
 def test_defects_are_named_in_the_table(arms):
     html = (arms / "defects" / "report" / "report.html").read_text()
     assert "[inertia-box]" in row(html, "link", "arm")
@@ -171,6 +175,7 @@ def test_defects_are_named_in_the_table(arms):
     assert "(0, -1, 0)" in row(flipped, "joint", "shoulder")
 
 
+@pytest.mark.slow
 def test_defects_are_visible_in_the_pictures(arms):
     healthy, defects = arms / "healthy" / "report", arms / "defects" / "report"
     # the flagged links' inertia boxes are drawn red, the 60 m "tool" fills the picture
@@ -183,6 +188,7 @@ def test_defects_are_visible_in_the_pictures(arms):
     assert red(healthy / "inertia.png") == 0
 
 
+@pytest.mark.slow
 def test_flipped_axis_shows_in_the_limit_pictures(arms):
     """q -> -q: the flipped joint at its lower limit is the healthy one at its upper limit."""
     def panels(name):
@@ -201,6 +207,7 @@ def test_flipped_axis_shows_in_the_limit_pictures(arms):
     assert differ(healthy[0], healthy[2]) > 0.02  # the joint moves visibly
 
 
+@pytest.mark.slow
 def test_report_of_a_foreign_urdf_and_an_mjcf_file(assets, turret, tmp_path):
     done = run_cli("report", assets / "turret_bot" / "urdf" / "turret_bot.urdf", "-o", tmp_path / "urdf",
                    "--package-path", f"turret_bot={assets / 'turret_bot'}")
@@ -228,6 +235,7 @@ def test_report_of_a_foreign_urdf_and_an_mjcf_file(assets, turret, tmp_path):
     assert row(html, "link", "rotor").split("</td>")[:5] == row(built, "link", "rotor").split("</td>")[:5]
 
 
+@pytest.mark.slow
 def test_report_bad_input(tmp_path):
     done = run_cli("report", tmp_path / "nothing.yaml")
     assert (done.returncode, done.stderr) == (2, f"{tmp_path / 'nothing.yaml'}: no such file or folder\n")
@@ -238,6 +246,8 @@ def test_report_bad_input(tmp_path):
                            ".sdf or MJCF .xml)\n")
 
 
+@pytest.mark.browser
+@pytest.mark.slow
 def test_report_in_chromium(turret):
     """The page loads with no console error, every picture loads and is not blank, and the
     inertia-box picture is not the visual picture."""
@@ -265,6 +275,8 @@ def test_report_in_chromium(turret):
     assert (diff > 30).mean() > 0.01
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_check_github_writes_a_job_summary(turret, tmp_path):
     robot_dir, _ = turret
     summary = tmp_path / "summary.md"

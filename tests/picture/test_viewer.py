@@ -17,6 +17,8 @@ from PIL import Image
 from conftest import RECIPES
 from tests.picture.test_report import chromium
 
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
+
 
 def free_port() -> int:
     with socket.socket() as s:

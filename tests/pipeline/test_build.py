@@ -21,6 +21,7 @@ def report(out: Path, robot: str) -> dict:
     return json.loads((out / robot / "report.json").read_text())
 
 
+@pytest.mark.slow
 def test_ur5_collision_pieces_are_closed_convex_and_cached(tmp_path):
     out1, out2 = tmp_path / "cold", tmp_path / "warm"
     cache = tmp_path / "cache"
@@ -64,6 +65,7 @@ def test_ur5_collision_pieces_are_closed_convex_and_cached(tmp_path):
     mujoco().MjModel.from_xml_path(str(out1 / "ur5" / "mjcf" / "scene.xml"))
 
 
+@pytest.mark.slow
 def test_fidelity_numbers_on_known_shapes(tmp_path):
     sphere = trimesh.creation.icosphere(subdivisions=5, radius=0.1)
     cube = trimesh.creation.box([0.1, 0.2, 0.3])
@@ -86,6 +88,7 @@ def test_fidelity_numbers_on_known_shapes(tmp_path):
     assert box["volume_ratio"] == pytest.approx(6 / math.pi, rel=2e-3)  # cube around a sphere
 
 
+@pytest.mark.slow
 def test_collision_strategy_per_format(tmp_path):
     mesh = trimesh.creation.cylinder(radius=0.05, height=0.3, sections=64)
     recipe = write_recipe(tmp_path, """
@@ -109,6 +112,7 @@ def test_collision_strategy_per_format(tmp_path):
     ign_sdf_check(robot / "model.sdf")
 
 
+@pytest.mark.slow
 def test_decimated_visual_is_written_in_metres(tmp_path):
     mesh = trimesh.creation.icosphere(subdivisions=5, radius=50.0)  # millimetres, 20k faces
     recipe = write_recipe(tmp_path, """
@@ -143,6 +147,7 @@ BAD = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(BAD))
 def test_bad_meshes(tmp_path, case):
     make, link, expected = BAD[case]

@@ -4,6 +4,8 @@ actuators with no force range) and what a format cannot express, one line each o
 
 from __future__ import annotations
 
+import pytest
+
 import trimesh
 
 from conftest import run_cli, write_recipe
@@ -35,6 +37,7 @@ actuators:
 """
 
 
+@pytest.mark.slow
 def test_build_warns_with_file_line_and_key(tmp_path):
     wheel = trimesh.creation.cylinder(radius=66.0, height=26.0, sections=64)  # millimetres, declared as metres
     write_recipe(tmp_path, RECIPE, "careless.yaml", {"wheel.stl": wheel})
@@ -56,6 +59,7 @@ def test_build_warns_with_file_line_and_key(tmp_path):
     assert [line for line in again.stderr.splitlines() if "warning:" in line] == warnings
 
 
+@pytest.mark.slow
 def test_a_clean_recipe_builds_without_warnings(tmp_path):
     write_recipe(tmp_path, RECIPE.replace("  blue: {rgba: [0, 0, 0.8, 1]}\n", "")
                  .replace("{mesh: wheel.stl}", "{mesh: wheel.stl, units: mm}")

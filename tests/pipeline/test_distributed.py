@@ -117,6 +117,7 @@ def _assert_entries_whole(objects: dict[str, bytes]):
         assert hashlib.sha256(payload).hexdigest() == m["payload"]["sha256"]
 
 
+@pytest.mark.slow
 def test_shared_cache_on_s3(s3, tmp_path):
     """One machine computes and publishes; another with an empty local cache rebuilds the
     same bytes from the shared copy without computing anything."""
@@ -141,6 +142,7 @@ def test_shared_cache_on_s3(s3, tmp_path):
     assert third.returncode == 0, third.stderr
 
 
+@pytest.mark.slow
 def test_corrupt_shared_entry_is_detected_and_rebuilt(s3, tmp_path):
     fs, env = s3
     recipe = write_recipe(tmp_path / "src", RECIPE, meshes=_meshes())
@@ -165,6 +167,7 @@ def test_corrupt_shared_entry_is_detected_and_rebuilt(s3, tmp_path):
     assert after == before
 
 
+@pytest.mark.slow
 def test_read_only_shared_cache_is_never_written(s3, tmp_path):
     fs, env = s3
     recipe = write_recipe(tmp_path / "src", RECIPE, meshes=_meshes())
@@ -176,6 +179,7 @@ def test_read_only_shared_cache_is_never_written(s3, tmp_path):
     assert list((tmp_path / "l").rglob("*.json"))  # the local copy still works
 
 
+@pytest.mark.slow
 def test_unreachable_shared_cache_costs_time_not_the_build(tmp_path):
     recipe = write_recipe(tmp_path / "src", RECIPE, meshes=_meshes())
     port = _free_port()  # nothing listens there
@@ -276,6 +280,7 @@ class Cluster:
                 p.kill()
 
 
+@pytest.mark.slow
 def test_build_sends_mesh_work_to_the_cluster(tmp_path):
     recipe = write_recipe(tmp_path / "src", RECIPE, meshes=_meshes())
     local = _build(recipe, tmp_path / "here", {"ROBOTKIT_CACHE": str(tmp_path / "c1")})
@@ -295,6 +300,7 @@ def _l_shape(size: float) -> trimesh.Trimesh:
     return trimesh.boolean.union([a, b]).subdivide()
 
 
+@pytest.mark.slow
 def test_catalogue_on_a_cluster_survives_a_killed_worker(tmp_path):
     """A catalogue with broken meshes among good ones, on two workers, one of which is killed
     while it works: every good object is made once, every broken one is reported, and the
@@ -371,6 +377,7 @@ def test_catalogue_on_a_cluster_survives_a_killed_worker(tmp_path):
                                                                     if k != "knot.stl"}
 
 
+@pytest.mark.slow
 def test_catalogue_bad_input(tmp_path):
     from conftest import run_cli
 

@@ -78,6 +78,7 @@ def scale_mesh(path: Path):
     mesh.export(path)
 
 
+@pytest.mark.slow
 def test_second_build_answers_from_the_stamp_and_changes_fall_through(project, capsys, monkeypatch):
     calls = Calls(monkeypatch)
     first = build(capsys)
@@ -117,6 +118,7 @@ def test_second_build_answers_from_the_stamp_and_changes_fall_through(project, c
     assert (project / "out" / "bot" / "urdf" / "bot.urdf").is_file()
 
 
+@pytest.mark.slow
 def test_a_failed_build_removes_the_stamp(project, capsys, monkeypatch):
     calls = Calls(monkeypatch)
     build(capsys)
@@ -129,6 +131,7 @@ def test_a_failed_build_removes_the_stamp(project, capsys, monkeypatch):
     assert build(capsys).startswith("out/bot: up to date (") and calls.n == 3
 
 
+@pytest.mark.slow
 def test_another_output_folder_has_its_own_stamp(project, capsys, monkeypatch):
     calls = Calls(monkeypatch)
     build(capsys)
@@ -137,6 +140,7 @@ def test_another_output_folder_has_its_own_stamp(project, capsys, monkeypatch):
     assert build(capsys).startswith("out/bot: up to date (") and calls.n == 2
 
 
+@pytest.mark.slow
 def test_a_no_op_build_imports_no_heavy_library(project, capsys):
     build(capsys)
     code = ("import sys; from robotkit.cli import main; rc = main(['build', 'bot.yaml', '--out', 'out']); "

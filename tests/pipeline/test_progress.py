@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 import io
 import os
 import subprocess
@@ -87,6 +89,7 @@ def test_clock_moves_while_a_task_runs_and_stops_at_clear():
     assert len(out.getvalue()) == size  # the thread has stopped
 
 
+@pytest.mark.slow
 def test_build_progress_on_a_terminal_only(tmp_path):
     recipe = write_recipe(tmp_path, """
         robot: p

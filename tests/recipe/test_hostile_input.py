@@ -353,6 +353,7 @@ def load(recipe: Path, cwd: Path, monkeypatch) -> tuple[int, str, str]:
     return 0, "", ""
 
 
+@pytest.mark.slow
 def test_fuzz_example_recipes(tmp_path, capsys, monkeypatch):
     """Random single mutations of the example recipes, for a bounded time: every answer is a
     clean exit with one located line per problem, never a traceback; a failed build writes

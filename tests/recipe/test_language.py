@@ -216,6 +216,7 @@ def test_bad_recipes(tmp_path, case):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_arguments_from_the_command_line(tmp_path):
     write_recipe(tmp_path, """
         robot: r
@@ -241,6 +242,7 @@ def test_arguments_from_the_command_line(tmp_path):
     assert yaml.safe_load(proc.stdout)["links"]["base"]["visual"]["box"]["size"] == [0.3, 0.3, 0.3]
 
 
+@pytest.mark.slow
 def test_an_error_in_a_part_file_names_the_file_and_the_instances(tmp_path):
     (tmp_path / "parts").mkdir()
     write_recipe(tmp_path, """
@@ -410,6 +412,8 @@ def test_mirrored_meshes_are_written_mirrored_with_outward_faces(legs):
     np.testing.assert_allclose(written.center_mass, mirrored.center_mass * 0.01, atol=1e-7)
 
 
+@pytest.mark.consumers
+@pytest.mark.slow
 def test_every_format_of_the_mirrored_build_agrees(legs):
     proc = run_cli("check", legs / "parts/out/legs", "--format", "json")
     import json
@@ -423,6 +427,7 @@ def test_every_format_of_the_mirrored_build_agrees(legs):
     assert errors == [], proc.stdout
 
 
+@pytest.mark.slow
 def test_expand_prints_a_flat_recipe_that_builds_the_same_robot(legs, tmp_path):
     proc = run_cli("expand", legs / "parts/robot.yaml")
     assert proc.returncode == 0, proc.stderr
@@ -460,6 +465,7 @@ def test_instance_origin_with_a_rotation_composes_with_the_joint_origin(tmp_path
 # ---------------------------------------------------------------- conditions, variants, dependencies
 
 
+@pytest.mark.slow
 def test_conditions_and_variants_build_one_folder_each(tmp_path):
     recipe = write_recipe(tmp_path, """
         robot: cart
@@ -522,6 +528,7 @@ def test_changing_an_argument_reruns_only_what_reads_it(tmp_path):
     assert not build([recipe], tmp_path / "out", args={"arm_mass": "2"}).ran
 
 
+@pytest.mark.slow
 def test_the_no_op_fast_path_sees_arguments_and_part_files(tmp_path):
     (tmp_path / "parts").mkdir()
     part = write_recipe(tmp_path, """
@@ -569,6 +576,7 @@ def test_doit_takes_arguments_for_the_recipes_that_declare_them(tmp_path):
 # ---------------------------------------------------------------- the rewritten examples
 
 
+@pytest.mark.slow
 def test_turtlebot3_burger_written_with_parts_is_the_imported_robot(tmp_path):
     """The hand-written recipe (at most half the xacro's 165 lines) builds the robot the
     imported flat recipe builds, to 1e-9."""

@@ -323,6 +323,7 @@ def test_recipe_world_with_a_missing_map(tmp_path):
         "worlds.w.map: map file '" + str(tmp_path / "nowhere.yaml") + "' does not exist"]
 
 
+@pytest.mark.slow
 def test_recipe_world_with_the_robot_spawned(tmp_path, assets):
     import os
     import subprocess

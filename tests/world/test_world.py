@@ -228,6 +228,7 @@ def random_masks():
     yield ring
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["outline", "rectangles"])
 def test_mesher_is_exact_on_random_masks(method):
     for mask in random_masks():
@@ -578,6 +579,7 @@ def test_bad_name_and_height_with_the_map_problems(tmp_path, monkeypatch):
 # ---------------------------------------------------------------- the command, as a new user runs it
 
 
+@pytest.mark.slow
 def test_cli_writes_the_five_files(tmp_path):
     yaml_path = write_map(tmp_path / "maps", rooms_map(), name="office", resolution=0.05, origin="[-4.0, -3.0, 0.1]")
     proc = run_cli("world", yaml_path, "--out", "OUT", cwd=tmp_path)
