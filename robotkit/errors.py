@@ -115,3 +115,21 @@ class MeshError(RobotkitError):
 
 class MapError(RobotkitError):
     """An occupancy map (map_server YAML + image) is invalid."""
+
+
+class RendererUnavailable(RobotkitError):
+    """MuJoCo cannot draw offscreen here (no OSMesa, or a ``MUJOCO_GL`` that cannot work): the
+    picture report has no pictures.  A build still writes everything else and warns; ``robotkit
+    report`` stops on it (exit 2).  The message says what to install."""
+
+    def __init__(self, reason: str):
+        gl = os.environ.get("MUJOCO_GL", "")
+        super().__init__(Problem(
+            f"no pictures: MuJoCo cannot draw offscreen with MUJOCO_GL={gl!r} ({reason}); install Debian's "
+            "libosmesa6 (sudo apt-get install libosmesa6) and leave MUJOCO_GL unset or set to osmesa"))
+
+    @classmethod
+    def because(cls, exc: BaseException) -> "RendererUnavailable":
+        """The error for MuJoCo's own exception (its first line)."""
+        text = str(exc).strip()
+        return cls(text.splitlines()[0] if text else type(exc).__name__)

@@ -17,7 +17,7 @@ from pathlib import Path, PurePosixPath
 from robotkit.check.kinematics import read_mjcf, read_sdf
 from robotkit.check.lints import JointFacts, LinkFacts, lint, lint_joints, lint_link, read_urdf_facts
 from robotkit.emit.layout import REPORT_HTML, robot_layout
-from robotkit.errors import Problem, RobotkitError
+from robotkit.errors import Problem, RendererUnavailable, RobotkitError
 from robotkit.ioutil import write_if_changed
 from robotkit.picture import page
 
@@ -25,9 +25,11 @@ PAGE = PurePosixPath(REPORT_HTML).name  # report.html, in whichever folder the r
 VERSION = 1  # bump when the pictures or the page change for the same build
 
 
-def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: float | None = None) -> Path:
+def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: float | None = None,
+                     no_pictures: str | None = None) -> Path:
     """The report of a robotkit build folder: pictures from mjcf/<robot>.xml, tables from the URDF
-    (the check package's facts and lints) and report.json (collision fidelity, losses)."""
+    (the check package's facts and lints) and report.json (collision fidelity, losses).
+    ``no_pictures``: draw none, and say why on the page (MuJoCo cannot draw here)."""
     layout = robot_layout(robot_dir)
     name, urdf, mjcf = layout.name, layout.urdf, layout.mjcf
     for f in (urdf, mjcf):
@@ -37,9 +39,9 @@ def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: flo
     links, joints, notes = read_urdf_facts(urdf, {name: str(robot_dir)})
     findings = notes + lint(links, joints, declared_mass)
     losses, collision = page.read_losses(layout.report_json)
-    pictures = _pictures(mjcf, out, findings)
+    pictures = _pictures(mjcf, out, findings) if no_pictures is None else []
     return _write(out, name, source, pictures, links, joints, findings, losses, collision,
-                  urdf.read_text(encoding="utf-8"))
+                  urdf.read_text(encoding="utf-8"), [no_pictures] if no_pictures else [])
 
 
 def report_urdf(urdf: Path, out: Path, package_paths: dict[str, str], mjcf: Path | None,
@@ -77,7 +79,11 @@ def report_model_file(path: Path, out: Path, kind: str) -> Path:
 
 
 def _pictures(mjcf: Path, out: Path, findings) -> list:
-    from robotkit.picture.render import render_pictures  # imports MuJoCo (heavy): only to draw
+    """The pictures of ``mjcf`` drawn into ``out``; RendererUnavailable when MuJoCo cannot draw here."""
+    try:
+        from robotkit.picture.render import render_pictures  # imports MuJoCo (heavy): only to draw
+    except Exception as exc:  # noqa: BLE001  (MuJoCo's GL backend fails at import: MUJOCO_GL, no OSMesa)
+        raise RendererUnavailable.because(exc) from None
 
     flagged = {f.subject[6:-1] for f in findings if f.subject.startswith("link '")}
     pictures = render_pictures(mjcf, out, flagged)

@@ -22,7 +22,7 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from robotkit.check.lints import equivalent_box  # noqa: E402
-from robotkit.errors import Problem, RobotkitError  # noqa: E402
+from robotkit.errors import Problem, RendererUnavailable, RobotkitError  # noqa: E402
 from robotkit.ioutil import write_if_changed  # noqa: E402
 
 VISUAL, COLLISION, SENSOR = 2, 3, 4  # MuJoCo geom/site groups in robotkit's MJCF
@@ -87,9 +87,7 @@ def renderer(model, height: int, width: int):
     try:
         return mujoco.Renderer(model, height, width)
     except Exception as exc:  # noqa: BLE001  (no GL context: the backend is missing or needs a display)
-        raise RobotkitError(Problem(
-            f"cannot render offscreen with MUJOCO_GL={os.environ.get('MUJOCO_GL', '')!r}: {exc} (install "
-            "Debian's libosmesa6 and set MUJOCO_GL=osmesa before MuJoCo is first imported)")) from None
+        raise RendererUnavailable.because(exc) from None
 
 
 class Painter:

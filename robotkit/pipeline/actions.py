@@ -20,7 +20,7 @@ from doit.exceptions import TaskFailed
 
 from robotkit.emit.registry import FORMATS
 from robotkit.emit.layout import robot_layout
-from robotkit.errors import ConsumerError, Problem, RobotkitError, display_path
+from robotkit.errors import ConsumerError, Problem, RendererUnavailable, RobotkitError, display_path
 from robotkit.ioutil import write_if_changed
 from robotkit.mesh.cache import Cache, plain
 from robotkit.mesh.export import obj_bytes, stl_bytes
@@ -298,8 +298,26 @@ def publish_outputs(out_dir: str, robot: str, tasks: list[dict]):
 
 
 @_user_errors_fail
-def picture_report(robot_dir: str, out_dir: str):
-    """report.html and its pictures (robotkit.picture imports MuJoCo in the task)."""
+def picture_report(robot_dir: str, out_dir: str, record: str):
+    """report.html and its pictures (robotkit.picture imports MuJoCo in the task).  Where MuJoCo
+    cannot draw, the page is written without pictures and ``record`` says why (the build warns)."""
     shutil.rmtree(out_dir, ignore_errors=True)  # the staged report folder: no picture of an earlier build stays
     urdf = Path(os.path.relpath(robot_layout(robot_dir).urdf, out_dir)).as_posix()  # ../urdf/<robot>.urdf
-    report_build_dir(Path(robot_dir), Path(out_dir), urdf)
+    try:
+        report_build_dir(Path(robot_dir), Path(out_dir), urdf)
+        why = None
+    except RendererUnavailable as exc:  # an optional stage: the descriptions stand without it
+        why = exc.lines()[0]
+        shutil.rmtree(out_dir, ignore_errors=True)
+        report_build_dir(Path(robot_dir), Path(out_dir), urdf, no_pictures=why)
+    write_if_changed(record, dump_json({"no_pictures": why}))
+
+
+def pictures_drawn(record: str) -> bool:
+    """doit's ``uptodate`` of the picture report: False when it was last written without pictures,
+    so that it is drawn again once MuJoCo can draw (nothing else about the build changed)."""
+    try:
+        with open(record, encoding="utf-8") as f:
+            return not json.load(f).get("no_pictures")
+    except (OSError, ValueError, AttributeError):
+        return True

@@ -58,7 +58,7 @@ def build_warnings(robots, out: Path) -> list[tuple[str, str]]:
         for key, f in facts.items():  # recorded with their place (robotkit.pipeline.actions.mesh_facts): placed anew
             pairs += [(w, warning_line(_PLACE.sub("", w, count=1), where.get(key))) for w in f.get("warnings", [])]
     for loaded, robot, where, facts in places:
-        pairs += _losses(loaded, robot, out, where) + lints(loaded, robot, facts, where)
+        pairs += _losses(loaded, robot, out, where) + lints(loaded, robot, facts, where) + _pictures(loaded, robot, out)
     seen: dict[str, str] = {}
     for text, line in pairs:
         seen.setdefault(line, text)
@@ -74,6 +74,26 @@ def _mesh_facts(state: Path, robot) -> dict[str, dict]:
         except (OSError, ValueError):
             pass
     return out
+
+
+def no_pictures(name: str, out: Path) -> str | None:
+    """Why robot ``name``'s published picture report has no pictures (MuJoCo cannot draw here, as
+    the report task recorded), or None."""
+    if not layout.robot_layout(out / name).report_html.is_file():  # built without the report
+        return None
+    try:
+        record = json.loads((out / STATE / name / layout.RECORDS["pictures"]).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return record.get("no_pictures") if isinstance(record, dict) else None
+
+
+def _pictures(loaded, robot, out: Path) -> list[tuple[str, str]]:
+    why = no_pictures(robot.name, out)
+    if not why:
+        return []
+    text = f"{robot.name}: report/report.html: {why}"
+    return [(text, warning_line(text, _at(loaded, ("robot",))))]
 
 
 def _place(loaded, robot, what: str, name: str, where: dict) -> dict:

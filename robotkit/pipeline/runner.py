@@ -25,7 +25,7 @@ from robotkit.emit.env import template_dirs
 from robotkit.errors import Problem, RobotkitError
 from robotkit.model.load import load_robots, mesh_locations
 from robotkit.pipeline import stamp
-from robotkit.pipeline.buildwarn import build_warnings
+from robotkit.pipeline.buildwarn import build_warnings, no_pictures
 from robotkit.pipeline.progress import Progress
 from robotkit.pipeline.publish import STATE, publish, staged_files
 from robotkit.pipeline.tasks import robot_tasks
@@ -172,7 +172,9 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         result.errors.append(("doit", f"doit exited with status {rc}"))
     warnings = build_warnings(robots, out)  # (text, file:line: key: warning: text) pairs
     result.warnings, result.warning_lines = [t for t, _ in warnings], [line for _, line in warnings]
-    if rc == 0 and not result.errors and not result.failed:
+    # a report drawn without pictures is retried by the next build (MuJoCo may draw by then): no stamp
+    retry = any(no_pictures(name, out) for name in result.robots)
+    if rc == 0 and not result.errors and not result.failed and not retry:
         outputs = sorted({str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])} | set(published))
         try:
             stamp.write(out, stamp_options, inputs, outputs,

@@ -348,16 +348,16 @@ def report_task(place: Place, drawn: list[dict], meshes: list[dict]) -> dict:
     report.json and every mesh file MuJoCo reads (the targets of ``drawn``: the meshes the MJCF
     draws and the collision pieces' records), after the ``meshes`` tasks (rendering imports stay
     in the action)."""
-    built = layout.RobotLayout(place.root)
+    built, record = layout.RobotLayout(place.root), place.record("pictures", "")
     inputs = [str(built.urdf), str(built.mjcf), str(built.report_json)]
     inputs += [target for t in drawn for target in t["targets"]]
     return {
         "name": f"{place.robot.name}:report-html",
         "doc": layout.REPORT_HTML,
-        "actions": [(actions.picture_report, [str(place.root), str(built.pictures)])],
+        "actions": [(actions.picture_report, [str(place.root), str(built.pictures), record])],
         "file_dep": inputs + template_files([PICTURE_TEMPLATE]),
-        "targets": [str(built.report_html)],
-        "uptodate": [config_changed({"version": PICTURE_VERSION})],
+        "targets": [str(built.report_html), record],
+        "uptodate": [config_changed({"version": PICTURE_VERSION}), (actions.pictures_drawn, [record])],
         "task_dep": [t["name"] for t in meshes],
         "clean": True,
     }

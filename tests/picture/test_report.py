@@ -10,6 +10,7 @@ import shutil
 import numpy as np
 import pytest
 import trimesh
+from markupsafe import escape
 from PIL import Image
 
 from conftest import GOLDEN, RECIPES, assert_golden, run_cli, write_recipe
@@ -293,3 +294,42 @@ def test_check_github_writes_a_job_summary(turret, tmp_path):
     assert text.startswith("earlier step\n## robotkit check ")
     assert "Picture report: `turret_bot/report/report.html` (upload the folder `turret_bot/report` as an " \
            "artifact to see it)" in text
+
+
+NO_GL = {"bogus": "invalid value for environment variable MUJOCO_GL: bogus",  # MuJoCo's import fails
+         "disable": "module 'mujoco.rendering.classic.gl_context' has no attribute 'GLContext'"}  # no context
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("gl", sorted(NO_GL))
+def test_where_mujoco_cannot_draw_a_build_writes_everything_and_warns_once(tmp_path, gl):
+    """The picture report is optional: with no offscreen OpenGL (no OSMesa, an unusable MUJOCO_GL)
+    the build writes every description, the ROS package and a report without pictures, says
+    what to install in one warning and exits 0; the next build where MuJoCo can draw draws them.
+    ``robotkit report`` stops on it (exit 2) with the same line; no traceback anywhere."""
+    from robotkit.ioutil import environ
+
+    shutil.copytree(RECIPES, tmp_path / "recipes", ignore=shutil.ignore_patterns("*.yaml"))
+    shutil.copy(RECIPES / "turret_bot.yaml", tmp_path / "recipes")
+    why = (f"no pictures: MuJoCo cannot draw offscreen with MUJOCO_GL='{gl}' ({NO_GL[gl]}); install Debian's "
+           "libosmesa6 (sudo apt-get install libosmesa6) and leave MUJOCO_GL unset or set to osmesa")
+    with environ({"MUJOCO_GL": gl}):
+        built = run_cli("build", "recipes/turret_bot.yaml", "--out", "out", cwd=tmp_path)
+        report = run_cli("report", "out/turret_bot", "-o", "elsewhere", cwd=tmp_path)
+    assert built.returncode == 0, built.stderr
+    assert "Traceback" not in built.stderr + report.stderr
+    assert [line for line in built.stderr.splitlines() if "pictures" in line] == [
+        f"recipes/turret_bot.yaml:6: robot: warning: turret_bot: report/report.html: {why}"]
+    robot = tmp_path / "out" / "turret_bot"
+    for rel in ("urdf/turret_bot.urdf", "model.sdf", "model.config", "mjcf/turret_bot.xml", "mjcf/scene.xml",
+                "package.xml", "CMakeLists.txt", "launch/display.launch", "rviz/turret_bot.rviz", "report.json"):
+        assert (robot / rel).is_file(), rel
+    assert str(escape(why)) in (robot / "report" / "report.html").read_text(encoding="utf-8")  # as Jinja writes it
+    assert not list((robot / "report").glob("*.png"))
+    assert (report.returncode, report.stderr.splitlines()) == (2, [why])
+
+    again = run_cli("build", "recipes/turret_bot.yaml", "--out", "out", cwd=tmp_path)  # MuJoCo draws here
+    assert again.returncode == 0 and "pictures" not in again.stderr
+    assert "1 tasks run" in again.stdout  # the report alone
+    assert len(list((robot / "report").glob("*.png"))) > 4
+    assert "up to date" in run_cli("build", "recipes/turret_bot.yaml", "--out", "out", cwd=tmp_path).stdout

@@ -139,7 +139,13 @@ def test_the_report_task_reads_the_written_descriptions_and_meshes(bot, tmp_path
     tasks = robot_tasks(robot, out, report=True)
     [report] = [t for t in tasks if t["name"] == "bot:report-html"]
     stage = out / ".robotkit" / "stage" / "bot"
-    assert report["targets"] == [str(stage / "report" / "report.html")]
+    assert report["targets"] == [str(stage / "report" / "report.html"), str(out / ".robotkit" / "bot" / "pictures.json")]
+    # redrawn when it was written without pictures (MuJoCo could not draw): the record says so
+    pictures_drawn, [record] = report["uptodate"][1]
+    assert pictures_drawn(record)  # no record yet: nothing to redraw
+    Path(record).parent.mkdir(parents=True, exist_ok=True)
+    Path(record).write_text('{"no_pictures": "no OpenGL"}')
+    assert not pictures_drawn(record)
     assert report["file_dep"][:4] == [str(stage / "urdf" / "bot.urdf"), str(stage / "mjcf" / "bot.xml"),
                                       str(stage / "report.json"), str(stage / "meshes" / "visual" / "slider.stl")]
 
