@@ -15,7 +15,7 @@ def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error
            cases: list[tuple[str, str]] | None = None) -> str:
     """``fail_on`` (``--fail-on``): the lowest severity that fails the check; every format says
     which findings fail it (JUnit failures, GitHub ``::error``, JSON ``failed``, the text's last line).
-    ``cases``: every (check, subject) that ran (:func:`robotkit.check.cases`): JUnit lists the
+    ``cases``: every (check, subject) that ran (:func:`robotkit.commands.check.cases`): JUnit lists the
     ones without findings as passing test cases."""
     if fmt == "json":
         return json.dumps({"source": source, "errors": sum(f.severity == "error" for f in findings),
