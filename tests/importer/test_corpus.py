@@ -321,12 +321,12 @@ def test_pmb2_with_an_inertia_policy_builds_and_loads(tmp_path, policy):
 def test_defaults_change_no_value(corpus, name, tmp_path, monkeypatch):
     """The values moved to the recipe's ``defaults`` (and the exceptions written per joint or
     link) give, once merged, the recipe written without them: field for field."""
-    import robotkit.importer.defaults
+    import robotkit.importer
     from robotkit.recipe.load import load_recipes
 
     result = corpus[name][0]
     spec = CORPUS[name]
-    monkeypatch.setattr(robotkit.importer.defaults, "factor_defaults", lambda recipe: {})
+    monkeypatch.setattr(robotkit.importer, "factor_defaults", lambda recipe: {})  # the name import_file calls
     plain = import_file(spec["entry"], result.recipe_path.parent / "plain.yaml", spec["packages"], spec["args"])
     assert "\ndefaults:" not in plain.recipe_path.read_text(encoding="utf-8")
     (factored,), (unfactored,) = load_recipes(result.recipe_path), load_recipes(plain.recipe_path)
