@@ -1,0 +1,114 @@
+"""The step response in PyBullet (DIRECT mode, the URDF's own inertia, TORQUE_CONTROL).
+
+PyBullet integrates explicitly (semi-implicit Euler): the law's damping term is applied as an
+explicit torque, so a large kd dt / inertia diverges here where MuJoCo's implicitfast and
+Drake's implicit PD stay stable.  The default velocity motors are switched off, link damping
+is set to 0 and the joint speed cap (100 rad/s by default) is lifted so an explosion shows.
+
+PyBullet has no armature.  It is put inside the control loop, exactly (computed torque): with
+M from ``calculateMassMatrix`` and the bias h = ``calculateInverseDynamics(q, qd, 0)``, a robot
+with armature A would accelerate at qdd = (M + A)^-1 (tau - h); PyBullet is given
+tau - A qdd, which makes its (armature-free) robot accelerate the same.  The recorded torque
+is the motor's (tau, after the clip).  Gravity compensation is the same feed-forward:
+``calculateInverseDynamics(q, 0, 0)`` at the current positions, inside the clip."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from robotkit.check.motion.files import quiet, resolved_urdf
+from robotkit.check.motion.law import Drive, Recorder, Step, Trace, check_drives, law, targets
+
+NO_SPEED_CAP = 1e6
+
+
+def simulate_pybullet(urdf: Path, drives: list[Drive], step: Step, package_dirs: dict[str, Path],
+                      hold_base: bool = True, timestep: float = 1 / 240) -> Trace:
+    with quiet():  # heavy, and it prints its build banner
+        import pybullet as p
+
+    check_drives(drives, step)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = resolved_urdf(urdf, package_dirs, Path(tmp))
+        client = p.connect(p.DIRECT)
+        try:
+            with quiet():
+                body = p.loadURDF(str(path), useFixedBase=hold_base, flags=p.URDF_USE_INERTIA_FROM_FILE,
+                                  physicsClientId=client)
+            rec = Recorder("pybullet", timestep, step, drives)
+            run(p, client, body, drives, step, rec, hold_base)
+            return rec.trace()
+        finally:
+            p.disconnect(client)
+
+
+def movable_joints(p, client: int, body: int) -> dict[str, int]:
+    """{name: PyBullet joint index} of the revolute and prismatic joints, in index order."""
+    out = {}
+    for i in range(p.getNumJoints(body, physicsClientId=client)):
+        info = p.getJointInfo(body, i, physicsClientId=client)
+        if info[2] in (p.JOINT_REVOLUTE, p.JOINT_PRISMATIC):
+            out[info[1].decode()] = i
+    return out
+
+
+def prepare(p, client: int, body: int, joints: dict[str, int], step: Step) -> None:
+    """The start pose, no link damping, no speed cap, the default velocity motors off."""
+    for link in range(-1, p.getNumJoints(body, physicsClientId=client)):
+        p.changeDynamics(body, link, linearDamping=0.0, angularDamping=0.0, maxJointVelocity=NO_SPEED_CAP,
+                         physicsClientId=client)
+    for name, i in joints.items():
+        p.resetJointState(body, i, step.start.get(name, 0.0), 0.0, physicsClientId=client)
+    p.setJointMotorControlArray(body, list(joints.values()), p.VELOCITY_CONTROL,
+                                forces=[0.0] * len(joints), physicsClientId=client)
+
+
+def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorder, hold_base: bool) -> None:
+    joints = movable_joints(p, client, body)
+    missing = [d.joint for d in drives if d.joint not in joints]
+    if missing:
+        raise ValueError(f"joints not movable in the URDF: {', '.join(missing)}")
+    p.setGravity(0, 0, -9.81, physicsClientId=client)
+    p.setTimeStep(timestep := rec.timestep, physicsClientId=client)
+    prepare(p, client, body, joints, step)
+    names = list(joints)
+    column = {n: k for k, n in enumerate(names)}
+    armature = np.array([next((d.armature for d in drives if d.joint == n), 0.0) for n in names])
+    wanted = {d.joint: targets(d, step) for d in drives}
+    base = 0 if hold_base else 6  # a free base's six velocities come first in PyBullet's M and h
+    for i in range(rec.steps()):
+        states = p.getJointStates(body, list(joints.values()), physicsClientId=client)
+        q = [s[0] for s in states]
+        qd = [s[1] for s in states]
+        gravity = (p.calculateInverseDynamics(body, q, [0.0] * len(q), [0.0] * len(q), physicsClientId=client)
+                   if any(d.gravcomp for d in drives) else [0.0] * (base + len(q)))
+        tau = np.zeros(len(names))
+        for d in drives:
+            k = column[d.joint]
+            tau[k] = law(d, *wanted[d.joint], q[k], qd[k], gravity[base + k])
+        if not rec.record(i * timestep, dict(zip(names, q)), dict(zip(names, qd)), float(tau[column[step.joint]])):
+            return
+        applied = tau - armature * accelerations(p, client, body, q, qd, tau, armature, base) \
+            if armature.any() else tau
+        p.setJointMotorControlArray(body, list(joints.values()), p.TORQUE_CONTROL, forces=applied.tolist(),
+                                    physicsClientId=client)
+        p.stepSimulation(physicsClientId=client)
+
+
+def accelerations(p, client, body, q, qd, tau, armature, base: int) -> np.ndarray:
+    """The joint accelerations qdd = (M + A)^-1 (tau - h) of the robot with armature A."""
+    n = len(q)
+    M = np.array(p.calculateMassMatrix(body, q, physicsClientId=client))
+    h = np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * n, physicsClientId=client))
+    A = np.zeros(len(M))
+    A[base:] = armature
+    force = np.zeros(len(M))
+    force[base:] = tau
+    if len(h) == len(M):
+        force -= h
+    else:  # only the joints' bias given
+        force[base:] -= h[-n:]
+    return np.linalg.solve(M + np.diag(A), force)[base:]
