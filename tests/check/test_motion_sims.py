@@ -186,3 +186,35 @@ def test_metrics_saturation_and_chatter():
     m = metrics(trace, 0.0, 1.0, "velocity", effort=5.0)
     assert m["saturated"] == pytest.approx(0.25)
     assert m["chatter"] == len(t) // 2 - 2
+
+
+@pytest.mark.consumers
+@pytest.mark.parametrize("simulator", ["pybullet", "drake"])
+def test_urdf_rooted_at_world(tmp_path, simulator):
+    """A root link named ``world`` (Drake welds the robot itself) gives the same response."""
+    urdf, mjcf = fixture(tmp_path, "hinge", i=J, armature=A)
+    text = urdf.read_text().replace('<link name="base_link">', '<link name="world"/>\n  <joint name="fix" type="fixed">'
+                                    '<parent link="world"/><child link="base_link"/></joint>\n  <link name="base_link">')
+    rooted = tmp_path / "rooted.urdf"
+    rooted.write_text(text)
+    step = Step("hinge", {}, 0.5, seconds=0.5)
+    np.testing.assert_allclose(run(simulator, rooted, mjcf, [CRITICAL], step).q,
+                               run(simulator, urdf, mjcf, [CRITICAL], step).q, atol=1e-9)
+
+
+@pytest.mark.consumers
+def test_pybullet_refuses_a_free_base_it_cannot_compensate(tmp_path):
+    urdf, _ = fixture(tmp_path, "hinge", i=J, armature=A)
+    with pytest.raises(ValueError, match="PyBullet cannot give the armature or gravity compensation of a free base"):
+        SIMULATORS["pybullet"](urdf, [CRITICAL], Step("hinge", {}, 0.5, seconds=0.1), {}, hold_base=False)
+
+
+def test_mujoco_holds_a_free_base(tmp_path):
+    _, bare = fixture(tmp_path, "bare", i=J, armature=A)
+    free = tmp_path / "free.xml"
+    free.write_text(bare.read_text().replace('<body name="base_link">', '<body name="base_link">\n      <freejoint/>'))
+    step = Step("hinge", {}, 0.5, seconds=0.5)
+    np.testing.assert_allclose(simulate_mujoco(free, [CRITICAL], step).q, simulate_mujoco(bare, [CRITICAL], step).q,
+                               atol=1e-12)
+    falling = simulate_mujoco(free, [CRITICAL], step, hold_base=False)
+    assert falling.diverged is None  # the whole robot falls: the hinge's response is not the held one

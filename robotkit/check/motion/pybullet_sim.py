@@ -10,7 +10,9 @@ M from ``calculateMassMatrix`` and the bias h = ``calculateInverseDynamics(q, qd
 with armature A would accelerate at qdd = (M + A)^-1 (tau - h); PyBullet is given
 tau - A qdd, which makes its (armature-free) robot accelerate the same.  The recorded torque
 is the motor's (tau, after the clip).  Gravity compensation is the same feed-forward:
-``calculateInverseDynamics(q, 0, 0)`` at the current positions, inside the clip."""
+``calculateInverseDynamics(q, 0, 0)`` at the current positions, inside the clip.  Both need a
+held base: PyBullet's inverse dynamics of a free base raises (or gives zeros with flags=1), so
+a free base with armature or gravity compensation is refused with a ValueError."""
 
 from __future__ import annotations
 
@@ -78,37 +80,30 @@ def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorde
     column = {n: k for k, n in enumerate(names)}
     armature = np.array([next((d.armature for d in drives if d.joint == n), 0.0) for n in names])
     wanted = {d.joint: targets(d, step) for d in drives}
-    base = 0 if hold_base else 6  # a free base's six velocities come first in PyBullet's M and h
+    if not hold_base and (armature.any() or any(d.gravcomp for d in drives)):
+        raise ValueError("PyBullet cannot give the armature or gravity compensation of a free base: its "
+                         "calculateInverseDynamics raises on one (and returns zeros with flags=1); hold the base")
     for i in range(rec.steps()):
         states = p.getJointStates(body, list(joints.values()), physicsClientId=client)
         q = [s[0] for s in states]
         qd = [s[1] for s in states]
         gravity = (p.calculateInverseDynamics(body, q, [0.0] * len(q), [0.0] * len(q), physicsClientId=client)
-                   if any(d.gravcomp for d in drives) else [0.0] * (base + len(q)))
+                   if any(d.gravcomp for d in drives) else [0.0] * len(q))
         tau = np.zeros(len(names))
         for d in drives:
             k = column[d.joint]
-            tau[k] = law(d, *wanted[d.joint], q[k], qd[k], gravity[base + k])
+            tau[k] = law(d, *wanted[d.joint], q[k], qd[k], gravity[k])
         if not rec.record(i * timestep, dict(zip(names, q)), dict(zip(names, qd)), float(tau[column[step.joint]])):
             return
-        applied = tau - armature * accelerations(p, client, body, q, qd, tau, armature, base) \
+        applied = tau - armature * accelerations(p, client, body, q, qd, tau, armature) \
             if armature.any() else tau
         p.setJointMotorControlArray(body, list(joints.values()), p.TORQUE_CONTROL, forces=applied.tolist(),
                                     physicsClientId=client)
         p.stepSimulation(physicsClientId=client)
 
 
-def accelerations(p, client, body, q, qd, tau, armature, base: int) -> np.ndarray:
-    """The joint accelerations qdd = (M + A)^-1 (tau - h) of the robot with armature A."""
-    n = len(q)
+def accelerations(p, client, body, q, qd, tau, armature) -> np.ndarray:
+    """The joint accelerations qdd = (M + A)^-1 (tau - h) of the (fixed-base) robot with armature A."""
     M = np.array(p.calculateMassMatrix(body, q, physicsClientId=client))
-    h = np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * n, physicsClientId=client))
-    A = np.zeros(len(M))
-    A[base:] = armature
-    force = np.zeros(len(M))
-    force[base:] = tau
-    if len(h) == len(M):
-        force -= h
-    else:  # only the joints' bias given
-        force[base:] -= h[-n:]
-    return np.linalg.solve(M + np.diag(A), force)[base:]
+    h = np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * len(q), physicsClientId=client))
+    return np.linalg.solve(M + np.diag(armature), tau - h)
