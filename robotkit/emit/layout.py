@@ -40,7 +40,8 @@ WORLD_FILES = ("model.config", "model.sdf", "meshes/{name}.stl", "{name}.world",
 
 # the build's records, below OUT/.robotkit/<robot>/; {key} is a mesh key, a proxy key or a link's file stem
 RECORDS = {"mesh": "mesh/{key}.json", "collision": "collision/{key}.json", "visual": "visual/{key}.json",
-           "inertial": "inertial/{key}.json", "pictures": "pictures.json"}
+           "inertial": "inertial/{key}.json", "pictures": "pictures.json",
+           "drives": "drives.json"}
 
 
 def output_path(template: str | Mapping[str, str], name: str, ros: str = "ros2") -> str:

@@ -114,10 +114,12 @@ def _plane_axes(normal) -> tuple[tuple, tuple]:
     return tuple(u), tuple(v)
 
 
-def joints_of(j) -> list[dict]:
-    """The MJCF joints of a URDF joint (none for a fixed one; three for a planar one)."""
+def joints_of(j, gravcomp: frozenset = frozenset()) -> list[dict]:
+    """The MJCF joints of a URDF joint (none for a fixed one; three for a planar one);
+    ``gravcomp``: the joints whose actuators carry gravity compensation."""
     if j.type in ("revolute", "continuous", "prismatic"):
-        d = {"name": j.name, "type": "slide" if j.type == "prismatic" else "hinge", "axis": j.axis}
+        d = {"name": j.name, "type": "slide" if j.type == "prismatic" else "hinge", "axis": j.axis,
+             "gravcomp": j.name in gravcomp}
         if j.type != "continuous":
             d["range"] = (j.limit.lower, j.limit.upper)
         if j.limit is not None and j.limit.effort:
@@ -135,9 +137,11 @@ def joints_of(j) -> list[dict]:
     return []
 
 
-def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str]) -> dict:
+def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str],
+         gravcomp: tuple[frozenset, frozenset] = (frozenset(), frozenset())) -> dict:
     """The context of one body: its place, joints, inertial, geoms, cameras and sites, and its
-    ``children`` (link names)."""
+    ``children`` (link names); ``gravcomp``: (bodies whose weight is compensated, joints whose
+    actuators carry it)."""
     name = link.name
     extras = sens["bodies"].get(name, {"cameras": [], "sites": []})
     for site in extras["sites"]:
@@ -149,7 +153,8 @@ def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str
         "name": name,
         "pos": joint.origin.xyz if joint is not None else (0.0, 0.0, 0.0),
         "quat": rpy_quat(joint.origin.rpy) if joint is not None else (1.0, 0.0, 0.0, 0.0),
-        "joints": joints_of(joint) if joint is not None else [],
+        "joints": joints_of(joint, gravcomp[1]) if joint is not None else [],
+        "gravcomp": name in gravcomp[0],
         "inertial": link.inertial,
         "visuals": [_geom(robot, g, f"{name}_visual_{i}", assets) for i, g in enumerate(link.visuals)],
         "collisions": [dict(_geom(robot, g, f"{name}_collision_{i}", assets, "collision"), friction=friction)
@@ -169,8 +174,10 @@ def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list
         children.setdefault(j.parent, []).append(j.child)
     parent_joint = {j.child: j for j in robot.joints}
 
+    comp = gravcomp_sets(robot)
+
     def make(name: str, joint) -> dict:
-        return body(robot, links[name], joint, assets, sens, children.get(name, []))
+        return body(robot, links[name], joint, assets, sens, children.get(name, []), comp)
 
     root = robot.root
     if root == WORLD:
@@ -196,6 +203,50 @@ def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list
     return world_geoms, tree
 
 
+def gravcomp_sets(robot: Robot) -> tuple[frozenset, frozenset]:
+    """(the bodies below an actuated joint, the actuated joints) when the tuner asked for gravity
+    compensation (:mod:`robotkit.model.gains`): each such body's weight is compensated
+    (``gravcomp="1"``) and routed through the joints' actuators (``actuatorgravcomp``), so the
+    compensation counts against their force limits as a feed-forward would."""
+    actuated = {a.joint for a in robot.actuators if a.gravcomp}
+    if not actuated:
+        return frozenset(), frozenset()
+    children: dict[str, list] = {}
+    for j in robot.joints:
+        children.setdefault(j.parent, []).append(j)
+    bodies, stack = set(), [(robot.root, False)]
+    while stack:
+        name, below = stack.pop()
+        if below:
+            bodies.add(name)
+        stack.extend((j.child, below or j.name in actuated) for j in children.get(name, []))
+    return frozenset(bodies), frozenset(actuated)
+
+
+def keyframes(robot: Robot, tree: list[dict], actuators: list[dict], lift_at) -> list[dict]:
+    """One MJCF keyframe per named pose (``home`` first): qpos in the file's joint order (a free
+    joint at the body's place, raised to stand at that pose: ``lift_at(values)``), ctrl at the pose."""
+    poses = sorted(robot.poses, key=lambda p: p.name != "home") if robot.home() is not None else []
+    mimics = {j.name: j.mimic for j in robot.joints if j.mimic is not None}
+    out = []
+    for pose in poses:
+        values = dict(pose.values)
+        for name, m in mimics.items():
+            values[name] = m.multiplier * values.get(m.joint, 0.0) + m.offset
+        qpos = []
+        for step in tree:
+            b = step["body"]
+            for j in (b["joints"] if b else []):
+                if j["type"] == "free":
+                    pos = b["pos"][:2] + (lift_at(values),)
+                    qpos.extend(pos + tuple(b["quat"]))
+                else:
+                    qpos.append(values.get(j["name"], 0.0))
+        ctrl = [values.get(a["joint"], 0.0) if a["kind"] == "position" else 0.0 for a in actuators]
+        out.append({"name": pose.name, "qpos": tuple(qpos), "ctrl": tuple(ctrl)})
+    return out
+
+
 def actuator_contexts(robot: Robot) -> list[dict]:
     """One MJCF actuator per recipe actuator: position and velocity servos, motors."""
     joint_by_name = {j.name: j for j in robot.joints}
@@ -216,16 +267,19 @@ def actuator_contexts(robot: Robot) -> list[dict]:
     return actuators
 
 
-def context(robot: Robot, lift: float = 0.0) -> dict:
-    """``lift``: height of the root body (a robot not rooted in ``world`` stands on the floor)."""
+def context(robot: Robot, lift: float = 0.0, lift_at=None) -> dict:
+    """``lift``: height of the root body (a robot not rooted in ``world`` stands on the floor);
+    ``lift_at(joint values)``: its height at a named pose (keyframes)."""
     assets = _assets(robot)
     sens = mjcf_context(robot)
     world_geoms, tree = body_tree(robot, lift, assets, sens)
+    actuators = actuator_contexts(robot)
     equalities = [{"name": f"{j.name}_mimic", "joint1": j.name, "joint2": j.mimic.joint,
                    "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
                   for j in robot.joints if j.mimic is not None]
     excludes = [(j.parent, j.child) for j in robot.joints if j.parent != WORLD]
-    return {"robot": robot, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuator_contexts(robot),
+    keys = keyframes(robot, tree, actuators, lift_at or (lambda values: lift))
+    return {"robot": robot, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "keys": keys,
             "assets": sorted(assets.values(), key=lambda a: a["name"]),
             "materials": robot.materials, "world_geoms": world_geoms, "tree": tree,
             "equalities": equalities}
@@ -252,15 +306,30 @@ def _touch_volume(link) -> tuple[tuple[float, ...], tuple[float, float, float]]:
     return tuple(float(v) for v in (hi - lo) / 2 * 1.05 + 0.002), tuple(float(v) for v in (hi + lo) / 2)
 
 
-def zero_pose_frames(robot: Robot) -> dict[str, np.ndarray]:
-    """Every link frame in the root frame with all joints at zero (no recursion)."""
+def joint_motion(j, value: float) -> np.ndarray:
+    """The child frame's motion in the joint frame at joint value ``value``."""
+    T = np.eye(4)
+    if not value or j.type not in ("revolute", "continuous", "prismatic"):
+        return T
+    axis = np.asarray(j.axis, dtype=float)
+    if j.type == "prismatic":
+        T[:3, 3] = axis * value
+        return T
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    T[:3, :3] = np.eye(3) + math.sin(value) * K + (1 - math.cos(value)) * K @ K  # Rodrigues
+    return T
+
+
+def zero_pose_frames(robot: Robot, values: dict[str, float] | None = None) -> dict[str, np.ndarray]:
+    """Every link frame in the root frame with the joints at ``values`` (default all zero; no recursion)."""
+    values = values or {}
     frames = {robot.root: np.eye(4)}
     pending = list(robot.joints)
     while pending:
         rest = [j for j in pending if j.parent not in frames]
         for j in pending:
             if j.parent in frames:
-                frames[j.child] = frames[j.parent] @ j.origin.matrix()
+                frames[j.child] = frames[j.parent] @ j.origin.matrix() @ joint_motion(j, values.get(j.name, 0.0))
         if len(rest) == len(pending):
             break
         pending = rest
@@ -274,11 +343,12 @@ def collision_meshes(robot: Robot) -> list[str]:
                    for g in link.collisions_for("mjcf") if g.shape.kind == "mesh"})
 
 
-def lowest_point(robot: Robot, points: dict[str, np.ndarray] | None) -> float | None:
-    """Lowest z of the robot's MJCF collision geometry at its zero pose, in the root frame
-    (mesh geoms: the vertices of their files in ``points``, as MuJoCo collides with their convex
-    hulls; none without ``points``); None without any."""
-    frames = zero_pose_frames(robot)
+def lowest_point(robot: Robot, points: dict[str, np.ndarray] | None,
+                 values: dict[str, float] | None = None) -> float | None:
+    """Lowest z of the robot's MJCF collision geometry at its zero pose (or with the joints at
+    ``values``), in the root frame (mesh geoms: the vertices of their files in ``points``, as
+    MuJoCo collides with their convex hulls; none without ``points``); None without any."""
+    frames = zero_pose_frames(robot, values)
     lows = []
     for link in robot.links:
         for g in link.collisions_for("mjcf"):
@@ -305,12 +375,14 @@ def render_mjcf(robot: Robot, points: dict[str, np.ndarray] | None = None) -> st
     """The robot's MJCF.  A robot not rooted in ``world`` stands on the floor at its zero pose:
     its root body is raised (or lowered) so that its lowest collision point is at z = 0
     (``points``: the vertices of :func:`collision_meshes`; without them, mesh geoms are left out)."""
-    lift = 0.0
-    if robot.root != WORLD:
-        low = lowest_point(robot, points)
+    def lift_at(values: dict[str, float] | None = None) -> float:
+        if robot.root == WORLD:
+            return 0.0
+        low = lowest_point(robot, points, values)
         # up to the next micrometre: never inside the floor, and no float32 noise in the file
-        lift = math.ceil(-low * 1e6) / 1e6 if low is not None else 0.0
-    return render("mjcf/robot.xml.j2", **context(robot, lift=lift))
+        return math.ceil(-low * 1e6) / 1e6 if low is not None else 0.0
+
+    return render("mjcf/robot.xml.j2", **context(robot, lift=lift_at(), lift_at=lift_at))
 
 
 def render_scene(robot: Robot) -> str:

@@ -11,7 +11,6 @@ Two steps:
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import math
 import os
@@ -24,10 +23,11 @@ from robotkit import presets
 from robotkit.errors import Problem, RecipeError, display_path
 from robotkit.geometry import matrix_rpy
 from robotkit.model import inertia_policy, massprops
+from robotkit.model.drives import resolve_actuators, resolve_poses, unknown_name
 from robotkit.model.massprops import Bounding, bounding_primitive, combine
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
-    Actuator, Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World,
+    Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World,
 )
 from robotkit.paths import ReadPolicy, file_stem, recipe_policy
 from robotkit.recipe import schema
@@ -85,7 +85,7 @@ class _Context:
         """A recipe geometry as a model Geom; None (reported) when its mesh cannot be used."""
         r = self.r
         if g.material is not None and g.material not in self.material_names:
-            self.report(path + ("material",), _unknown("material", g.material, self.material_names))
+            self.report(path + ("material",), unknown_name("material", g.material, self.material_names))
         origin = Pose(_t(g.origin.xyz), _t(g.origin.rpy))
         if g.box is not None:
             shape = Shape("box", size=_t(g.box.size))
@@ -151,7 +151,8 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
         known_links.add(link.name)
     links += extra_links
     joints += extra_joints
-    actuators = _actuators(cx, joints)
+    actuators, joints = resolve_actuators(cx.report, cx.r.actuators, joints)
+    poses = resolve_poses(cx.report, cx.r.poses, joints)
     worlds = _worlds(cx)
     ros, gazebo = _ros_and_gazebo(cx, ros)
     link_names = [link.name for link in links]
@@ -161,7 +162,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
     if cx.problems:
         raise RecipeError(cx.problems)
     return Robot(r.robot, tuple(links), tuple(joints), materials, _metadata(r.metadata), r.self_collide,
-                 tuple(r.urdf_extras), tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base)
+                 tuple(r.urdf_extras), tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base, tuple(poses))
 
 
 def _safe_name(src: str) -> str:
@@ -318,7 +319,7 @@ def _joint(cx: _Context, name: str, j, link_names: list[str]) -> Joint:
     for end in ("parent", "child"):
         value = getattr(j, end)
         if value not in cx.r.links:
-            cx.report(jp + (end,), _unknown("link", value, link_names))
+            cx.report(jp + (end,), unknown_name("link", value, link_names))
     if j.parent == j.child:
         cx.report(jp + ("child",), f"a joint cannot connect link '{j.child}' to itself")
     axis = np.asarray(j.axis, dtype=float)
@@ -341,7 +342,7 @@ def _joint(cx: _Context, name: str, j, link_names: list[str]) -> Joint:
 def _mimic(cx: _Context, jp: tuple, name: str, j) -> Mimic:
     joints = cx.r.joints
     if j.mimic.joint not in joints:
-        cx.report(jp + ("mimic", "joint"), _unknown("joint", j.mimic.joint, list(joints)))
+        cx.report(jp + ("mimic", "joint"), unknown_name("joint", j.mimic.joint, list(joints)))
     elif j.mimic.joint == name:
         cx.report(jp + ("mimic", "joint"), "a joint cannot mimic itself")
     elif joints[j.mimic.joint].type in ("fixed", "floating", "planar"):
@@ -350,28 +351,6 @@ def _mimic(cx: _Context, jp: tuple, name: str, j) -> Mimic:
     if j.type not in ("revolute", "continuous", "prismatic"):
         cx.report(jp + ("mimic",), f"a {j.type} joint cannot mimic another joint")
     return Mimic(j.mimic.joint, j.mimic.multiplier, j.mimic.offset)
-
-
-def _actuators(cx: _Context, joints: list[Joint]) -> list[Actuator]:
-    """The recipe's actuators, each on a revolute, continuous or prismatic joint that mimics none."""
-    actuators = []
-    joint_types = {j.name: j for j in joints}
-    for name, a in cx.r.actuators.items():
-        j = joint_types.get(name)
-        if j is None:
-            cx.report(("actuators", name), _unknown("joint", name, list(cx.r.joints)))
-        elif j.type not in ("revolute", "continuous", "prismatic"):
-            cx.report(("actuators", name), f"joint '{name}' is {j.type}: only revolute, "
-                                           "continuous and prismatic joints can be actuated")
-        elif j.mimic is not None:
-            cx.report(("actuators", name), f"joint '{name}' mimics '{j.mimic.joint}'; "
-                                           "actuate the joint it follows")
-        elif a.interface == "effort" and (j.limit is None or not j.limit.effort):
-            cx.report(("actuators", name), f"an effort actuator needs joint '{name}' "
-                                           "to have an effort limit")
-        else:
-            actuators.append(Actuator(name, a.interface, float(a.p), float(a.i), float(a.d)))
-    return actuators
 
 
 def _worlds(cx: _Context) -> list[World]:
@@ -415,7 +394,7 @@ def _sensors(cx: _Context):
     for name, s in r.sensors.items():
         sp = ("sensors", name)
         if s.parent not in r.links:
-            cx.report(sp + ("parent",), _unknown("link", s.parent, list(r.links)))
+            cx.report(sp + ("parent",), unknown_name("link", s.parent, list(r.links)))
             continue
         origin = Pose(_t(s.origin.xyz), _t(s.origin.rpy))
         topic = s.topic or name
@@ -549,12 +528,6 @@ def _show(path: str) -> str:
     if "\0" in path:  # display_path cannot resolve it; show the escape, not the byte
         return repr(path)[1:-1]
     return display_path(path)
-
-
-def _unknown(kind: str, value: str, known) -> str:
-    msg = f"no {kind} named '{value}'"
-    close = difflib.get_close_matches(value, list(known), n=1)
-    return msg + (f" (did you mean '{close[0]}'?)" if close else "")
 
 
 def _inertial_spec(spec, default_density: float) -> InertialSpec:

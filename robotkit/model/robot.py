@@ -253,6 +253,19 @@ class Actuator:
     p: float = 0.0
     i: float = 0.0
     d: float = 0.0
+    auto: bool = False  # gains derived from the robot's inertia (robotkit.model.gains), p and d filled then
+    bandwidth: float | None = None  # Hz, with auto: None = chosen by the tuner
+    damping_ratio: float = 1.0
+    armature: float = 0.0  # the motor's reflected inertia (already inside the joint's dynamics.armature)
+    gravcomp: bool = False  # the drive compensates gravity (MJCF actuatorgravcomp), set by the tuner
+
+
+@dataclass(frozen=True)
+class NamedPose:
+    """A named joint configuration: (joint, value) for the joints it names (the others at zero)."""
+
+    name: str
+    values: tuple[tuple[str, float], ...]
 
 
 @dataclass(frozen=True)
@@ -279,6 +292,13 @@ class Robot:
     gazebo: str = "sim"  # sim | classic
     ros: str = "ros2"  # ros2 | ros1: the package type, ros_control flavour, launch files
     base: str = "fixed"
+    poses: tuple[NamedPose, ...] = ()
+    drive_report: str = ""  # JSON: robotkit.model.gains.tune's report, once the build has tuned the drives
+
+    def home(self) -> NamedPose | None:
+        """The pose the robot starts in: ``home``, else the first pose, else None (all zero)."""
+        by_name = {p.name: p for p in self.poses}
+        return by_name.get("home") or (self.poses[0] if self.poses else None)
 
     def frame_links(self) -> set[str]:
         """Massless links fixed to another link: SDF writes them as ``<frame>`` (an SDF link

@@ -13,6 +13,7 @@ import functools
 import json
 import os
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -26,13 +27,16 @@ from robotkit.mesh.cache import Cache, plain
 from robotkit.mesh.export import obj_bytes, stl_bytes
 from robotkit.mesh.inertia import hull_points, mesh_mass_properties
 from robotkit.mesh.io import load_mesh, read_vertices, volume_mesh
-from robotkit.model.resolve import finalize, finalize_link_inertial, inertial_from_json, inertial_to_json
+from robotkit.model import gains
+from robotkit.model.resolve import (compute_inertial, finalize, finalize_link_inertial, inertial_from_json,
+                                    inertial_to_json)
 from robotkit.picture import report_build_dir
 from robotkit.pipeline.distributed import run as run_distributed  # on a Dask cluster when one is configured
 from robotkit.pipeline.publish import publish, staged_files
 from robotkit.world import build_world
 
 FACTS_VERSION = 4  # 3: sources relative to the recipe (no absolute or working-folder paths); 4: hull points
+DRIVES_VERSION = 1
 
 
 def _user_errors_fail(fn):
@@ -113,11 +117,32 @@ def link_inertial(link, fact_paths: dict[str, str], target: str):
 
 
 def _finalized(robot, fact_paths: dict[str, str], inertial_paths: dict[str, str]):
-    inertials = {}
+    return finalize(robot, read_facts(fact_paths), _read_inertials(inertial_paths))
+
+
+def _read_inertials(inertial_paths: dict[str, str]) -> dict:
+    out = {}
     for link, path in inertial_paths.items():
         with open(path, encoding="utf-8") as f:
-            inertials[link] = inertial_from_json(json.load(f))
-    return finalize(robot, read_facts(fact_paths), inertials)
+            out[link] = inertial_from_json(json.load(f))
+    return out
+
+
+@_user_errors_fail
+def tune_drives(robot, inertial_paths: dict[str, str], target: str):
+    """The actuators' gains and checks (robotkit.model.gains) from the links' inertials."""
+    inertials = _read_inertials(inertial_paths)
+    links = tuple(replace(link, inertial=inertials[link.name] if link.name in inertials
+                          else compute_inertial(link, {})) for link in robot.links)
+    write_if_changed(target, dump_json(gains.tune(replace(robot, links=links))))
+
+
+def with_drives(robot, path: str | None):
+    """``robot`` with the tuner's gains of the record at ``path`` (None: as it is)."""
+    if not path:
+        return robot
+    with open(path, encoding="utf-8") as f:
+        return gains.apply(robot, json.load(f))
 
 
 @_user_errors_fail
@@ -131,7 +156,7 @@ def emit(name: str, robot, fact_paths: dict[str, str], inertial_paths: dict[str,
     robot that their consumers would refuse (a moving link without mass...): ConsumerError, naming the
     link (``where``: link -> recipe location)."""
     fmt = FORMATS[name]
-    full = robot if how.get("raw") else _finalized(robot, fact_paths, inertial_paths)
+    full = with_drives(robot if how.get("raw") else _finalized(robot, fact_paths, inertial_paths), how.get("drives"))
     if fmt.consumed:
         problems = [Problem(msg, **(where or {}).get(link, {}))
                     for link, msg, formats in full.consumer_problems() if name in formats]

@@ -82,6 +82,11 @@ class Place:
         return {key: self.record("collision", key) for key in self.robot.proxies()}
 
     @property
+    def drives(self) -> str | None:
+        """The tuner's record (gains, checks) of a robot with actuators."""
+        return self.record("drives", "") if self.robot.actuators else None
+
+    @property
     def inertials(self) -> dict[str, str]:
         """Link -> its inertial, for the links whose inertial a task computes."""
         return {link.name: self.record("inertial", file_stem(link.name)) for link in self.robot.links
@@ -103,7 +108,7 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     files = visual_tasks(place) + copy_tasks(place) + convert_tasks(place)  # the mesh files below meshes/
     textures = texture_tasks(place)
     outputs = output_tasks(place, [t["targets"][0] for t in files])
-    tasks = meshes + collisions + files + textures + inertial_tasks(place) + outputs
+    tasks = meshes + collisions + files + textures + inertial_tasks(place) + drive_tasks(place) + outputs
     if report:
         tasks.append(report_task(place, collisions + files + textures, meshes))
     return tasks + world_tasks(robot, out_dir)
@@ -266,6 +271,24 @@ def inertial_tasks(place: Place) -> list[dict]:
     return tasks
 
 
+def drive_tasks(place: Place) -> list[dict]:
+    """``<robot>:drives``: the actuators' gains from the robot's inertia and their checks
+    (:mod:`robotkit.model.gains`), for the outputs that write gains."""
+    robot = place.robot
+    if place.drives is None:
+        return []
+    structure = {k: v for k, v in robot.to_dict().items() if k not in ("worlds", "sensors", "metadata")}
+    return [{
+        "name": f"{robot.name}:drives",
+        "doc": "actuator gains and checks",
+        "actions": [(actions.tune_drives, [robot, place.inertials, place.drives])],
+        "file_dep": list(place.inertials.values()),
+        "targets": [place.drives],
+        "uptodate": [config_changed({"robot": structure, "version": actions.DRIVES_VERSION})],
+        "clean": True,
+    }]
+
+
 class Reading(NamedTuple):
     """What an output's task gives its action and hashes, for one kind of ``reads``
     (:data:`robotkit.emit.formats.READS`)."""
@@ -276,6 +299,7 @@ class Reading(NamedTuple):
     inertials: dict[str, str]  # the inertials it reads
     raw: bool = False  # rendered from the resolved robot, not the finalized one
     with_facts: bool = False  # the render gets the mesh facts (keyword facts)
+    drives: str | None = None  # the tuner's record: gains applied before rendering
 
 
 def readings(place: Place) -> dict[str, Reading]:
@@ -289,15 +313,19 @@ def readings(place: Place) -> dict[str, Reading]:
     package.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds], meshes=bool(robot.meshes()))
     no_inertials = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
                                            for link in structure["links"]]}
+    drives = place.drives
     return {
-        "robot": Reading(robot, structure, {**{k: facts[k] for k in recentered}, **proxies}, inertials),
-        "summary": Reading(robot, structure, {**facts, **proxies}, inertials, with_facts=True),
+        "robot": Reading(robot, structure, {**{k: facts[k] for k in recentered}, **proxies}, inertials,
+                         drives=drives),
+        "summary": Reading(robot, structure, {**facts, **proxies}, inertials, with_facts=True, drives=drives),
         # the visual geometry's extent, the sensors' topics: no inertial
         "rviz": Reading(robot, no_inertials, {k: facts[k] for k in shown_meshes(robot) if k in facts}, {},
                         raw=True, with_facts=True),
         "ros-package": Reading(robot, package, {}, {}, raw=True),
         "structure": Reading(robot, {"name": robot.name, "ros": robot.ros, "gazebo": robot.gazebo,
-                                     "actuators": [asdict(a) for a in robot.actuators]}, {}, {}, raw=True),
+                                     "actuators": [asdict(a) for a in robot.actuators],
+                                     "poses": [asdict(p) for p in robot.poses]}, {}, {}, raw=True,
+                             drives=drives if any(a.auto for a in robot.actuators) else None),
         "metadata": Reading(replace(robot, links=(), joints=(), materials=()),
                             {"name": robot.name, "metadata": asdict(robot.metadata)}, {}, {}),
     }
@@ -313,7 +341,7 @@ def output_tasks(place: Place, written: list[str]) -> list[dict]:
 def output_task(place: Place, fmt: Format, reading: Reading, written: list[str]) -> dict:
     robot = place.robot
     target = place.out(fmt.path)
-    how = {"raw": reading.raw, "facts": reading.with_facts,
+    how = {"raw": reading.raw, "facts": reading.with_facts, "drives": reading.drives,
            "meshes": place.out(layout.MESHES) if fmt.points is not None else None}
     options = {**fmt.options, **{k: True for k, v in how.items() if v}}  # hashed with the robot's values
     return {
@@ -322,7 +350,7 @@ def output_task(place: Place, fmt: Format, reading: Reading, written: list[str])
         "actions": [(actions.emit, [fmt.name, reading.robot, reading.facts, reading.inertials, target, how,
                                     {k[5:]: v for k, v in place.where.items() if k.startswith("link:")}])],
         "file_dep": list(reading.facts.values()) + list(reading.inertials.values()) + template_files(fmt.templates)
-        + (written if fmt.points is not None else []),
+        + (written if fmt.points is not None else []) + ([reading.drives] if reading.drives else []),
         "targets": [target],
         "uptodate": [config_changed({"robot": reading.config, "options": options})],
         # no output is written while any mesh of the robot fails

@@ -658,19 +658,52 @@ class Sensor(Strict):
         return self
 
 
+class Motor(Strict):
+    """A geared motor: its rotor's inertia seen at the joint is ``rotor_inertia * gear**2`` (the joint's armature)."""
+
+    rotor_inertia: NonNegative
+    """Inertia of the rotor about its own axis (kg m^2), from the motor's datasheet."""
+    gear: Annotated[float, Field(gt=0, le=1e6)]
+    """Gear ratio (motor turns per joint turn)."""
+
+
 class Actuator(Strict):
-    """A joint drive: ros_control interface, PID gains, and the matching MJCF actuator."""
+    """A joint drive: ros_control interface, PID gains (given, or ``gains: auto`` from the robot's own inertia), the motor's reflected inertia, and the matching MJCF actuator."""
 
     interface: Literal["position", "velocity", "effort"] = "position"
     """Command interface (MJCF: position servo, velocity servo, or motor)."""
+    gains: Literal["auto"] | None = None
+    """``auto``: derive ``p`` and ``d`` from the joint's largest effective inertia (joint-space mass matrix over the joint's range, the named poses and sampled configurations, plus the armature): ``p = J w^2``, ``d = 2 zeta J w`` for a position drive, ``p = 2 zeta J w`` for a velocity drive. Every number and its reason is in report.json under ``actuators``."""
+    bandwidth: Positive | None = None
+    """With ``gains: auto``: the closed-loop natural frequency in Hz. Default: the highest that keeps a reference step (a tenth of the range, at most 0.2 rad or 2 cm) within the effort limit against gravity, at most 5 Hz, and stable at every simulator's time step."""
+    damping_ratio: Annotated[float, Field(gt=0, le=100)] = 1.0
+    """With ``gains: auto``: the damping ratio zeta (1: critically damped)."""
     p: NonNegative = 0.0
     """Proportional gain (MJCF position: kp; velocity: kv)."""
     i: NonNegative = 0.0
     """Integral gain (ros_control only; MJCF actuators have none)."""
     d: NonNegative = 0.0
     """Derivative gain (MJCF position: kv)."""
+    armature: NonNegative | None = None
+    """Reflected rotor inertia at the joint (kg m^2, or kg for a prismatic joint), added to the joint's ``dynamics.armature``; MJCF joint ``armature``, Drake's rotor inertia; listed as a loss for URDF and SDF."""
+    motor: Motor | None = None
+    """The motor instead of ``armature``: armature = rotor_inertia x gear^2 (as mjlab and MuJoCo Menagerie model geared motors)."""
     if_: bool | None = Field(None, alias="if")
     """Keep this entry only when true (usually an expression of arguments: ``${with_camera}``)."""
+
+    @model_validator(mode="after")
+    def _gains(self):
+        given = [k for k in ("p", "d") if k in self.model_fields_set]
+        if self.gains == "auto" and given:
+            raise ValueError(f"gains: auto derives p and d; remove {' and '.join(given)} or gains: auto")
+        if self.gains == "auto" and self.interface == "effort":
+            raise ValueError("an effort actuator takes no gains (gains: auto is for position and velocity)")
+        tuning = [k for k in ("bandwidth", "damping_ratio") if k in self.model_fields_set]
+        if tuning and self.gains != "auto":
+            raise ValueError(f"{' and '.join(tuning)} only apply with gains: auto")
+        if self.armature is not None and self.motor is not None:
+            raise ValueError("give armature or motor, not both (motor gives armature = rotor_inertia x gear^2)")
+        return self
 
 
 class World(Strict):
@@ -773,6 +806,8 @@ class Recipe(Strict):
     """Sensors by name; each adds its frame link(s) and appears in every format."""
     actuators: dict[str, Actuator] = {}
     """Actuators by joint name: transmissions / ros2_control in the URDF, actuators in the MJCF, controllers YAML."""
+    poses: dict[Name, dict[str, Position]] = {}
+    """Named joint configurations: ``home: {elbow_joint: 90 deg}`` (joints not named are at zero; units as the joint's limits). ``home`` (else the first pose) is the MJCF keyframe 0 and the actuators' initial targets; every pose is an MJCF keyframe, the ros2_control initial values come from ``home``, and ``robotkit check`` steps every actuated joint from every pose."""
     base: Literal["fixed", "free"] = "fixed"
     """How the root link sits in MuJoCo: ``fixed`` (welded to the world, as MuJoCo imports a URDF) or ``free`` (a free joint: a mobile robot). In Gazebo a model without a ``world`` link is always free."""
     ros: Literal["ros2", "ros1"] = "ros2"

@@ -142,7 +142,7 @@ def test_first_build_runs_every_task_once_then_nothing(project):
         # collision geometry as OBJ (Drake's convex meshes), in every format
         "turret_bot:convert:collision/base.obj", "turret_bot:convert:collision/slider.obj",
         "turret_bot:convert:collision/rotor.obj",
-        "turret_bot:inertial:base", "turret_bot:inertial:slider", "turret_bot:inertial:rotor",
+        "turret_bot:inertial:base", "turret_bot:inertial:slider", "turret_bot:inertial:rotor", "turret_bot:drives",
         "turret_bot:urdf", "turret_bot:sdf", "turret_bot:mjcf", "turret_bot:mjcf-scene", "turret_bot:report",
         "turret_bot:model.config", "turret_bot:package.xml", "turret_bot:CMakeLists.txt",
         "turret_bot:controllers", "turret_bot:xacro", "turret_bot:env-hook", "turret_bot:display-launch",
@@ -166,8 +166,9 @@ def test_editing_one_links_density_reruns_that_inertial_and_the_urdf(project):
                                    "    inertial: {density: 2700}"))
     again = build([recipe], out)
     # the outputs that contain inertials rerun; model.config, package.xml, the scene and the meshes do not
-    assert sorted(again.ran) == ["turret_bot:inertial:rotor", "turret_bot:mjcf", "turret_bot:report",
-                                 "turret_bot:sdf", "turret_bot:urdf", "turret_bot:xacro"]
+    # and the drives' checks (turret_bot's gains are given: controllers.yaml does not rerun)
+    assert sorted(again.ran) == ["turret_bot:drives", "turret_bot:inertial:rotor", "turret_bot:mjcf",
+                                 "turret_bot:report", "turret_bot:sdf", "turret_bot:urdf", "turret_bot:xacro"]
     mass = urdf_inertials(out / "turret_bot" / "urdf" / "turret_bot.urdf")["rotor"][0]
     assert mass == pytest.approx(2.1141772435614743 / 1250 * 2700, rel=1e-12)
 
@@ -183,7 +184,7 @@ def test_changing_one_mesh_file_reruns_only_what_depends_on_it(project):
     assert sorted(again.ran) == sorted([
         next(n for n in again.uptodate + again.ran if n.startswith("turret_bot:mesh:slider")),
         "turret_bot:copy:slider.stl", "turret_bot:convert:collision/slider.obj", "turret_bot:inertial:slider",
-        "turret_bot:urdf", "turret_bot:sdf",
+        "turret_bot:drives", "turret_bot:urdf", "turret_bot:sdf",
         "turret_bot:mjcf", "turret_bot:report", "turret_bot:xacro", "turret_bot:rviz"])  # rviz: the robot's extent
 
 

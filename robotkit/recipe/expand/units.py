@@ -15,7 +15,7 @@ import typing
 
 from pydantic import BaseModel
 
-from robotkit.recipe.schema import Dim, Recipe
+from robotkit.recipe.schema import Dim, Position, Recipe
 
 # unit -> (dimension, convert to SI); division by powers of ten keeps 5 cm == 0.05 exactly
 UNITS = {
@@ -50,8 +50,35 @@ def convert(data: dict, problem) -> dict:
     """Replace every quantity in the flat recipe ``data`` by its SI number (in place).
 
     ``problem(path, message)`` records a problem at a key path."""
+    convert_poses(data, problem)
     convert_tree(data, Recipe, (), None, problem)
     return data
+
+
+def convert_poses(data: dict, problem) -> None:
+    """The quantities of ``poses`` (in place), each in the unit of its joint's type (a joint
+    the recipe lacks takes either: resolution names it)."""
+    poses, joints = data.get("poses"), data.get("joints")
+    if not isinstance(poses, dict):
+        return
+    types_ = {k: j.get("type") for k, j in joints.items() if isinstance(j, dict)} if isinstance(joints, dict) else {}
+    for name, pose in poses.items():
+        if not isinstance(pose, dict):
+            continue
+        for joint, value in pose.items():
+            if not isinstance(value, str):
+                continue
+            path = ("poses", name, joint)
+            if joint in types_:
+                pose[joint] = convert_tree(value, Position, path, types_[joint], problem)
+                continue
+            try:
+                q = parse(value)
+            except ValueError as exc:
+                problem(path, str(exc))
+                continue
+            if q is not None:
+                pose[joint] = q[0]
 
 
 def _dims_and_kinds(tp, dims: list, kinds: list):
