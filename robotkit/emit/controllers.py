@@ -58,6 +58,16 @@ def render_controllers(robot: Robot) -> str:
     return header + yaml.safe_dump(controllers(robot), sort_keys=False, default_flow_style=False)
 
 
+def gravcomp_losses(robot: Robot, where: str) -> list[str]:
+    """The drives the MJCF compensates for gravity, which ``where`` cannot."""
+    joints = [a.joint for a in robot.actuators if a.gravcomp and a.interface == "position"]
+    if not joints:
+        return []
+    return [f"joints {', '.join(repr(j) for j in joints)}: the MJCF compensates gravity (gravcomp); {where} "
+            "cannot, so they sag under gravity with p alone: give them an integral gain (i) or a gravity "
+            "feed-forward (report.json: actuators, sag)"]
+
+
 def has_actuators(robot: Robot) -> bool:
     return bool(robot.actuators)
 

@@ -129,7 +129,9 @@ def render_env_hook(robot: Robot) -> str:
 
 
 def render_display_launch(robot: Robot) -> str:
-    return render(DISPLAY_LAUNCH[flavour(robot)], robot=robot)
+    """RViz with the joint state publisher starting at the ``home`` pose (its ``zeros``)."""
+    home = robot.home()
+    return render(DISPLAY_LAUNCH[flavour(robot)], robot=robot, zeros=dict(home.values) if home else {})
 
 
 def spawn_pose(robot: Robot) -> dict:

@@ -20,6 +20,7 @@ from robotkit.emit.formats import Format
 from robotkit.emit.meshfiles import collision_file
 from robotkit.emit.urdf import MASSLESS, geom_context
 from robotkit.emit.sensors import contexts, host_of
+from robotkit.emit.controllers import gravcomp_losses
 from robotkit.emit.sensors import losses as sensor_losses
 from robotkit.geometry import matrix_rpy
 from robotkit.model.robot import Inertial, Pose, Robot
@@ -51,6 +52,7 @@ def losses(robot: Robot) -> list[str]:
         if j.dynamics is not None and j.dynamics.armature:
             out.append(f"joint '{j.name}': armature is not written (SDF has no such joint property)")
     out += extras_losses(robot, "model.sdf")
+    out += gravcomp_losses(robot, "model.sdf's joint controllers (Gazebo Sim)")
     return out + sensor_losses(robot)["sdf"]
 
 
@@ -143,7 +145,32 @@ def context(robot: Robot) -> dict:
     if anchor is not None:
         frame_list.insert(0, {"name": robot.root, "attached_to": anchor, "origin": None})
     return {"robot": robot, "version": SDF_VERSION, "links": links, "joints": joints, "frames": frame_list,
-            "specular": SPECULAR}
+            "specular": SPECULAR, "controllers": controller_contexts(robot, names)}
+
+
+CONTROLLER_SYSTEMS = {
+    "position": ("gz-sim-joint-position-controller-system", "gz::sim::systems::JointPositionController"),
+    "velocity": ("gz-sim-joint-controller-system", "gz::sim::systems::JointController"),
+    "effort": ("gz-sim-apply-joint-force-system", "gz::sim::systems::ApplyJointForce"),
+}
+
+
+def controller_contexts(robot: Robot, names: dict[str, str]) -> list[dict]:
+    """Gazebo Sim's joint controller systems for the actuators, with the same gains as the MJCF
+    and controllers.yaml (Gazebo Sim only: Gazebo classic knows none of them)."""
+    if robot.gazebo != "sim":
+        return []
+    joints = {j.name: j for j in robot.joints}
+    home = dict(robot.home().values) if robot.home() is not None else {}
+    out = []
+    for a in robot.actuators:
+        lim = joints[a.joint].limit
+        effort = lim.effort if lim is not None and lim.effort else None
+        filename, name = CONTROLLER_SYSTEMS[a.interface]
+        out.append({"filename": filename, "name": name, "joint": names.get(a.joint, a.joint),
+                    "interface": a.interface, "p": a.p, "i": a.i, "d": a.d, "effort": effort,
+                    "initial": home.get(a.joint, 0.0)})
+    return out
 
 
 def _uri(robot: Robot, geom, role: str = "visual") -> str | None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 
 from robotkit.emit import layout, mjcf, ros, sdf
+from robotkit.emit.controllers import gravcomp_losses
 from robotkit.emit.formats import Format
 from robotkit.emit.sensors import host_of
 from robotkit.emit.urdf import massless_mass, typed_transmissions
@@ -30,7 +31,7 @@ def urdf_losses(robot: Robot) -> list[str]:
 
 def losses(robot: Robot, facts: dict) -> dict[str, list[str]]:
     return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts),
-            "package": ros.losses(robot)}
+            "package": ros.losses(robot) + gravcomp_losses(robot, "the ros_control controllers (controllers.yaml)")}
 
 
 def consumers(robot: Robot) -> dict:
@@ -75,8 +76,13 @@ def summary(robot: Robot, facts: dict) -> dict:
             collision[key] = {"source": f["source"], "strategy": f["strategy"]["kind"], "pieces": f["pieces"],
                               "fidelity": f["fidelity"], "repair": f.get("repair")}
     meshes = {k: v for k, v in meshes.items() if k not in collision}
-    return {"robot": robot.name, "losses": losses(robot, facts), "consumers": consumers(robot), "meshes": meshes,
-            "inertials": links, "collision": collision}
+    out = {"robot": robot.name, "losses": losses(robot, facts), "consumers": consumers(robot), "meshes": meshes,
+           "inertials": links, "collision": collision}
+    if robot.drive_report:  # the tuner's gains, their reasons and checks (robotkit.model.gains)
+        out["actuators"] = json.loads(robot.drive_report)
+    if robot.poses:
+        out["poses"] = {p.name: dict(p.values) for p in robot.poses}
+    return out
 
 
 def render_summary(robot: Robot, facts: dict | None = None) -> str:

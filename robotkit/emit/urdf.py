@@ -115,7 +115,10 @@ def context(robot: Robot) -> dict:
 
 
 def actuator_contexts(robot: Robot) -> list[dict]:
+    """Each actuator's command interface and range, its gains, and its joint's ``home`` value
+    (ros2_control's ``initial_value``)."""
     joints = {j.name: j for j in robot.joints}
+    home = dict(robot.home().values) if robot.home() is not None else {}
     out = []
     for a in robot.actuators:
         j = joints[a.joint]
@@ -127,7 +130,8 @@ def actuator_contexts(robot: Robot) -> list[dict]:
             lo, hi = -lim.velocity, lim.velocity
         elif a.interface == "effort" and lim is not None and lim.effort:
             lo, hi = -lim.effort, lim.effort
-        out.append({"joint": a.joint, "interface": a.interface, "min": lo, "max": hi, "p": a.p, "i": a.i, "d": a.d})
+        out.append({"joint": a.joint, "interface": a.interface, "min": lo, "max": hi, "p": a.p, "i": a.i, "d": a.d,
+                    "initial": home.get(a.joint)})
     return out
 
 

@@ -309,7 +309,7 @@ def readings(place: Place) -> dict[str, Reading]:
     # the finalized robot needs the facts of recentered meshes (their offsets) and every inertial
     recentered = sorted({g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link)
                          if g.shape.mesh is not None and g.recenter != "none"})
-    package = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators")}
+    package = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators", "poses")}
     package.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds], meshes=bool(robot.meshes()))
     no_inertials = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
                                            for link in structure["links"]]}

@@ -117,7 +117,7 @@ def test_config_changed_holds_exactly_what_each_output_reads(bot):
     assert set(config(t["bot:model.config"])["robot"]) == {"name", "metadata"}  # no geometry, no inertial
     assert config(t["bot:model.config"])["options"] == {"sdf": "model.sdf"}
     assert set(config(t["bot:package.xml"])["robot"]) == {"name", "metadata", "ros", "gazebo", "sensors",
-                                                           "actuators", "worlds", "meshes"}
+                                                           "actuators", "poses", "worlds", "meshes"}
     controllers = config(t["bot:controllers"])["robot"]
     assert set(controllers) == {"name", "ros", "gazebo", "actuators", "poses"}
     assert {k: controllers["actuators"][0][k] for k in ("joint", "interface", "p", "i", "d", "auto")} == {

@@ -1,18 +1,20 @@
 """The step response in PyBullet (DIRECT mode, the URDF's own inertia, TORQUE_CONTROL).
 
-PyBullet integrates explicitly (semi-implicit Euler): the law's damping term is applied as an
-explicit torque, so a large kd dt / inertia diverges here where MuJoCo's implicitfast and
-Drake's implicit PD stay stable.  The default velocity motors are switched off, link damping
-is set to 0 and the joint speed cap (100 rad/s by default) is lifted so an explosion shows.
+PyBullet integrates explicitly (semi-implicit Euler).  By default (``implicit``) the drive's
+damping is integrated implicitly, as MuJoCo's implicitfast and Drake's PD controllers do: with
+M from ``calculateMassMatrix`` and the bias h = ``calculateInverseDynamics(q, qd, 0)``, the
+accelerations are qdd = (M + A + dt Kd)^-1 (tau_law - h) (A: the armature, Kd: kd of a position
+drive, kv of a velocity drive) and the motor gives tau = tau_law - dt Kd qdd, clipped ("stable
+PD", Tan, Liu and Turk 2011).  With ``implicit=False`` the law's torque is applied as it is, as a
+hand-written torque loop would: then a large kd dt / inertia diverges here.
 
-PyBullet has no armature.  It is put inside the control loop, exactly (computed torque): with
-M from ``calculateMassMatrix`` and the bias h = ``calculateInverseDynamics(q, qd, 0)``, a robot
-with armature A would accelerate at qdd = (M + A)^-1 (tau - h); PyBullet is given
+PyBullet has no armature.  It is put inside the control loop, exactly (computed torque): a
+robot with armature A accelerates at qdd = (M + A)^-1 (tau - h); PyBullet is given
 tau - A qdd, which makes its (armature-free) robot accelerate the same.  The recorded torque
 is the motor's (tau, after the clip).  Gravity compensation is the same feed-forward:
-``calculateInverseDynamics(q, 0, 0)`` at the current positions, inside the clip.  Both need a
+``calculateInverseDynamics(q, 0, 0)`` at the current positions, inside the clip.  All three need a
 held base: PyBullet's inverse dynamics of a free base raises (or gives zeros with flags=1), so
-a free base with armature or gravity compensation is refused with a ValueError."""
+a free base with armature, gravity compensation or the implicit loop is refused with a ValueError."""
 
 from __future__ import annotations
 
@@ -22,13 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from robotkit.check.motion.files import quiet, resolved_urdf
-from robotkit.check.motion.law import Drive, Recorder, Step, Trace, check_drives, law, targets
+from robotkit.check.motion.law import Drive, Recorder, Step, Trace, check_drives, clip, law, targets
 
 NO_SPEED_CAP = 1e6
 
 
 def simulate_pybullet(urdf: Path, drives: list[Drive], step: Step, package_dirs: dict[str, Path],
-                      hold_base: bool = True, timestep: float = 1 / 240) -> Trace:
+                      hold_base: bool = True, timestep: float = 1 / 240, implicit: bool = True) -> Trace:
     with quiet():  # heavy, and it prints its build banner
         import pybullet as p
 
@@ -41,7 +43,7 @@ def simulate_pybullet(urdf: Path, drives: list[Drive], step: Step, package_dirs:
                 body = p.loadURDF(str(path), useFixedBase=hold_base, flags=p.URDF_USE_INERTIA_FROM_FILE,
                                   physicsClientId=client)
             rec = Recorder("pybullet", timestep, step, drives)
-            run(p, client, body, drives, step, rec, hold_base)
+            run(p, client, body, drives, step, rec, hold_base, implicit and hold_base)
             return rec.trace()
         finally:
             p.disconnect(client)
@@ -68,7 +70,8 @@ def prepare(p, client: int, body: int, joints: dict[str, int], step: Step) -> No
                                 forces=[0.0] * len(joints), physicsClientId=client)
 
 
-def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorder, hold_base: bool) -> None:
+def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorder, hold_base: bool,
+        implicit: bool = True) -> None:
     joints = movable_joints(p, client, body)
     missing = [d.joint for d in drives if d.joint not in joints]
     if missing:
@@ -80,6 +83,9 @@ def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorde
     column = {n: k for k, n in enumerate(names)}
     armature = np.array([next((d.armature for d in drives if d.joint == n), 0.0) for n in names])
     wanted = {d.joint: targets(d, step) for d in drives}
+    kd = np.zeros(len(names))  # the velocity gain of each drive: integrated implicitly
+    for d in drives:
+        kd[column[d.joint]] = d.kd if d.interface == "position" else d.kp if d.interface == "velocity" else 0.0
     if not hold_base and (armature.any() or any(d.gravcomp for d in drives)):
         raise ValueError("PyBullet cannot give the armature or gravity compensation of a free base: its "
                          "calculateInverseDynamics raises on one (and returns zeros with flags=1); hold the base")
@@ -93,6 +99,8 @@ def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorde
         for d in drives:
             k = column[d.joint]
             tau[k] = law(d, *wanted[d.joint], q[k], qd[k], gravity[k])
+        if implicit:
+            tau = implicit_damping(p, client, body, q, qd, tau, armature + timestep * kd, drives, column)
         if not rec.record(i * timestep, dict(zip(names, q)), dict(zip(names, qd)), float(tau[column[step.joint]])):
             return
         applied = tau - armature * accelerations(p, client, body, q, qd, tau, armature) \
@@ -100,6 +108,18 @@ def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorde
         p.setJointMotorControlArray(body, list(joints.values()), p.TORQUE_CONTROL, forces=applied.tolist(),
                                     physicsClientId=client)
         p.stepSimulation(physicsClientId=client)
+
+
+def implicit_damping(p, client, body, q, qd, tau, implicit_inertia, drives, column) -> np.ndarray:
+    """The motor torques with the drives' damping integrated implicitly: tau - dt Kd qdd where
+    qdd = (M + A + dt Kd)^-1 (tau - h) (``implicit_inertia``: A + dt Kd), each clipped again."""
+    qdd = accelerations(p, client, body, q, qd, tau, implicit_inertia)
+    out = tau.copy()
+    for d in drives:
+        k = column[d.joint]
+        extra = implicit_inertia[k] - d.armature
+        out[k] = clip(tau[k] - extra * qdd[k], d.effort)
+    return out
 
 
 def accelerations(p, client, body, q, qd, tau, armature) -> np.ndarray:
