@@ -86,7 +86,7 @@ def resolve_poses(report: Report, poses: dict, joints: list[Joint]) -> list[Name
                 report(path, f"joint '{joint}' mimics '{j.mimic.joint}'; set the joint it follows")
             elif j.limit is not None and j.limit.lower is not None and not (
                     j.limit.lower - 1e-12 <= value <= j.limit.upper + 1e-12):
-                report(path, f"{short_number(value)} is outside joint '{joint}''s limits "
+                report(path, f"{short_number(value)} is outside the limits of joint '{joint}' "
                              f"[{short_number(j.limit.lower)}, {short_number(j.limit.upper)}]")
             else:
                 kept.append((joint, float(value)))

@@ -214,7 +214,7 @@ def tune(robot: Robot, timesteps: dict[str, float] | None = None) -> dict:
         dof = int(model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, a.joint)])
         drives[a.joint] = drive_entry(a, joints[a.joint], float(j_min[dof]), float(j_max[dof]),
                                       float(g_max[dof]), timesteps)
-    gravcomp = fixed and any(d.get("needs_gravcomp") for d in drives.values())
+    gravcomp = fixed and any(d.get("needs_gravcomp") and d["source"] == "auto" for d in drives.values())
     for d in drives.values():
         d["gravcomp"] = gravcomp
         _sag_notes(d, gravcomp, fixed)
@@ -302,7 +302,7 @@ def _checks(entry: dict, j_min: float, timesteps: dict[str, float], kind: str) -
     if entry["interface"] == "position":
         peak = p * entry["reference_step"] + g
         out["peak_effort"] = peak
-        out["saturates"] = bool(effort and peak > effort)
+        out["saturates"] = bool(effort and peak > effort * (1 + 1e-3))  # 1e-3: the gains' four digits
         out["sag"] = g / p if p > 0 else math.inf
         out["needs_gravcomp"] = out["sag"] > SAG_TOLERANCE[kind]
     return out
@@ -310,6 +310,10 @@ def _checks(entry: dict, j_min: float, timesteps: dict[str, float], kind: str) -
 
 def _sag_notes(d: dict, gravcomp: bool, fixed: bool) -> None:
     if not d.get("needs_gravcomp"):
+        return
+    if d["source"] == "recipe" and not gravcomp:
+        d["notes"].append("sag under gravity above tolerance with the recipe's gains: raise p, add i, or use "
+                          "gains: auto (which compensates gravity in the MJCF)")
         return
     if gravcomp:
         d["notes"].append("sag under gravity above tolerance: MJCF compensates gravity (gravcomp); the ROS "

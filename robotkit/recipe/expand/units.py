@@ -51,7 +51,10 @@ def convert(data: dict, problem) -> dict:
 
     ``problem(path, message)`` records a problem at a key path."""
     convert_poses(data, problem)
+    poses = data.pop("poses", None)  # converted above, by their joints' types
     convert_tree(data, Recipe, (), None, problem)
+    if poses is not None:
+        data["poses"] = poses
     return data
 
 
