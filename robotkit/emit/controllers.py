@@ -58,14 +58,30 @@ def render_controllers(robot: Robot) -> str:
     return header + yaml.safe_dump(controllers(robot), sort_keys=False, default_flow_style=False)
 
 
+def joints_phrase(joints: list[str]) -> str:
+    """``joint 'a'`` or ``joint 'a' and 2 more ('b', 'c')``: one loss line for many joints, named
+    as ``joint 'a'`` so the build's warning points at the first."""
+    more = f" and {len(joints) - 1} more ({', '.join(repr(j) for j in joints[1:])})" if joints[1:] else ""
+    return f"joint '{joints[0]}'{more}"
+
+
+def armature_losses(robot: Robot, fmt: str) -> list[str]:
+    """One line for the joints whose armature ``fmt`` (URDF, SDF) cannot carry."""
+    joints = [j.name for j in robot.joints if j.dynamics is not None and j.dynamics.armature]
+    if not joints:
+        return []
+    return [f"{joints_phrase(joints)}: armature is not written ({fmt} has no such joint property; the MJCF "
+            "carries it)"]
+
+
 def gravcomp_losses(robot: Robot, where: str) -> list[str]:
     """The drives the MJCF compensates for gravity, which ``where`` cannot."""
     joints = [a.joint for a in robot.actuators if a.gravcomp and a.interface == "position"]
     if not joints:
         return []
-    return [f"joints {', '.join(repr(j) for j in joints)}: the MJCF compensates gravity (gravcomp); {where} "
-            "cannot, so they sag under gravity with p alone: give them an integral gain (i) or a gravity "
-            "feed-forward (report.json: actuators, sag)"]
+    return [f"{joints_phrase(joints)}: the MJCF compensates gravity (gravcomp); {where} cannot, so they sag "
+            "under gravity with p alone: give them an integral gain (i) or a gravity feed-forward "
+            "(report.json: actuators, sag)"]
 
 
 def has_actuators(robot: Robot) -> bool:

@@ -15,6 +15,7 @@ import os
 import numpy as np
 
 from robotkit.emit import layout
+from robotkit.emit.controllers import joints_phrase
 from robotkit.emit.env import render
 from robotkit.geometry import rpy_quat
 from robotkit.emit.formats import Format
@@ -48,8 +49,10 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
         if j.type == "floating" and j.parent != WORLD:
             out.append(f"joint '{j.name}': MuJoCo allows free joints only on bodies of the world; "
                        f"link '{j.child}' is welded to '{j.parent}'")
-        if j.limit is not None and j.limit.velocity is not None and j.type not in ("fixed",):
-            out.append(f"joint '{j.name}': MJCF has no velocity limit ({j.limit.velocity:g} not enforced)")
+    fast = [j for j in robot.joints if j.limit is not None and j.limit.velocity is not None and j.type != "fixed"]
+    if fast:
+        speeds = ", ".join(sorted({f"{j.limit.velocity:g}" for j in fast}, key=float))
+        out.append(f"{joints_phrase([j.name for j in fast])}: MJCF has no velocity limit ({speeds} not enforced)")
     for link in robot.links:
         c = link.contact
         if c is not None and (c.kp is not None or c.kd is not None):

@@ -20,7 +20,7 @@ from robotkit.emit.formats import Format
 from robotkit.emit.meshfiles import collision_file
 from robotkit.emit.urdf import MASSLESS, geom_context
 from robotkit.emit.sensors import contexts, host_of
-from robotkit.emit.controllers import gravcomp_losses
+from robotkit.emit.controllers import armature_losses, gravcomp_losses
 from robotkit.emit.sensors import losses as sensor_losses
 from robotkit.geometry import matrix_rpy
 from robotkit.model.robot import Inertial, Pose, Robot
@@ -49,8 +49,7 @@ def losses(robot: Robot) -> list[str]:
         if j.mimic is not None:
             out.append(f"joint '{j.name}': SDF {SDF_VERSION} cannot express mimic joints (SDF 1.11 can); "
                        f"it moves independently of '{j.mimic.joint}' in Gazebo")
-        if j.dynamics is not None and j.dynamics.armature:
-            out.append(f"joint '{j.name}': armature is not written (SDF has no such joint property)")
+    out += armature_losses(robot, "SDF")
     out += extras_losses(robot, "model.sdf")
     out += gravcomp_losses(robot, "model.sdf's joint controllers (Gazebo Sim)")
     return out + sensor_losses(robot)["sdf"]

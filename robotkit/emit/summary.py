@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 
 from robotkit.emit import layout, mjcf, ros, sdf
-from robotkit.emit.controllers import gravcomp_losses
+from robotkit.emit.controllers import armature_losses, gravcomp_losses
 from robotkit.emit.formats import Format
 from robotkit.emit.sensors import host_of
 from robotkit.emit.urdf import massless_mass, typed_transmissions
@@ -18,10 +18,7 @@ from robotkit.model.robot import Robot
 
 
 def urdf_losses(robot: Robot) -> list[str]:
-    out = []
-    for j in robot.joints:
-        if j.dynamics is not None and j.dynamics.armature:
-            out.append(f"joint '{j.name}': armature is not written (URDF has no such joint property)")
+    out = armature_losses(robot, "URDF")
     for extra in robot.urdf_extras:
         for name, kind in typed_transmissions(extra)[1]:
             out.append(f"transmission '{name}' names its class in <plugin> only: written with <type>{kind}</type> "

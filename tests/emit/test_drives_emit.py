@@ -76,8 +76,8 @@ def test_ros2_control_starts_at_home_and_gazebo_sim_gets_the_same_gains(arm):
 
 def test_what_a_format_cannot_carry_is_a_loss(arm):
     losses = json.loads((arm / "report.json").read_text())["losses"]
-    assert "joint 'hinge': armature is not written (URDF has no such joint property)" in losses["urdf"]
-    assert any(line.startswith("joints 'hinge': the MJCF compensates gravity (gravcomp); model.sdf's joint "
+    assert "joint 'hinge': armature is not written (URDF has no such joint property; the MJCF carries it)" in losses["urdf"]
+    assert any(line.startswith("joint 'hinge': the MJCF compensates gravity (gravcomp); model.sdf's joint "
                                "controllers (Gazebo Sim) cannot") for line in losses["sdf"])
     assert any("the ros_control controllers (controllers.yaml) cannot" in line for line in losses["package"])
 

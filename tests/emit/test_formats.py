@@ -165,7 +165,8 @@ def test_mimic_floating_base_contact_and_losses(tmp_path):
            "it moves independently of 'left_finger' in Gazebo" in result.warnings
     assert "gripper: SDF: joint 'base': SDF has no floating joint; link 'palm' is a free body placed at " \
            "the joint's pose" in result.warnings
-    assert "gripper: URDF: joint 'left_finger': armature is not written (URDF has no such joint property)" \
+    assert "gripper: URDF: joint 'left_finger': armature is not written (URDF has no such joint property; the " \
+           "MJCF carries it)" \
         in result.warnings
     assert "gripper: MJCF: link 'palm': MuJoCo friction is isotropic; mu2 0.7 dropped, mu1 0.9 used" \
         in result.warnings
