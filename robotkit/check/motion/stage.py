@@ -422,8 +422,11 @@ def instability(plan: Plan, joint: str, dt: float, implicit: bool) -> tuple[str,
     return None
 
 
-def static_findings(plan: Plan) -> list[Finding]:
-    """The explicit-integration criteria at the MJCF's own integrator and time step."""
+def static_findings(plan: Plan, runs: dict[str, dict]) -> list[Finding]:
+    """The explicit-integration criteria at the MJCF's own integrator and time step.  An implicit
+    integrator takes a drive's damping implicitly only while its force is within the force range:
+    a saturated step is explicit again, so kv*dt/M > 2 with a saturated, overshooting MuJoCo step
+    is an error too (a warning without that evidence)."""
     out = []
     implicit = plan.integrator in ("implicit", "implicitfast")
     for d in plan.drives:
@@ -433,18 +436,31 @@ def static_findings(plan: Plan) -> list[Finding]:
                                f"{found[0]}: explicit integration diverges", found[1]))
             continue
         pose, f = worst_pose(plan, d.joint, "kv_dt_M")
-        if implicit and f["kv_dt_M"] > EXPLICIT_LIMIT:
-            out.append(Finding("warning", STAGE, f"joint '{d.joint}'", f"kv*dt/M = {f['kv_dt_M']:.3g} at pose "
-                               f"'{pose}' (M {f['M']:.3g}, kv {f['kv']:.4g}, dt {plan.timestep:.3g} s): stable only "
-                               f"because integrator {plan.integrator} takes damping implicitly; Euler (and "
-                               "PyBullet) diverge", f"add armature (about {f['kv'] * plan.timestep - f['M']:.3g} "
-                               f"brings kv*dt/M to 1) or lower kv to {f['M'] / plan.timestep:.3g}"))
+        if not implicit or f["kv_dt_M"] <= EXPLICIT_LIMIT:
+            continue
+        bad = [r for r in runs.get("mujoco", {}).get("runs", []) if r["joint"] == d.joint and not r.get("refused")
+               and (r.get("saturated") or 0) > 0 and (r.get("overshoot") or 0) > OVERSHOOT]
+        _, inertia, _ = units(plan, d.joint)
+        figure = (f"kv*dt/M = {f['kv_dt_M']:.3g} > {EXPLICIT_LIMIT:g} at pose '{pose}' (kv {f['kv']:.4g}, M "
+                  f"{f['M']:.3g} {inertia} incl. armature {d.armature:.3g}, dt {plan.timestep:.3g} s)")
+        fix = (f"add armature (about {f['kv'] * plan.timestep - f['M']:.3g} {inertia} brings kv*dt/M to 1) or lower "
+               f"kv to {f['M'] / plan.timestep:.3g}")
+        if bad:
+            worst = max(bad, key=lambda r: r["overshoot"])
+            out.append(Finding("error", STAGE, f"joint '{d.joint}'", f"unstable at its force limit: {figure}; "
+                               f"integrator {plan.integrator} takes the damping implicitly only within the force "
+                               f"range, and the step from pose '{worst['pose']}' saturates and overshoots by "
+                               f"{100 * worst['overshoot']:.3g} % in MuJoCo", fix))
+        else:
+            out.append(Finding("warning", STAGE, f"joint '{d.joint}'", f"{figure}: stable only because integrator "
+                               f"{plan.integrator} takes damping implicitly (within the force range); Euler "
+                               "diverges", fix))
     return out
 
 
 def findings(plan: Plan, runs: dict[str, dict], results: dict) -> list[Finding]:
     robot = f"robot '{plan.mjcf.stem}'"
-    out = static_findings(plan)
+    out = static_findings(plan, runs)
     unstable = {f.subject for f in out if f.severity == "error"}
     for s, r in runs.items():
         if r.get("error"):
