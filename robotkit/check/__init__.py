@@ -21,6 +21,7 @@ from robotkit.check.findings import Finding
 from robotkit.check.kinematics import read_mjcf, read_sdf
 from robotkit.check.lints import LinkFacts, lint, lint_link, read_urdf_facts
 from robotkit.check.locate import locate
+from robotkit.check.motion.stage import MotionRun, has_actuators
 from robotkit.check.simulation import smoke_test
 from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
 from robotkit.emit.layout import robot_layout
@@ -132,9 +133,11 @@ def urdf_tree(path: Path) -> tuple[dict[str, int], list[Finding]]:
     return lines, found
 
 
-def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list[Finding]:
+def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion: dict | None = None) -> list[Finding]:
     """Every stage on a build folder: lints, validators, equivalence of the formats, what each
-    consuming program sees, and the MuJoCo scene's own simulation.  Every stage always runs."""
+    consuming program sees, the MuJoCo scene's own simulation and, when the MJCF has actuators,
+    the step responses of its drives (``motion``: gets the robot's motion results by name).
+    Every stage always runs."""
     layout = robot_layout(robot_dir)
     name, urdf, sdf, mjcf, scene = layout.name, layout.urdf, layout.sdf, layout.mjcf, layout.scene
     for p in (urdf, sdf, mjcf, scene):
@@ -142,6 +145,7 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
             raise RobotkitError(Problem(f"not a robotkit build folder: {p.relative_to(robot_dir)} is missing",
                                         file=str(robot_dir)))
     subject = f"robot '{name}'"
+    started = start_motion(mjcf, urdf, {name: robot_dir})  # its simulators run beside the other stages
     links, joints, notes = read_urdf_facts(urdf, {name: str(robot_dir)})
     findings = notes + lint(links, joints, declared_mass)
     findings += validate_urdf(urdf) + validate_sdf(sdf) + validate_mjcf(mjcf) + validate_mjcf(scene)
@@ -161,15 +165,45 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None) -> list
                 + [Finding("warning", "simulation", subject, n, "MuJoCo scene mjcf/scene.xml") for n in notes])
 
     findings += _stage("simulation", subject, simulate)
-    return findings
+    return findings + finish_motion(started, subject, name, motion)
 
 
-def check_model_file(path: Path, kind: str) -> list[Finding]:
+def start_motion(mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path]) -> MotionRun | Exception | None:
+    """The motion stage started (None when the MJCF has no actuator; the exception if it cannot start)."""
+    try:
+        return MotionRun(mjcf, urdf, package_dirs) if has_actuators(mjcf) else None
+    except Exception as exc:  # reported by finish_motion, as _stage reports a stage's failure
+        return exc
+
+
+def finish_motion(started: MotionRun | Exception | None, subject: str, name: str,
+                  motion: dict | None) -> list[Finding]:
+    if started is None:
+        return []
+
+    def finish() -> list[Finding]:
+        if isinstance(started, Exception):
+            raise started
+        found, results = started.finish()
+        if motion is not None:
+            motion[name] = results
+        return found
+
+    return _stage("motion", subject, finish)
+
+
+def check_model_file(path: Path, kind: str, motion: dict | None = None) -> list[Finding]:
     """An SDF (``kind`` sdf) or MJCF (mjcf) file: its validator, then, for an MJCF the validator
-    accepts and for every SDF, the mass and inertia lints (their geometry is not measured yet)."""
+    accepts and for every SDF, the mass and inertia lints (their geometry is not measured yet);
+    for an accepted MJCF with actuators, the motion stage in MuJoCo (``motion``: gets its results)."""
     if kind == "sdf":
         return locate(validate_sdf(path) + _inertial_lints(path, kind), path)
-    return locate(validate_mjcf(path) or _inertial_lints(path, kind), path)
+    invalid = validate_mjcf(path)
+    if invalid:
+        return locate(invalid, path)
+    started = start_motion(path, None, {})
+    findings = _inertial_lints(path, kind) + finish_motion(started, f"robot '{path.stem}'", path.stem, motion)
+    return locate(findings, path)
 
 
 def _inertial_lints(path: Path, kind: str) -> list[Finding]:

@@ -12,22 +12,26 @@ from robotkit.errors import display_path
 
 
 def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error",
-           cases: list[tuple[str, str]] | None = None) -> str:
+           cases: list[tuple[str, str]] | None = None, motion: dict | None = None) -> str:
     """``fail_on`` (``--fail-on``): the lowest severity that fails the check; every format says
     which findings fail it (JUnit failures, GitHub ``::error``, JSON ``failed``, the text's last line).
     ``cases``: every (check, subject) that ran (:func:`robotkit.commands.check.cases`): JUnit lists the
-    ones without findings as passing test cases."""
+    ones without findings as passing test cases.  ``motion``: the motion stage's results by robot
+    (JSON: under ``motion``; text: one line per joint)."""
     if fmt == "json":
-        return json.dumps({"source": source, "errors": sum(f.severity == "error" for f in findings),
-                           "warnings": sum(f.severity == "warning" for f in findings), "fail_on": fail_on,
-                           "failed": sum(f.fails(fail_on) for f in findings),
-                           "findings": [asdict(f) for f in findings]}, indent=1) + "\n"
+        out = {"source": source, "errors": sum(f.severity == "error" for f in findings),
+               "warnings": sum(f.severity == "warning" for f in findings), "fail_on": fail_on,
+               "failed": sum(f.fails(fail_on) for f in findings), "findings": [asdict(f) for f in findings]}
+        if motion:
+            out["motion"] = motion
+        return json.dumps(out, indent=1) + "\n"
     if fmt == "junit":
         return _junit(findings, source, fail_on, cases or [])
     if fmt == "github":
         return "".join(annotation(f, fail_on) + "\n" for f in findings)
+    table = motion_table(motion or {})
     if not findings:
-        return f"{source}: ok, no problems found\n"
+        return "".join(line + "\n" for line in table) + f"{source}: ok, no problems found\n"
     groups: dict[str, list[Finding]] = {}
     for f in findings:
         groups.setdefault(f.subject, []).append(f)
@@ -44,8 +48,40 @@ def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error
     errors = sum(f.severity == "error" for f in findings)
     warnings = len(findings) - errors
     tail = " (they fail the check: --fail-on warning)" if fail_on == "warning" and warnings else ""
+    out += table
     out.append(f"{source}: {errors} error{'s' * (errors != 1)}, {warnings} warning{'s' * (warnings != 1)}{tail}")
     return "\n".join(out) + "\n"
+
+
+def motion_table(motion: dict) -> list[str]:
+    """Per robot, one line per joint: its slowest step (pose, simulator), rise time, overshoot
+    and final error; then each simulator's wall time."""
+    out = []
+    for robot, r in motion.items():
+        sims = ", ".join(f"{s} {v['wall']:.2f} s" if v.get("wall") is not None else f"{s} {v['status']}"
+                         for s, v in r["simulators"].items())
+        out.append(f"motion of robot '{robot}' ({r['integrator']}, dt {r['timestep']:g} s; stage {r['wall']:.2f} s: "
+                   f"{sims})")
+        out.append(f"  {'joint':<24} {'pose':<10} {'sim':<9} {'rise':>9} {'overshoot':>9} {'final error':>12}")
+        for joint, j in r["joints"].items():
+            runs = [(pose, s, x) for pose, p in j["poses"].items() for s, x in p["simulators"].items()
+                    if "refused" not in x]
+            if not runs:
+                out.append(f"  {joint:<24} not stepped ({j['interface']})")
+                continue
+            pose, sim, x = max(runs, key=_slowness)
+            rise = "diverged" if x.get("diverged") else "never" if x["rise_time"] is None else f"{x['rise_time']:.3f} s"
+            over = "-" if x["overshoot"] is None else f"{100 * x['overshoot']:.1f} %"
+            out.append(f"  {joint:<24} {pose:<10} {sim:<9} {rise:>9} {over:>9} {x['final_error']:>12.3g}")
+        for n in r.get("not_checked", []):
+            out.append(f"  actuator '{n['actuator']}' not checked: {n['why']}")
+    return out
+
+
+def _slowness(run: tuple) -> tuple:
+    """Diverged first, then never rising, then the largest final error, then the longest rise."""
+    x = run[2]
+    return (bool(x.get("diverged")), x["rise_time"] is None, x["final_error"] or 0.0, x["rise_time"] or 0.0)
 
 
 def _escape_data(text: str) -> str:

@@ -36,27 +36,29 @@ def run(args) -> int:
 def _check_paths(args, packages: dict[str, str]) -> int:
     """Every PATH in turn; bad input (exit 2) is reported in the chosen format too, so a CI
     report never comes out empty, and its lines go to stderr as always."""
-    findings, status, ran = [], 0, []
+    findings, status, ran, motion = [], 0, [], {}
     for path in args.paths:
         try:  # github: the job summary points at the picture report, so a recipe's build writes it
             findings += check(path, args.out, packages, args=dict(args.arg),
-                              report=args.format == "github" and not args.temp_out)
+                              report=args.format == "github" and not args.temp_out, motion=motion)
             ran += cases(path, args.out, dict(args.arg))
         except RobotkitError as exc:
             for line in exc.lines():
                 print(line, file=sys.stderr)
             findings += input_findings(exc.problems, path)
             status = max(status, exc.exit_status)
-    _write_findings(args, findings, status, ran)
+    _write_findings(args, findings, status, ran, motion)
     return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)
 
 
-def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[str, str]]) -> None:
+def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[str, str]],
+                    motion: dict | None = None) -> None:
     source = " ".join(args.paths)
     if args.format != "text" or not status:
-        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran))
+        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran, motion=motion))
     elif any(f.check != "input" for f in findings):  # the paths that could be checked
-        sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on))
+        sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on,
+                                motion=motion))
     if args.junit:
         Path(args.junit).parent.mkdir(parents=True, exist_ok=True)
         Path(args.junit).write_text(render(findings, "junit", source, args.fail_on, ran), encoding="utf-8")
@@ -66,23 +68,24 @@ def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[
 
 
 def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
-          args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
+          args: dict[str, str] | None = None, report: bool = False, motion: dict | None = None) -> list[Finding]:
     """The findings on PATH.  ``report``: a recipe's build also writes its picture report (as
-    ``robotkit build`` does)."""
+    ``robotkit build`` does).  ``motion``: gets each robot's motion results by name."""
     what = classify(path)
     package_paths = package_paths or {}
     if what.kind == "build":  # a build folder's findings point at its URDF
-        return [f for d in what.robots for f in locate(check_build_dir(d.root), d.urdf)]
+        return [f for d in what.robots for f in locate(check_build_dir(d.root, motion=motion), d.urdf)]
     if what.kind == "recipe":
-        return check_recipe(what.path, out_dir, args, report)
+        return check_recipe(what.path, out_dir, args, report, motion)
     if what.kind == "urdf":
         return check_urdf_file(what.path, package_paths)
     if what.kind == "xacro":
         return check_xacro_file(what.path, package_paths, args or {})
-    return check_model_file(what.path, what.kind)
+    return check_model_file(what.path, what.kind, motion)
 
 
-def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False) -> list[Finding]:
+def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False,
+                 motion: dict | None = None) -> list[Finding]:
     """Build the recipe, then check each of its robots (one per variant), the build's warnings
     and the findings placed on the recipe's lines."""
     located = []
@@ -94,15 +97,15 @@ def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, r
         # a warning naming another variant's robot belongs to that one; the rest to the first
         mine = [w for w in warnings if w[3].startswith(f"{name}:")
                 or (i == 0 and not any(w[3].startswith(f"{o}:") for o in others))]
-        located += _check_variant(loaded, mine, out_dir)
+        located += _check_variant(loaded, mine, out_dir, motion)
     return located
 
 
-def _check_variant(loaded, warnings: list[tuple], out_dir: str) -> list[Finding]:
+def _check_variant(loaded, warnings: list[tuple], out_dir: str, motion: dict | None = None) -> list[Finding]:
     name = loaded.recipe.robot
     build_findings = [Finding("warning", "build", key or f"robot '{name}'", text, file=file, line=line)
                       for file, line, key, text in warnings]
-    findings = check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass)
+    findings = check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass, motion)
     marks = loaded.marks
     located = []
     for f in findings:
