@@ -29,7 +29,7 @@ import numpy as np
 from robotkit.geometry import rpy_quat
 from robotkit.model.robot import Robot
 
-TIMESTEPS = {"mujoco": 0.002, "pybullet": 1 / 240, "drake": 0.001}
+TIMESTEPS = {"mujoco": 0.002, "pybullet": 1 / 240, "drake": 0.002}
 """Each simulator's time step as robotkit's outputs and checks use it (MuJoCo: the MJCF's default)."""
 IMPLICIT_DAMPING = {"mujoco": True, "pybullet": True, "drake": True}
 """Whether the drive's damping is integrated implicitly: MuJoCo's implicitfast (the MJCF's

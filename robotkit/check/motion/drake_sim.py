@@ -23,7 +23,7 @@ from robotkit.check.motion.law import Drive, Recorder, Step, Trace, check_drives
 
 
 def simulate_drake(urdf: Path, drives: list[Drive], step: Step, package_dirs: dict[str, Path],
-                   hold_base: bool = True, timestep: float = 1e-3) -> Trace:
+                   hold_base: bool = True, timestep: float = 2e-3) -> Trace:
     from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
     from pydrake.multibody.parsing import Parser
 
@@ -51,8 +51,11 @@ def add_actuators(plant, model, drives: list[Drive]) -> dict[str, object]:
     """{joint: its JointActuator}, added where the URDF made none, set up as the drive says."""
     from pydrake.multibody.tree import PdControllerGains
 
-    existing = {plant.get_joint_actuator(i).joint().name(): plant.get_joint_actuator(i)
-                for i in plant.GetJointActuatorIndices(model)}
+    from pydrake.multibody.tree import JointActuatorIndex
+
+    # before Finalize, GetJointActuatorIndices(model) lists none: the URDF's transmissions are looked up one by one
+    every = (plant.get_joint_actuator(JointActuatorIndex(i)) for i in range(plant.num_actuators()))
+    existing = {a.joint().name(): a for a in every if a.model_instance() == model}
     out = {}
     for d in drives:
         if not plant.HasJointNamed(d.joint, model):

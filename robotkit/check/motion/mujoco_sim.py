@@ -78,11 +78,16 @@ def run(model, data, rec: Recorder, joints: dict[str, int], stepped: str, gravco
 
 
 def hold(spec, mujoco) -> None:
-    """Delete the free joint of each root body (the base is held where the file puts it)."""
+    """Delete the free joint of each root body (the base is held where the file puts it), and
+    the keyframes, whose qpos counted it (the step sets its own start)."""
+    held = False
     for body in spec.worldbody.bodies:
         for joint in list(body.joints):
             if joint.type == mujoco.mjtJoint.mjJNT_FREE:
                 spec.delete(joint)
+                held = True
+    for key in list(spec.keys) if held else []:
+        spec.delete(key)
 
 
 def matches(actuator, drive: Drive) -> bool:

@@ -89,6 +89,7 @@ def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorde
     if not hold_base and (armature.any() or any(d.gravcomp for d in drives)):
         raise ValueError("PyBullet cannot give the armature or gravity compensation of a free base: its "
                          "calculateInverseDynamics raises on one (and returns zeros with flags=1); hold the base")
+    damping = joint_damping(p, client, body, joints) if implicit else np.zeros(len(names))
     for i in range(rec.steps()):
         states = p.getJointStates(body, list(joints.values()), physicsClientId=client)
         q = [s[0] for s in states]
@@ -99,31 +100,49 @@ def run(p, client: int, body: int, drives: list[Drive], step: Step, rec: Recorde
         for d in drives:
             k = column[d.joint]
             tau[k] = law(d, *wanted[d.joint], q[k], qd[k], gravity[k])
+        total = tau
+        mh = dynamics(p, client, body, q, qd) if implicit or armature.any() else None
         if implicit:
-            tau = implicit_damping(p, client, body, q, qd, tau, armature + timestep * kd, drives, column)
+            tau, total = implicit_damping(mh, np.asarray(qd), tau, (armature, kd, damping, timestep), drives, column)
         if not rec.record(i * timestep, dict(zip(names, q)), dict(zip(names, qd)), float(tau[column[step.joint]])):
             return
-        applied = tau - armature * accelerations(p, client, body, q, qd, tau, armature) \
-            if armature.any() else tau
+        applied = total - armature * accelerations(mh, total, armature) if armature.any() else total
         p.setJointMotorControlArray(body, list(joints.values()), p.TORQUE_CONTROL, forces=applied.tolist(),
                                     physicsClientId=client)
         p.stepSimulation(physicsClientId=client)
 
 
-def implicit_damping(p, client, body, q, qd, tau, implicit_inertia, drives, column) -> np.ndarray:
-    """The motor torques with the drives' damping integrated implicitly: tau - dt Kd qdd where
-    qdd = (M + A + dt Kd)^-1 (tau - h) (``implicit_inertia``: A + dt Kd), each clipped again."""
-    qdd = accelerations(p, client, body, q, qd, tau, implicit_inertia)
-    out = tau.copy()
-    for d in drives:
-        k = column[d.joint]
-        extra = implicit_inertia[k] - d.armature
-        out[k] = clip(tau[k] - extra * qdd[k], d.effort)
+def joint_damping(p, client: int, body: int, joints: dict[str, int]) -> np.ndarray:
+    """The URDF's joint damping, taken out of PyBullet (which applies it explicitly) to be
+    integrated implicitly with the drives', as MuJoCo and Drake do."""
+    out = np.array([p.getJointInfo(body, i, physicsClientId=client)[6] for i in joints.values()])
+    for i in joints.values():
+        p.changeDynamics(body, i, jointDamping=0.0, physicsClientId=client)
     return out
 
 
-def accelerations(p, client, body, q, qd, tau, armature) -> np.ndarray:
-    """The joint accelerations qdd = (M + A)^-1 (tau - h) of the (fixed-base) robot with armature A."""
+def implicit_damping(mh, v, tau, gains, drives, column) -> tuple[np.ndarray, np.ndarray]:
+    """(the motor torques, the motor and damping torques) with the drives' damping Kd and the
+    joints' damping B integrated implicitly: qdd = (M + A + dt (Kd + B))^-1 (tau - B qd - h), the
+    motor gives tau - dt Kd qdd (clipped again) and the joint's damper -B (qd + dt qdd)."""
+    armature, kd, damping, dt = gains
+    qdd = accelerations(mh, tau - damping * v, armature + dt * (kd + damping))
+    motor = tau.copy()
+    for d in drives:
+        k = column[d.joint]
+        motor[k] = clip(tau[k] - dt * kd[k] * qdd[k], d.effort)
+    return motor, motor - damping * (v + dt * qdd)
+
+
+def dynamics(p, client, body, q: list, qd: list) -> tuple[np.ndarray, np.ndarray]:
+    """(M, h) of the (fixed-base) robot at (q, qd): its mass matrix and bias forces.  PyBullet
+    takes lists (numpy arrays crash it)."""
     M = np.array(p.calculateMassMatrix(body, q, physicsClientId=client))
     h = np.array(p.calculateInverseDynamics(body, q, qd, [0.0] * len(q), physicsClientId=client))
+    return M, h
+
+
+def accelerations(mh: tuple[np.ndarray, np.ndarray], tau, armature) -> np.ndarray:
+    """The joint accelerations qdd = (M + A)^-1 (tau - h) of the robot with armature A."""
+    M, h = mh
     return np.linalg.solve(M + np.diag(armature), tau - h)
