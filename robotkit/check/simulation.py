@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from robotkit import mj
 
 START_GAP = 1e-3  # m: a free robot must start on the floor, not above it or inside it
 REST_SPEED = 1e-2  # |qvel| of a free base at the end (m/s, rad/s)
@@ -18,7 +19,7 @@ def smoke_test(scene: str | Path, seconds: float = 3.0, notes: list[str] | None 
     """Problems seen while stepping ``scene``: NaN, an explosion, a MuJoCo warning, a robot
     that starts inside the floor, and a free base that tips over or does not come to rest.
     ``notes`` collects what is worth a warning: a free robot that starts above the floor."""
-    import mujoco  # heavy: imported when the scene is stepped
+    mujoco = mj.load()  # heavy: imported when the scene is stepped
 
     model = mujoco.MjModel.from_xml_path(str(scene))
     data = mujoco.MjData(model)

@@ -26,6 +26,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from robotkit import mj
 from robotkit.geometry import rpy_quat
 from robotkit.model.robot import Robot
 
@@ -57,7 +58,7 @@ def _free_angle_range(j) -> tuple[float, float]:
 def dynamics_model(robot: Robot):
     """A MuJoCo model of the finalized robot's bodies, inertials and joints (no geometry), its
     base held; joint names as the robot's.  Mimic joints are left free (their coupling is not in M)."""
-    import mujoco  # heavy: only a build with actuators tunes
+    mujoco = mj.load()  # heavy: only a build with actuators tunes
 
     spec = mujoco.MjSpec()
     spec.option.gravity = [0, 0, -9.81]
@@ -102,7 +103,7 @@ PRIMITIVES = {"sphere": "mjGEOM_SPHERE", "box": "mjGEOM_BOX", "cylinder": "mjGEO
 def _feet_geoms(body, link) -> None:
     """The link's primitive shapes (collision, else visual), massless and without contacts: where
     a free robot's feet touch the floor (:func:`stance`)."""
-    import mujoco
+    mujoco = mj.load()
 
     for g in [g for g in link.collisions if g.shape.kind in PRIMITIVES] or [
             g for g in link.visuals if g.shape.kind in PRIMITIVES]:
@@ -119,7 +120,7 @@ def stance(model, data) -> tuple[np.ndarray, np.ndarray]:
     shared by its lowest leaf bodies (the feet, within 1 cm of the lowest), each foot's share
     pushing up at its lowest point.  Returns (the inertia of the body's share reflected at each
     dof: m |J_foot column|^2, the torque each dof holds: |J_foot^T F|)."""
-    import mujoco
+    mujoco = mj.load()
 
     parents = set(int(p) for p in model.body_parentid[1:])
     leaves = [b for b in range(1, model.nbody) if b not in parents]
@@ -146,7 +147,7 @@ def stance(model, data) -> tuple[np.ndarray, np.ndarray]:
 def configurations(robot: Robot, model, samples: int = SAMPLES, seed: int = SEED) -> np.ndarray:
     """The configurations the tuner looks at (rows of qpos): zero, the named poses, each actuated
     joint's range swept (9 points) with the others at each pose, and seeded random samples."""
-    import mujoco
+    mujoco = mj.load()
 
     joints = {j.name: j for j in robot.joints if j.type in ACTUATED}
     adr = {name: int(model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)])
@@ -177,7 +178,7 @@ def configurations(robot: Robot, model, samples: int = SAMPLES, seed: int = SEED
 def inertia_and_gravity(model, qs: np.ndarray, standing: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(min of diag M, max of diag M, max |gravity torque|) per dof over the configurations ``qs``;
     the first ``standing`` of them are also taken standing on the feet (:func:`stance`)."""
-    import mujoco
+    mujoco = mj.load()
 
     data = mujoco.MjData(model)
     full = np.zeros((model.nv, model.nv))
@@ -200,7 +201,7 @@ def inertia_and_gravity(model, qs: np.ndarray, standing: int = 0) -> tuple[np.nd
 def tune(robot: Robot, timesteps: dict[str, float] | None = None) -> dict:
     """report.json's ``actuators``: per drive its inertia, gains and their reasons, and the
     stability, saturation and sag checks at each simulator's time step."""
-    import mujoco
+    mujoco = mj.load()
 
     timesteps = timesteps or TIMESTEPS
     model = dynamics_model(robot)

@@ -6,6 +6,7 @@ lints that fired on it, what each format lost), rendered through the one Jinja e
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -105,8 +106,17 @@ def joint_rows(urdf_text: str | None, joints, findings: list[Finding], losses: d
         rows.append(JointRow(j.name, j.type, parent, child, axis, j.lower, j.upper, j.mimic,
                              [f for f in findings if f.subject == subject],
                              [f"{FORMATS.get(fmt, fmt)}: {item}" for fmt, items in sorted(losses.items())
-                              for item in items if subject in item]))
+                              for item in items if names_joint(item, j.name)]))
     return rows
+
+
+def names_joint(item: str, name: str) -> bool:
+    """A loss line about joint ``name``: ``joint 'name'``, or one of the joints after ``joint 'a' and
+    2 more ('b', 'c')`` (robotkit.emit.controllers.joints_phrase)."""
+    if f"joint '{name}'" in item:
+        return True
+    m = re.match(r"joint '[^']+' and \d+ more \(([^)]*)\)", item)
+    return bool(m) and f"'{name}'" in m.group(1)
 
 
 def other_findings(findings: list[Finding], rows: list[LinkRow], joints: list[JointRow]) -> list[Finding]:

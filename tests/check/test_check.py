@@ -225,11 +225,10 @@ def test_examples_check_clean(tmp_path, name):
     # turtlebot3's upstream collision box is 5.25x the volume of the base's plates, rightly warned
     # about since its decimated visual is a closed volume (MeshLib drops the non-manifold faces)
     allowed = {"ur5": {"inertia-box", "com-offset"}, "turtlebot3_burger": {"collision-volume"}}.get(name, set())
-    # the motion stage's known answers: turret_bot keeps its tutorial gains, which settle in 1.5-1.8 s
-    # (the example shows what they do); a free quadruped gets no gravity compensation (it would lift the
+    # the motion stage's known answer: a free quadruped gets no gravity compensation (it would lift the
     # base), so its hip rolls, stepped with the base held, sag 0.2 degree under the leg's weight, as
     # gravity torque / kp predicts (report.json: actuators)
-    motion = {"turret_bot": "settles within 2 % only after", "quadruped": "sags under gravity"}
+    motion = {"quadruped": "sags under gravity"}
     expected = next((text for robot, text in motion.items() if name.startswith(robot)), None)
     assert [f for f in data["findings"] if f["check"] != "build"
             and not (f["check"] == "motion" and f["severity"] == "warning" and expected

@@ -117,7 +117,13 @@ def test_equivalence_finds_a_moved_joint_axis(examples, tmp_path):
 @pytest.mark.slow
 def test_check_command_on_a_build_folder(examples, tmp_path):
     proc = run_cli("check", examples / "turret_bot")
-    assert (proc.returncode, proc.stdout) == (0, f"{examples / 'turret_bot'}: ok, no problems found\n"), proc.stderr
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    lines = proc.stdout.splitlines()
+    assert lines[-1] == f"{examples / 'turret_bot'}: ok, no problems found"
+    # the drives' step responses: a line per joint (its slowest simulator)
+    assert lines[0].startswith("motion of robot 'turret_bot' (implicitfast, dt 0.002 s; stage ")
+    assert lines[1].split() == ["joint", "pose", "sim", "rise", "overshoot", "final", "error"]
+    assert [line.split()[:2] for line in lines[2:4]] == [["j1", "zero"], ["j2", "zero"]]
     robot = _copy(examples, tmp_path)
     sdf = robot / "model.sdf"
     sdf.write_text(sdf.read_text().replace("<xyz>0 0 1</xyz>", "<xyz>0 1 0</xyz>"))

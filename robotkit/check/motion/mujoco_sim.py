@@ -19,13 +19,14 @@ from pathlib import Path
 
 import numpy as np
 
+from robotkit import mj
 from robotkit.check.motion.law import Drive, Recorder, Step, Trace, check_drives, isclose, targets
 
 TOL = 1e-9
 
 
 def simulate_mujoco(mjcf: Path, drives: list[Drive], step: Step, hold_base: bool = True) -> Trace:
-    import mujoco  # heavy: imported when a robot is stepped
+    mujoco = mj.load()  # heavy: imported when a robot is stepped
 
     check_drives(drives, step)
     spec = mujoco.MjSpec.from_file(str(mjcf))

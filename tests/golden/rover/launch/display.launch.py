@@ -13,6 +13,7 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 PACKAGE = 'rover'
+ZEROS = {}  # the home pose
 
 
 def generate_launch_description():
@@ -26,7 +27,9 @@ def generate_launch_description():
         DeclareLaunchArgument("rvizconfig", default_value=os.path.join(share, "rviz", PACKAGE + ".rviz")),
         Node(package="robot_state_publisher", executable="robot_state_publisher",
              parameters=[{"robot_description": robot_description}]),
-        Node(package="joint_state_publisher_gui", executable="joint_state_publisher_gui", condition=IfCondition(gui)),
-        Node(package="joint_state_publisher", executable="joint_state_publisher", condition=UnlessCondition(gui)),
+        Node(package="joint_state_publisher_gui", executable="joint_state_publisher_gui", condition=IfCondition(gui),
+             parameters=[ZEROS]),
+        Node(package="joint_state_publisher", executable="joint_state_publisher", condition=UnlessCondition(gui),
+             parameters=[ZEROS]),
         Node(package="rviz2", executable="rviz2", arguments=["-d", LaunchConfiguration("rvizconfig")]),
     ])
