@@ -3,12 +3,11 @@
 
 from __future__ import annotations
 
-import contextlib
-import os
 
 import numpy as np
 
 from robotkit import urdfxml
+from robotkit.ioutil import quiet
 from robotkit.check.consumers import Missing, Refused, View, listed, with_mesh_paths
 
 
@@ -16,20 +15,6 @@ MAX_LINKS = 128
 PRECISION = 1e-6  # PyBullet's wheels compute kinematics in single precision
 
 
-@contextlib.contextmanager
-def _quiet():
-    """PyBullet prints to the C-level stdout and stderr (build time, warnings)."""
-    saved = [os.dup(1), os.dup(2)]
-    with open(os.devnull, "w") as null:
-        os.dup2(null.fileno(), 1)
-        os.dup2(null.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            for fd in saved:
-                os.close(fd)
 
 
 DEFAULT_MASS = 1.0  # what PyBullet gives a link without <inertial>
@@ -51,11 +36,11 @@ def _T(pos, orn) -> np.ndarray:
 
 def from_urdf(build) -> View:
     try:  # optional: imported when PyBullet is asked (quietly: it prints its build banner)
-        with _quiet():
+        with quiet():
             import pybullet as p
     except ImportError:
         raise Missing("PyBullet is not installed (pip install pybullet)") from None
-    with _quiet(), with_mesh_paths(build) as (urdf, _):  # PyBullet knows no ROS packages
+    with quiet(), with_mesh_paths(build) as (urdf, _):  # PyBullet knows no ROS packages
         client = p.connect(p.DIRECT)
         try:
             # loaded free, so the base keeps its mass from the file (a fixed base is reported massless)

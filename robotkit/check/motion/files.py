@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
-import os
 import re
 from pathlib import Path
 
@@ -41,17 +39,3 @@ def root_link(urdf: Path) -> str | None:
     return roots[0] if roots else None
 
 
-@contextlib.contextmanager
-def quiet():
-    """Silence the C-level stdout and stderr (PyBullet prints its build banner and warnings there)."""
-    saved = [os.dup(1), os.dup(2)]
-    with open(os.devnull, "w") as null:
-        os.dup2(null.fileno(), 1)
-        os.dup2(null.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            for fd in saved:
-                os.close(fd)

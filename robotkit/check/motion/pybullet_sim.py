@@ -23,7 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from robotkit.check.motion.files import quiet, resolved_urdf
+from robotkit.check.motion.files import resolved_urdf
+from robotkit.ioutil import quiet
 from robotkit.check.motion.law import Drive, Recorder, Step, Trace, check_drives, clip, law, targets
 
 NO_SPEED_CAP = 1e6

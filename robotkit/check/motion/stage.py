@@ -269,7 +269,7 @@ def load_simulator(simulator: str):
         from robotkit.check.motion.mujoco_sim import simulate_mujoco
         return simulate_mujoco
     if simulator == "pybullet":
-        from robotkit.check.motion.files import quiet
+        from robotkit.ioutil import quiet
 
         with quiet():  # it prints its build banner
             import pybullet  # noqa: F401
