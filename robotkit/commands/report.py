@@ -9,6 +9,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from robotkit.check.motion.stage import has_actuators, motion_stage
 from robotkit.commands.inputs import classify, enclosing_build, package_paths
 from robotkit.emit.layout import robot_layout
 from robotkit.errors import RobotkitError
@@ -37,13 +38,14 @@ def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = No
     p = what.path
     if what.kind == "build":
         robot = what.one_robot()
-        return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p))
+        return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
+                                motion=step_responses(robot))
     if what.kind == "recipe":
         loaded = load_recipe(p)
         build([p], build_out, report=False)
         robot = robot_layout(Path(build_out) / loaded.recipe.robot)
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
-                                loaded.recipe.measured_mass)
+                                loaded.recipe.measured_mass, motion=step_responses(robot))
     if what.kind == "sdf" and (robot := enclosing_build(p)) is not None:  # a build folder's SDF is drawn
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p))
     out = Path(out_dir) if out_dir else p.parent / f"{p.stem}-report"
@@ -52,6 +54,17 @@ def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = No
             mjcf, notes = _built_mjcf(p, Path(tmp), package_paths or {})
             return report_urdf(p, out, package_paths or {}, mjcf, notes)
     return report_model_file(p, out, what.kind)
+
+
+def step_responses(robot) -> dict | None:
+    """The motion stage's results for a build folder with drives (its step responses are plotted);
+    None without drives or when the stage cannot run (``robotkit check`` says why)."""
+    if not robot.mjcf.is_file() or not has_actuators(robot.mjcf):
+        return None
+    try:
+        return motion_stage(robot.mjcf, robot.urdf, {robot.name: robot.root})[1]
+    except Exception:  # noqa: BLE001  (the page is drawn without them; check names the problem)
+        return None
 
 
 def _built_mjcf(urdf: Path, tmp: Path, package_paths: dict[str, str]) -> tuple[Path | None, list[str]]:

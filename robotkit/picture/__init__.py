@@ -17,19 +17,22 @@ from pathlib import Path, PurePosixPath
 from robotkit.check.kinematics import read_mjcf, read_sdf
 from robotkit.check.lints import JointFacts, LinkFacts, lint, lint_joints, lint_link, read_urdf_facts
 from robotkit.emit.layout import REPORT_HTML, robot_layout
+from robotkit import mj
 from robotkit.errors import Problem, RendererUnavailable, RobotkitError
 from robotkit.ioutil import write_if_changed
 from robotkit.picture import page
+from robotkit.picture.plots import step_plots
 
 PAGE = PurePosixPath(REPORT_HTML).name  # report.html, in whichever folder the report is written
 VERSION = 1  # bump when the pictures or the page change for the same build
 
 
 def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: float | None = None,
-                     no_pictures: str | None = None) -> Path:
+                     no_pictures: str | None = None, motion: dict | None = None) -> Path:
     """The report of a robotkit build folder: pictures from mjcf/<robot>.xml, tables from the URDF
     (the check package's facts and lints) and report.json (collision fidelity, losses).
-    ``no_pictures``: draw none, and say why on the page (MuJoCo cannot draw here)."""
+    ``no_pictures``: draw none, and say why on the page (MuJoCo cannot draw here); ``motion``:
+    the motion stage's results, plotted."""
     layout = robot_layout(robot_dir)
     name, urdf, mjcf = layout.name, layout.urdf, layout.mjcf
     for f in (urdf, mjcf):
@@ -41,7 +44,7 @@ def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: flo
     losses, collision = page.read_losses(layout.report_json)
     pictures = _pictures(mjcf, out, findings) if no_pictures is None else []
     return _write(out, name, source, pictures, links, joints, findings, losses, collision,
-                  urdf.read_text(encoding="utf-8"), [no_pictures] if no_pictures else [])
+                  urdf.read_text(encoding="utf-8"), [no_pictures] if no_pictures else [], step_plots(motion))
 
 
 def report_urdf(urdf: Path, out: Path, package_paths: dict[str, str], mjcf: Path | None,
@@ -80,6 +83,8 @@ def report_model_file(path: Path, out: Path, kind: str) -> Path:
 
 def _pictures(mjcf: Path, out: Path, findings) -> list:
     """The pictures of ``mjcf`` drawn into ``out``; RendererUnavailable when MuJoCo cannot draw here."""
+    if mj.GL_FAILURE:  # MuJoCo was imported earlier in this process without a GL backend
+        raise RendererUnavailable(mj.GL_FAILURE[0])
     try:
         from robotkit.picture.render import render_pictures  # imports MuJoCo (heavy): only to draw
     except Exception as exc:  # noqa: BLE001  (MuJoCo's GL backend fails at import: MUJOCO_GL, no OSMesa)
@@ -95,11 +100,11 @@ def _pictures(mjcf: Path, out: Path, findings) -> list:
 
 
 def _write(out: Path, robot: str, source: str, pictures, links, joints, findings, losses, collision,
-           urdf_text: str | None, notes=()) -> Path:
+           urdf_text: str | None, notes=(), plots=()) -> Path:
     rows = page.link_rows(links, findings, losses, collision)
     jrows = page.joint_rows(urdf_text, joints, findings, losses)
     html = page.render_page(robot, source, pictures, rows, jrows, page.other_findings(findings, rows, jrows),
-                            page.other_losses(losses, rows, jrows), notes)
+                            page.other_losses(losses, rows, jrows), notes, plots)
     target = out / PAGE
     write_if_changed(target, html)
     return target

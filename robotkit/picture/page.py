@@ -141,7 +141,8 @@ def _vec(v, digits: int = 4) -> str:
 
 
 def render_page(robot: str, source: str, pictures, links: list[LinkRow], joints: list[JointRow],
-                findings: list[Finding], losses: list[str], notes: list[str] = ()) -> str:
+                findings: list[Finding], losses: list[str], notes: list[str] = (), plots=()) -> str:
+    """The page; ``plots``: the drives' step responses (robotkit.picture.plots), when measured."""
     env = environment().overlay()
     env.filters["num"] = _num
     env.filters["v"] = _vec
@@ -152,7 +153,7 @@ def render_page(robot: str, source: str, pictures, links: list[LinkRow], joints:
     return env.get_template(TEMPLATE).render(
         robot=robot, source=source, pictures=list(pictures), links=links, joints=joints, findings=findings,
         losses=losses, notes=list(notes), errors=errors, warnings=warnings,
-        total_mass=sum(r.mass or 0.0 for r in links))
+        total_mass=sum(r.mass or 0.0 for r in links), plots=list(plots))
 
 
 def read_losses(report_json: Path) -> tuple[dict[str, list[str]], dict]:
