@@ -11,11 +11,13 @@ compensation on.  Prints one row per joint per simulator and the totals; no time
 
 from __future__ import annotations
 
+import json
 import math
 import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -79,7 +81,9 @@ def main() -> None:
         step = Step(drive.joint, POSE, q0 + STEP, seconds=1.5)
         for name, simulate in SIMULATORS.items():
             t = time.perf_counter()
-            trace = simulate(mjcf, drives, step) if name == "mujoco" else simulate(urdf, drives, step, packages)
+            # the MJCF compensates gravity itself (body gravcomp, actuatorgravcomp): MuJoCo gets no second one
+            trace = (simulate(mjcf, [replace(d, gravcomp=False) for d in drives], step) if name == "mujoco"
+                     else simulate(urdf, drives, step, packages))
             wall = time.perf_counter() - t
             totals[name] += wall
             m = metrics(trace, q0, q0 + STEP, "position", effort=drive.effort)
@@ -89,6 +93,20 @@ def main() -> None:
                   f"| {trace.others_max_dev:.2e} | {trace.diverged or ''} |")
     print("totals (wall, s): " + ", ".join(f"{s} {v:.2f}" for s, v in totals.items())
           + f"; all {sum(totals.values()):.2f}")
+    whole_check(robotkit, d)
+
+
+def whole_check(robotkit: Path, robot_dir: Path) -> None:
+    """``robotkit check`` on the build, side by side with its motion stage (the build's own gains,
+    the three simulators in parallel beside the other stages)."""
+    t = time.perf_counter()
+    proc = subprocess.run([str(robotkit), "check", str(robot_dir), "--format", "json"], capture_output=True,
+                          text=True, cwd=REPO)
+    wall = time.perf_counter() - t
+    motion = json.loads(proc.stdout)["motion"][robot_dir.name]
+    sims = ", ".join(f"{s} {v['wall']:.2f} s" for s, v in motion["simulators"].items())
+    print(f"robotkit check {robot_dir.name}: {wall:.2f} s wall (exit {proc.returncode}); its motion stage "
+          f"{motion['wall']:.2f} s ({sims}) running beside the other stages")
 
 
 def fmt(x) -> str:
