@@ -220,6 +220,10 @@ def test_display_launch(run, name):
     from scipy.spatial.transform import Rotation
 
     robot = resolve(load_recipe(RECIPES / f"{name}.yaml"), "ros1")
+    # joint_state_publisher starts at the recipe's home pose (its private ~zeros), the other joints at 0
+    home = dict(robot.home().values) if robot.home() is not None else {}
+    for joint in movable:
+        assert r["joint_states"][joint] == pytest.approx(home.get(joint, 0.0), abs=1e-9), joint
     for link, T in link_poses(robot, r["joint_states"]).items():
         np.testing.assert_allclose(r["tf"][link][:3], T[:3, 3], atol=1e-6, err_msg=link)
         R = Rotation.from_quat(r["tf"][link][3:]).as_matrix()
