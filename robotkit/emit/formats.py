@@ -17,6 +17,7 @@ READS = {
     "rviz": "the resolved robot without inertials, and the facts of its shown meshes (keyword facts)",
     "ros-package": "name, metadata, ros, gazebo, sensors, actuators, worlds, whether there are meshes",
     "structure": "name, ros, gazebo, actuators",
+    "groups": "name, base, joints, link names, poses, and the self-collision matrix",
     "metadata": "name and metadata",
 }
 """What part of the robot an output depends on: what its task hashes and which records it waits for."""

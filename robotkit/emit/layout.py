@@ -27,6 +27,7 @@ ENV_HOOK = {"ros1": "env-hooks/50.{name}.sh.in", "ros2": "hooks/{name}.dsv.in"}
 DISPLAY_LAUNCH = {"ros1": "launch/display.launch", "ros2": "launch/display.launch.py"}
 GAZEBO_LAUNCH = {"ros1": "launch/gazebo.launch", "ros2": "launch/gazebo.launch.py"}
 RVIZ = "rviz/{name}.rviz"
+SRDF = "srdf/{name}.srdf"
 CONTROLLERS = "config/controllers.yaml"
 PICTURES = "report"  # the picture report's folder
 REPORT_HTML = "report/report.html"
@@ -41,7 +42,7 @@ WORLD_FILES = ("model.config", "model.sdf", "meshes/{name}.stl", "{name}.world",
 # the build's records, below OUT/.robotkit/<robot>/; {key} is a mesh key, a proxy key or a link's file stem
 RECORDS = {"mesh": "mesh/{key}.json", "collision": "collision/{key}.json", "visual": "visual/{key}.json",
            "inertial": "inertial/{key}.json", "pictures": "pictures.json",
-           "drives": "drives.json"}
+           "drives": "drives.json", "self-collision": "self_collision.json"}
 
 
 def output_path(template: str | Mapping[str, str], name: str, ros: str = "ros2") -> str:

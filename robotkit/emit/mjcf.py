@@ -280,12 +280,25 @@ def context(robot: Robot, lift: float = 0.0, lift_at=None) -> dict:
     equalities = [{"name": f"{j.name}_mimic", "joint1": j.name, "joint2": j.mimic.joint,
                    "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
                   for j in robot.joints if j.mimic is not None]
-    excludes = [(j.parent, j.child) for j in robot.joints if j.parent != WORLD]
+    collide, excludes = self_contacts(robot)
     keys = keyframes(robot, tree, actuators, lift_at or (lambda values: lift))
-    return {"robot": robot, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "keys": keys,
+    return {"robot": robot, "collide": collide, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "keys": keys,
             "assets": sorted(assets.values(), key=lambda a: a["name"]),
             "materials": robot.materials, "world_geoms": world_geoms, "tree": tree,
             "equalities": equalities}
+
+
+def self_contacts(robot: Robot) -> tuple[bool, list[tuple[str, str]]]:
+    """Whether the robot's geoms collide with each other, and the body pairs excluded: the
+    self-collision matrix's disabled pairs (every one, adjacent ones included: MuJoCo's parent
+    filter does not act on a body welded to the world), on unless the recipe says
+    ``self_collide: false``; without a matrix, only on when asked, the joined pairs excluded."""
+    m = robot.collision_matrix
+    if robot.self_collide is False:
+        return False, []
+    if m is not None:
+        return True, sorted((p.a, p.b) for p in m.disabled())
+    return bool(robot.self_collide), [(j.parent, j.child) for j in robot.joints if j.parent != WORLD]
 
 
 def _touch_volume(link) -> tuple[tuple[float, ...], tuple[float, float, float]]:

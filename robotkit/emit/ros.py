@@ -49,7 +49,7 @@ def folders(robot: Robot) -> list[str]:
     out = [top(layout.URDF)]
     if robot.meshes():
         out.append(layout.MESHES)
-    out += [top(layout.MJCF), top(layout.DISPLAY_LAUNCH["ros2"]), top(layout.RVIZ)]
+    out += [top(layout.MJCF), top(layout.DISPLAY_LAUNCH["ros2"]), top(layout.RVIZ), top(layout.SRDF)]
     if robot.actuators:
         out.append(top(layout.CONTROLLERS))
     if robot.worlds:

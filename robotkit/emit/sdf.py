@@ -23,6 +23,7 @@ from robotkit.emit.sensors import contexts, host_of
 from robotkit.emit.controllers import armature_losses, gravcomp_losses
 from robotkit.emit.sensors import losses as sensor_losses
 from robotkit.geometry import matrix_rpy
+from robotkit.model.selfcollision import solve_masks
 from robotkit.model.robot import Inertial, Pose, Robot
 
 SDF_VERSION = "1.9"
@@ -50,9 +51,37 @@ def losses(robot: Robot) -> list[str]:
             out.append(f"joint '{j.name}': SDF {SDF_VERSION} cannot express mimic joints (SDF 1.11 can); "
                        f"it moves independently of '{j.mimic.joint}' in Gazebo")
     out += armature_losses(robot, "SDF")
+    out += self_collide(robot)[2]
     out += extras_losses(robot, "model.sdf")
     out += gravcomp_losses(robot, "model.sdf's joint controllers (Gazebo Sim)")
     return out + sensor_losses(robot)["sdf"]
+
+
+def self_collide(robot: Robot) -> tuple[bool, dict[str, int], list[str]]:
+    """Gazebo's ``self_collide``, each link's ``collide_bitmask`` and the loss: the self-collision
+    matrix expressed by bit masks (two collisions touch when their masks share a bit; Gazebo itself
+    skips links joined by a joint and the geometry of one link) when 16 bits can, exactly."""
+    m = robot.collision_matrix
+    if robot.self_collide is False or m is None:
+        return bool(robot.self_collide), {}, []
+    carrier = {name: host_of(robot, name)[0] for name in robot.frame_links()}
+    sdf_link = {link.name: carrier.get(link.name, link.name) for link in robot.links}
+    joined = {frozenset((sdf_link[j.parent], sdf_link[j.child])) for j in robot.joints if j.type in JOINT_TYPES}
+    nodes = sorted({n for p in m.pairs for n in (p.a, p.b)} - {"world"})
+    free = {frozenset((p.a, p.b)) for p in m.pairs if sdf_link[p.a] == sdf_link[p.b]
+            or frozenset((sdf_link[p.a], sdf_link[p.b])) in joined}
+    enabled = {frozenset((p.a, p.b)) for p in m.pairs if not p.disabled and "world" not in (p.a, p.b)}
+    masks = solve_masks(nodes, enabled, free) if not enabled & free else None
+    if masks is not None:
+        return True, masks, []
+    fight = sorted(f"{p.a}-{p.b}" for p in m.disabled() if p.reason in ("Default", "Always", "User")
+                   and frozenset((p.a, p.b)) not in free)
+    why = ("16 collide bit masks cannot express the self-collision matrix" if not enabled & free else
+           "the matrix checks links Gazebo never collides (joined by a joint)")
+    pairs = f" (Gazebo would make these disabled pairs fight: {', '.join(fight)})" if fight else ""
+    if robot.self_collide:
+        return True, {}, [f"self_collide: {why}; on with Gazebo's own filter{pairs}"]
+    return False, {}, [f"self-collision is off in model.sdf: {why}{pairs}"]
 
 
 def extras_losses(robot: Robot, where: str) -> list[str]:
@@ -107,6 +136,7 @@ def context(robot: Robot) -> dict:
     for name in sorted(frames):
         host, pose = host_of(robot, name)
         carried.setdefault(host, []).append((robot.link(name), pose))
+    collide, masks, _ = self_collide(robot)
     links = []
     for link in robot.links:
         if link.name in frames or link.name == "world":
@@ -121,16 +151,16 @@ def context(robot: Robot) -> dict:
             else:  # no SDF joint: a free body placed at the joint's pose
                 ctx_pose = ("__model__" if j.parent == "world" else j.parent, j.origin)
         visuals = list(link.visuals) + [_moved(g, pose) for f, pose in carried.get(link.name, []) for g in f.visuals]
-        collisions = list(link.collisions_for("sdf")) + [
-            _moved(g, pose) for f, pose in carried.get(link.name, []) for g in f.collisions_for("sdf")]
+        collisions = [(g, link.name) for g in link.collisions_for("sdf")] + [
+            (_moved(g, pose), f.name) for f, pose in carried.get(link.name, []) for g in f.collisions_for("sdf")]
         links.append({
             "name": link.name,
             "pose": ctx_pose,
             "sensors": [s for s in sensors if s["host"] == link.name],
             "visuals": [dict(geom_context(robot, g), uri=_uri(robot, g),
                              material=materials.get(g.material)) for g in visuals],
-            "collisions": [dict(geom_context(robot, g, "collision"), uri=_uri(robot, g, "collision"))
-                           for g in collisions],
+            "collisions": [dict(geom_context(robot, g, "collision"), uri=_uri(robot, g, "collision"),
+                                bitmask=masks.get(owner)) for g, owner in collisions],
             # a massless link SDF must keep a link (welded to the world, or moved by a joint): the
             # URDF emitter's explicit massless inertial, else Gazebo and Drake give it 1 kg
             "inertial": link.inertial if link.inertial is not None else Inertial(MASSLESS, (0.0, 0.0, 0.0),
@@ -143,7 +173,7 @@ def context(robot: Robot) -> dict:
                   for j in robot.joints if j.child in frames]
     if anchor is not None:
         frame_list.insert(0, {"name": robot.root, "attached_to": anchor, "origin": None})
-    return {"robot": robot, "version": SDF_VERSION, "links": links, "joints": joints, "frames": frame_list,
+    return {"robot": robot, "self_collide": collide, "version": SDF_VERSION, "links": links, "joints": joints, "frames": frame_list,
             "specular": SPECULAR, "controllers": controller_contexts(robot, names)}
 
 

@@ -79,6 +79,8 @@ def summary(robot: Robot, facts: dict) -> dict:
         out["actuators"] = json.loads(robot.drive_report)
     if robot.poses:
         out["poses"] = {p.name: dict(p.values) for p in robot.poses}
+    if robot.collision_matrix is not None:  # robotkit.model.selfcollision
+        out["self_collision"] = robot.collision_matrix.to_json()
     return out
 
 

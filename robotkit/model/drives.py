@@ -1,4 +1,4 @@
-"""The recipe's drives and named poses, resolved: actuators on joints that can carry them (the
+"""The recipe's drives, named poses and self-collision settings, resolved: actuators on joints that can carry them (the
 motor's reflected inertia folded into the joint's armature) and poses within the joints' limits.
 
 The gains of ``gains: auto`` are not known here (they need the robot's inertials): the tuner
@@ -12,6 +12,7 @@ from typing import Callable
 
 from robotkit.errors import short_number
 from robotkit.model.robot import Actuator, Dynamics, Joint, NamedPose
+from robotkit.model.selfcollision import Settings
 
 Report = Callable[[tuple, str], None]
 ACTUATED = ("revolute", "continuous", "prismatic")
@@ -92,3 +93,24 @@ def resolve_poses(report: Report, poses: dict, joints: list[Joint]) -> list[Name
                 kept.append((joint, float(value)))
         out.append(NamedPose(pose_name, tuple(kept)))
     return out
+
+
+def resolve_settings(report, spec, link_names: list[str]) -> Settings:
+    """The recipe's ``self_collision`` checked: pairs name two different existing links, and no
+    pair is both allowed and checked.  ``report(path, message)`` collects the problems."""
+    pairs: dict[str, list[tuple]] = {"allow": [], "check": []}
+    for kind in ("allow", "check"):
+        for i, entry in enumerate(getattr(spec, kind)):
+            a, b = entry[0], entry[1]
+            bad = [n for n in (a, b) if n not in link_names]
+            for n in bad:
+                report(("self_collision", kind, i), unknown_name("link", n, link_names))
+            if not bad and a == b:
+                report(("self_collision", kind, i), f"a pair names two links; '{a}' is named twice")
+            elif not bad:
+                pairs[kind].append((*sorted((a, b)), entry[2] if len(entry) > 2 else ""))
+    allowed = {p[:2] for p in pairs["allow"]}
+    for i, p in enumerate(pairs["check"]):
+        if p[:2] in allowed:
+            report(("self_collision", "check", i), f"pair '{p[0]}', '{p[1]}' is also in self_collision.allow")
+    return Settings(spec.samples, spec.seed, tuple(pairs["allow"]), tuple(p[:2] for p in pairs["check"]))

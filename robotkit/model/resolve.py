@@ -23,7 +23,7 @@ from robotkit import presets
 from robotkit.errors import Problem, RecipeError, display_path
 from robotkit.geometry import matrix_rpy
 from robotkit.model import inertia_policy, massprops
-from robotkit.model.drives import resolve_actuators, resolve_poses, unknown_name
+from robotkit.model.drives import resolve_actuators, resolve_poses, resolve_settings, unknown_name
 from robotkit.model.massprops import Bounding, bounding_primitive, combine
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
@@ -153,6 +153,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
     joints += extra_joints
     actuators, joints = resolve_actuators(cx.report, cx.r.actuators, joints)
     poses = resolve_poses(cx.report, cx.r.poses, joints)
+    collision = resolve_settings(cx.report, cx.r.self_collision, [link.name for link in links])
     worlds = _worlds(cx)
     ros, gazebo = _ros_and_gazebo(cx, ros)
     link_names = [link.name for link in links]
@@ -162,7 +163,8 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
     if cx.problems:
         raise RecipeError(cx.problems)
     return Robot(r.robot, tuple(links), tuple(joints), materials, _metadata(r.metadata), r.self_collide,
-                 tuple(r.urdf_extras), tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base, tuple(poses))
+                 tuple(r.urdf_extras), tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base, tuple(poses),
+                 self_collision=collision)
 
 
 def _safe_name(src: str) -> str:

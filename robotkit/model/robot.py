@@ -19,6 +19,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from robotkit.geometry import rpy_matrix
+from robotkit.model.selfcollision import Matrix, Settings
 
 Vec3 = tuple[float, float, float]
 
@@ -284,7 +285,7 @@ class Robot:
     joints: tuple[Joint, ...] = ()
     materials: tuple[Material, ...] = ()
     metadata: Metadata = field(default_factory=Metadata)
-    self_collide: bool = False
+    self_collide: bool | None = None  # None: on where the format expresses the matrix
     urdf_extras: tuple[str, ...] = ()
     worlds: tuple[World, ...] = ()
     sensors: tuple[Sensor, ...] = ()
@@ -294,6 +295,8 @@ class Robot:
     base: str = "fixed"
     poses: tuple[NamedPose, ...] = ()
     drive_report: str = ""  # JSON: robotkit.model.gains.tune's report, once the build has tuned the drives
+    self_collision: Settings = Settings()
+    collision_matrix: Matrix | None = None  # once the build has sampled it (robotkit.model.selfcollision)
 
     def home(self) -> NamedPose | None:
         """The pose the robot starts in: ``home``, else the first pose, else None (all zero)."""

@@ -27,7 +27,8 @@ from robotkit.mesh.cache import Cache, plain
 from robotkit.mesh.export import obj_bytes, stl_bytes
 from robotkit.mesh.inertia import hull_points, mesh_mass_properties
 from robotkit.mesh.io import load_mesh, read_vertices, volume_mesh
-from robotkit.model import gains
+from robotkit.model import gains, selfcollision
+from robotkit.model.robot import Inertial
 from robotkit.model.resolve import (compute_inertial, finalize, finalize_link_inertial, inertial_from_json,
                                     inertial_to_json)
 from robotkit.picture import report_build_dir
@@ -37,6 +38,7 @@ from robotkit.world import build_world
 
 FACTS_VERSION = 4  # 3: sources relative to the recipe (no absolute or working-folder paths); 4: hull points
 DRIVES_VERSION = 1
+SELF_COLLISION_VERSION = 1
 
 
 def _user_errors_fail(fn):
@@ -137,12 +139,44 @@ def tune_drives(robot, inertial_paths: dict[str, str], target: str):
     write_if_changed(target, dump_json(gains.tune(replace(robot, links=links))))
 
 
-def with_drives(robot, path: str | None):
-    """``robot`` with the tuner's gains of the record at ``path`` (None: as it is)."""
+def with_drives(robot, path: str | None, matrix: str | None = None):
+    """``robot`` with the tuner's gains of the record at ``path`` and the self-collision matrix of
+    the record at ``matrix`` (None: as it is)."""
+    if matrix:
+        with open(matrix, encoding="utf-8") as f:
+            robot = selfcollision.apply(robot, selfcollision.Matrix.from_json(json.load(f)))
     if not path:
         return robot
     with open(path, encoding="utf-8") as f:
         return gains.apply(robot, json.load(f))
+
+
+@_user_errors_fail
+def self_collision(robot, fact_paths: dict[str, str], meshes: str, target: str):
+    """The self-collision matrix (robotkit.model.selfcollision) on the MJCF's collision geometry
+    (the files below ``meshes``), cached by content: the MJCF without its inertials (geometry
+    only: every link gets the same placeholder, so a density edit does not resample), the mesh
+    files it reads, the settings."""
+    from robotkit.emit.mjcf import collision_meshes, render_mjcf
+
+    placeholder = {link.name: Inertial(1.0, (0.0, 0.0, 0.0), (1e-3, 0.0, 0.0, 1e-3, 0.0, 1e-3)) for link in robot.links}
+    full = replace(finalize(robot, read_facts(fact_paths), placeholder), self_collide=False, collision_matrix=None,
+                   actuators=(), sensors=())
+    files = collision_meshes(full)
+    xml = render_mjcf(full, points={rel: read_vertices(os.path.join(meshes, rel)) for rel in files})
+    geometry = "\n".join(line for line in xml.splitlines() if "<inertial " not in line)
+    settings = full.self_collision
+    params = {"samples": settings.samples, "seed": settings.seed, "allow": [list(p) for p in settings.allow],
+              "check": [list(p) for p in settings.check], "version": SELF_COLLISION_VERSION,
+              "clearance": selfcollision.CLEARANCE}
+
+    def compute():
+        matrix = selfcollision.classify(selfcollision.Sampler(xml, meshdir=meshes), settings)
+        return [], matrix.to_json()
+
+    inputs = [geometry] + [Path(meshes, rel).read_bytes() for rel in files]
+    _, info = _cache().get_or_compute("self-collision", params, inputs, compute)
+    write_if_changed(target, dump_json(info))
 
 
 @_user_errors_fail
@@ -156,7 +190,8 @@ def emit(name: str, robot, fact_paths: dict[str, str], inertial_paths: dict[str,
     robot that their consumers would refuse (a moving link without mass...): ConsumerError, naming the
     link (``where``: link -> recipe location)."""
     fmt = FORMATS[name]
-    full = with_drives(robot if how.get("raw") else _finalized(robot, fact_paths, inertial_paths), how.get("drives"))
+    full = with_drives(robot if how.get("raw") else _finalized(robot, fact_paths, inertial_paths), how.get("drives"),
+                       how.get("matrix"))
     if fmt.consumed:
         problems = [Problem(msg, **(where or {}).get(link, {}))
                     for link, msg, formats in full.consumer_problems() if name in formats]

@@ -87,6 +87,12 @@ class Place:
         return self.record("drives", "") if self.robot.actuators else None
 
     @property
+    def matrix(self) -> str | None:
+        """The self-collision matrix's record, for a robot with two links with collision geometry."""
+        solid = [link for link in self.robot.links if link.collisions_for("mjcf")]
+        return self.record("self-collision", "") if len(solid) >= 2 else None
+
+    @property
     def inertials(self) -> dict[str, str]:
         """Link -> its inertial, for the links whose inertial a task computes."""
         return {link.name: self.record("inertial", file_stem(link.name)) for link in self.robot.links
@@ -108,7 +114,8 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     files = visual_tasks(place) + copy_tasks(place) + convert_tasks(place)  # the mesh files below meshes/
     textures = texture_tasks(place)
     outputs = output_tasks(place, [t["targets"][0] for t in files])
-    tasks = meshes + collisions + files + textures + inertial_tasks(place) + drive_tasks(place) + outputs
+    tasks = meshes + collisions + files + textures + inertial_tasks(place) + drive_tasks(place)
+    tasks += self_collision_tasks(place, [t["targets"][0] for t in files]) + outputs
     if report:
         tasks.append(report_task(place, collisions + files + textures, meshes))
     return tasks + world_tasks(robot, out_dir)
@@ -289,6 +296,29 @@ def drive_tasks(place: Place) -> list[dict]:
     }]
 
 
+def self_collision_tasks(place: Place, written: list[str]) -> list[dict]:
+    """``<robot>:self-collision``: the self-collision matrix (:mod:`robotkit.model.selfcollision`)
+    on the MJCF's collision geometry (the collision pieces' records and the mesh files written)."""
+    robot, target = place.robot, place.matrix
+    if target is None:
+        return []
+    facts = {**place.facts, **place.proxies}
+    geometry = {k: v for k, v in robot.to_dict().items() if k in ("name", "joints", "base", "poses", "self_collision")}
+    geometry["links"] = [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
+                         for link in robot.to_dict()["links"]]
+    return [{
+        "name": f"{robot.name}:self-collision",
+        "doc": "self-collision matrix",
+        "actions": [(actions.self_collision, [robot, facts, place.out(layout.MESHES), target])],
+        "file_dep": list(facts.values()) + written
+        + template_files(("mjcf/robot.xml.j2",)),
+        "targets": [target],
+        "uptodate": [config_changed({"robot": geometry, "version": actions.SELF_COLLISION_VERSION})],
+        "task_dep": [f"{robot.name}:mesh:{k}" for k in place.facts],
+        "clean": True,
+    }]
+
+
 class Reading(NamedTuple):
     """What an output's task gives its action and hashes, for one kind of ``reads``
     (:data:`robotkit.emit.formats.READS`)."""
@@ -300,6 +330,7 @@ class Reading(NamedTuple):
     raw: bool = False  # rendered from the resolved robot, not the finalized one
     with_facts: bool = False  # the render gets the mesh facts (keyword facts)
     drives: str | None = None  # the tuner's record: gains applied before rendering
+    matrix: str | None = None  # the self-collision matrix's record: applied before rendering
 
 
 def readings(place: Place) -> dict[str, Reading]:
@@ -313,11 +344,12 @@ def readings(place: Place) -> dict[str, Reading]:
     package.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds], meshes=bool(robot.meshes()))
     no_inertials = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
                                            for link in structure["links"]]}
-    drives = place.drives
+    drives, matrix = place.drives, place.matrix
     return {
         "robot": Reading(robot, structure, {**{k: facts[k] for k in recentered}, **proxies}, inertials,
-                         drives=drives),
-        "summary": Reading(robot, structure, {**facts, **proxies}, inertials, with_facts=True, drives=drives),
+                         drives=drives, matrix=matrix),
+        "summary": Reading(robot, structure, {**facts, **proxies}, inertials, with_facts=True, drives=drives,
+                           matrix=matrix),
         # the visual geometry's extent, the sensors' topics: no inertial
         "rviz": Reading(robot, no_inertials, {k: facts[k] for k in shown_meshes(robot) if k in facts}, {},
                         raw=True, with_facts=True),
@@ -326,6 +358,9 @@ def readings(place: Place) -> dict[str, Reading]:
                                      "actuators": [asdict(a) for a in robot.actuators],
                                      "poses": [asdict(p) for p in robot.poses]}, {}, {}, raw=True,
                              drives=drives if any(a.auto for a in robot.actuators) else None),
+        "groups": Reading(robot, {"name": robot.name, "base": robot.base, "poses": [asdict(p) for p in robot.poses],
+                                  "joints": [asdict(j) for j in robot.joints],
+                                  "links": [link.name for link in robot.links]}, {}, {}, raw=True, matrix=matrix),
         "metadata": Reading(replace(robot, links=(), joints=(), materials=()),
                             {"name": robot.name, "metadata": asdict(robot.metadata)}, {}, {}),
     }
@@ -341,7 +376,7 @@ def output_tasks(place: Place, written: list[str]) -> list[dict]:
 def output_task(place: Place, fmt: Format, reading: Reading, written: list[str]) -> dict:
     robot = place.robot
     target = place.out(fmt.path)
-    how = {"raw": reading.raw, "facts": reading.with_facts, "drives": reading.drives,
+    how = {"raw": reading.raw, "facts": reading.with_facts, "drives": reading.drives, "matrix": reading.matrix,
            "meshes": place.out(layout.MESHES) if fmt.points is not None else None}
     options = {**fmt.options, **{k: True for k, v in how.items() if v}}  # hashed with the robot's values
     return {
@@ -350,7 +385,7 @@ def output_task(place: Place, fmt: Format, reading: Reading, written: list[str])
         "actions": [(actions.emit, [fmt.name, reading.robot, reading.facts, reading.inertials, target, how,
                                     {k[5:]: v for k, v in place.where.items() if k.startswith("link:")}])],
         "file_dep": list(reading.facts.values()) + list(reading.inertials.values()) + template_files(fmt.templates)
-        + (written if fmt.points is not None else []) + ([reading.drives] if reading.drives else []),
+        + (written if fmt.points is not None else []) + [r for r in (reading.drives, reading.matrix) if r],
         "targets": [target],
         "uptodate": [config_changed({"robot": reading.config, "options": options})],
         # no output is written while any mesh of the robot fails

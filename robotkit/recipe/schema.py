@@ -774,6 +774,19 @@ class Part(Strict):
     """Nested instances of parts, placed in this part's links."""
 
 
+class SelfCollision(Strict):
+    """How the self-collision matrix is found: MoveIt Setup Assistant's classification (Adjacent, Default, Always, Never) over configurations sampled uniformly within the joint limits (docs/selfcollision.md)."""
+
+    samples: Annotated[int, Field(gt=0, le=10_000_000)] = 10000
+    """Configurations sampled (MoveIt's default density; the examples' matrices are the same at 100,000)."""
+    seed: Annotated[int, Field(ge=0)] = 0
+    """Seed of the sampler: the same seed gives the same matrix."""
+    allow: list[Annotated[list[str], Field(min_length=2, max_length=3)]] = []
+    """Link pairs allowed to touch, never checked (SRDF reason ``User``): ``[a, b]`` or ``[a, b, why]``."""
+    check: list[Annotated[list[str], Field(min_length=2, max_length=2)]] = []
+    """Link pairs always checked, whatever the sampling found: ``[a, b]``."""
+
+
 class Recipe(Strict):
     """A robot recipe: the one source of truth for a robot description."""
 
@@ -793,8 +806,10 @@ class Recipe(Strict):
     """Mesh processing defaults: repair, visual decimation, collision strategy."""
     measured_mass: PositiveMass | None = None
     """The robot's total mass as weighed, in kg; `robotkit check` compares it with the sum of the links' masses."""
-    self_collide: bool = False
-    """Whether the robot's links collide with each other (Gazebo's ``self_collide``; MJCF contact filtering). Links joined by a joint never collide."""
+    self_collide: bool | None = None
+    """Whether the robot's links collide with each other in the simulators. Default: yes, filtered by the self-collision matrix (``self_collision``), in every format that can express the matrix (MJCF ``<exclude>``s; SDF collide bit masks when a set of 16 expresses it exactly; otherwise off there, and report.json says which pairs Gazebo would have made fight). ``false``: off everywhere (the SRDF still carries the matrix); ``true``: on everywhere, in the SDF with Gazebo's own filter (joined links) where masks cannot express the matrix."""
+    self_collision: SelfCollision = SelfCollision()
+    """The self-collision matrix (``srdf/<robot>.srdf``, the MJCF's excludes, the SDF's bit masks): how many configurations to sample and which pairs to force out of or into checking."""
     urdf_extras: list[XmlElement] = []
     """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
     metadata: Metadata = Metadata()

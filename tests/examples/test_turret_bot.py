@@ -146,7 +146,7 @@ def test_first_build_runs_every_task_once_then_nothing(project):
         "turret_bot:urdf", "turret_bot:sdf", "turret_bot:mjcf", "turret_bot:mjcf-scene", "turret_bot:report",
         "turret_bot:model.config", "turret_bot:package.xml", "turret_bot:CMakeLists.txt",
         "turret_bot:controllers", "turret_bot:xacro", "turret_bot:env-hook", "turret_bot:display-launch",
-        "turret_bot:gazebo-launch", "turret_bot:rviz"])
+        "turret_bot:gazebo-launch", "turret_bot:rviz", "turret_bot:self-collision", "turret_bot:srdf"])
     second = build([project / "turret_bot.yaml"], out)
     assert second.ran == []
     assert sorted(second.uptodate) == sorted(first.ran)
@@ -184,7 +184,7 @@ def test_changing_one_mesh_file_reruns_only_what_depends_on_it(project):
     assert sorted(again.ran) == sorted([
         next(n for n in again.uptodate + again.ran if n.startswith("turret_bot:mesh:slider")),
         "turret_bot:copy:slider.stl", "turret_bot:convert:collision/slider.obj", "turret_bot:inertial:slider",
-        "turret_bot:drives", "turret_bot:urdf", "turret_bot:sdf",
+        "turret_bot:drives", "turret_bot:urdf", "turret_bot:sdf", "turret_bot:self-collision", "turret_bot:srdf",
         "turret_bot:mjcf", "turret_bot:report", "turret_bot:xacro", "turret_bot:rviz"])  # rviz: the robot's extent
 
 

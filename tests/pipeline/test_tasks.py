@@ -57,7 +57,8 @@ def test_task_names_one_per_unit_of_work_and_one_per_format(bot):
     [key] = robot.meshes()
     # the arm collides with its visual mesh: converted to OBJ for every format
     assert names == [f"bot:mesh:{key}", "bot:copy:slider.stl", "bot:convert:collision/slider.obj",
-                     "bot:inertial:base", "bot:inertial:arm", "bot:drives", *(f"bot:{name}" for name in FORMATS)]
+                     "bot:inertial:base", "bot:inertial:arm", "bot:drives", "bot:self-collision",
+                     *(f"bot:{name}" for name in FORMATS)]
 
 
 def test_targets_below_the_staged_robot_folder_and_the_records(bot):
@@ -87,16 +88,22 @@ def test_file_deps_name_the_records_templates_and_mesh_files_each_output_reads(b
     assert t["bot:inertial:base"]["file_dep"] == []
     drives = str(state / "drives.json")  # the actuators' gains and checks, from every inertial
     assert t["bot:drives"]["file_dep"] == inertials and t["bot:drives"]["targets"] == [drives]
+    matrix = str(state / "self_collision.json")  # the self-collision matrix, on the MJCF's collision geometry
+    collide = t["bot:self-collision"]
+    assert collide["targets"] == [matrix] and collide["file_dep"] == [facts, *(  # geometry only, no inertial
+        t["bot:copy:slider.stl"]["targets"] + t["bot:convert:collision/slider.obj"]["targets"])] + [
+        str(Path(collide["file_dep"][-1]))] and collide["file_dep"][-1].endswith("robot.xml.j2")
     urdf = t["bot:urdf"]["file_dep"]
     assert urdf[:2] == inertials and [Path(p).name for p in urdf[2:]] == ["robot.urdf.j2", "sdf.j2", "classic.j2",
-                                                                          "drives.json"]
-    assert t["bot:report"]["file_dep"] == [facts, *inertials, drives]  # every fact and inertial, no template
+                                                                          "drives.json", "self_collision.json"]
+    assert t["bot:report"]["file_dep"] == [facts, *inertials, drives, matrix]  # every fact and inertial
+    assert [Path(p).name for p in t["bot:srdf"]["file_dep"]] == ["robot.srdf.j2", "self_collision.json"]
     assert t["bot:rviz"]["file_dep"] == [facts]  # the visual mesh's extent: no inertial
     assert [Path(p).name for p in t["bot:package.xml"]["file_dep"]] == ["package.xml.j2"]
     assert t["bot:controllers"]["file_dep"] == []
     mjcf = t["bot:mjcf"]["file_dep"]  # the MJCF measures the mesh files written beside it
-    assert mjcf[-3:] == (t["bot:copy:slider.stl"]["targets"] + t["bot:convert:collision/slider.obj"]["targets"]
-                         + t["bot:drives"]["targets"])
+    assert mjcf[-4:] == (t["bot:copy:slider.stl"]["targets"] + t["bot:convert:collision/slider.obj"]["targets"]
+                         + t["bot:drives"]["targets"] + [matrix])
     assert t["bot:convert:collision/slider.obj"]["file_dep"] == [robot.meshes()[key].source, facts]
     for fmt in FORMATS.values():  # no output before every mesh task succeeded
         assert t[f"bot:{fmt.name}"]["task_dep"] == [f"bot:mesh:{key}"]
@@ -123,8 +130,11 @@ def test_config_changed_holds_exactly_what_each_output_reads(bot):
     assert {k: controllers["actuators"][0][k] for k in ("joint", "interface", "p", "i", "d", "auto")} == {
         "joint": "j1", "interface": "position", "p": 10.0, "i": 0.0, "d": 1.0, "auto": False}
     assert config(t["bot:controllers"])["options"] == {"raw": True}  # given gains: not the drives' record
-    assert config(t["bot:mjcf"])["options"] == {"meshes": True, "drives": True}
-    assert config(t["bot:report"])["options"] == {"facts": True, "drives": True}
+    assert config(t["bot:mjcf"])["options"] == {"meshes": True, "drives": True, "matrix": True}
+    assert config(t["bot:report"])["options"] == {"facts": True, "drives": True, "matrix": True}
+    assert set(config(t["bot:srdf"])["robot"]) == {"name", "base", "poses", "joints", "links"}
+    assert set(config(t["bot:self-collision"])["robot"]) == {"name", "links", "joints", "base", "poses",
+                                                             "self_collision"}
     assert config(t["bot:rviz"])["options"] == {"raw": True, "facts": True}
     rviz_links = config(t["bot:rviz"])["robot"]["links"]
     assert rviz_links and not any("inertial" in link or "inertial_spec" in link for link in rviz_links)
