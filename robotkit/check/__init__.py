@@ -17,6 +17,7 @@ from pathlib import Path
 from robotkit import urdfxml
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.equivalence import equivalence
+from robotkit.check.selfcollision import interference
 from robotkit.check.findings import Finding
 from robotkit.check.kinematics import read_mjcf, read_sdf
 from robotkit.check.lints import LinkFacts, lint, lint_link, read_urdf_facts
@@ -165,6 +166,7 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
                 + [Finding("warning", "simulation", subject, n, "MuJoCo scene mjcf/scene.xml") for n in notes])
 
     findings += _stage("simulation", subject, simulate)
+    findings += _stage("self-collision", subject, lambda: interference(robot_dir))
     return findings + unreported_missing(findings, finish_motion(started, subject, name, motion))
 
 

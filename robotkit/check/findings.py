@@ -8,7 +8,7 @@ from robotkit.errors import display_path
 
 SEVERITIES = ("error", "warning")
 STAGES = ("check_urdf", "ign sdf -k", "mujoco", "equivalence", "consumer", "consumers", "simulation", "build",
-          "input", "motion")
+          "input", "motion", "self-collision")
 """The checks that are stages; every other rule is a physics lint (robotkit.check.lints)."""
 
 

@@ -199,6 +199,73 @@ class Sampler:
         return np.column_stack([np.repeat(which, counts), bodies]), np.concatenate(dists)
 
 
+class Approach:
+    """The closest approach of one link pair, searched: the distance between their collision
+    geoms (``mj_geomDistance``) minimised over the joints on the tree path between them, by a
+    pattern search from the closest of the first samples.  Sampling alone misses collisions that
+    need several joints just so (two diagonal legs' shins); this finds them."""
+
+    STARTS, FIRST, ROUNDS = 2, 128, 40
+
+    def __init__(self, sampler: Sampler, a: int, b: int):
+        m = sampler.model
+        self.sampler = sampler
+        solid = (m.geom_contype > 0)
+        self.pairs = [(int(g1), int(g2)) for g1 in np.flatnonzero((m.geom_bodyid == a) & solid)
+                      for g2 in np.flatnonzero((m.geom_bodyid == b) & solid)]
+        path = _path_bodies(m, a) ^ _path_bodies(m, b)
+        space = sampler.space
+        self.cols = [i for i, addr in enumerate(space.addr)
+                     if int(m.jnt_bodyid[_joint_at(m, addr)]) in path]
+
+    def distance(self, q: np.ndarray) -> float:
+        s = self.sampler
+        s.data.qpos[:] = s.space.follow(q.copy())
+        s._mujoco.mj_kinematics(s.model, s.data)
+        return min(s._mujoco.mj_geomDistance(s.model, s.data, g1, g2, 10.0, None) for g1, g2 in self.pairs)
+
+    def closest(self, samples: np.ndarray) -> float:
+        """The smallest distance found (negative: a collision exists)."""
+        if not self.pairs or not self.cols:
+            return float("inf")
+        first = samples[: self.FIRST]
+        ranked = sorted(range(len(first)), key=lambda i: self.distance(first[i]))
+        return min(self._descend(first[i].copy()) for i in ranked[: self.STARTS])
+
+    def _descend(self, q: np.ndarray) -> float:
+        space = self.sampler.space
+        best = self.distance(q)
+        step = 0.1 * (space.hi - space.lo)
+        for _ in range(self.ROUNDS):
+            if best < 0:
+                break
+            moved = False
+            for i in self.cols:
+                for sign in (1.0, -1.0):
+                    trial = q.copy()
+                    trial[space.addr[i]] = np.clip(q[space.addr[i]] + sign * step[i], space.lo[i], space.hi[i])
+                    d = self.distance(trial)
+                    if d < best:
+                        q, best, moved = trial, d, True
+                        break
+            if not moved:
+                step = step / 2
+        return best
+
+
+def _path_bodies(model, body: int) -> set[int]:
+    """``body`` and its ancestors (the world excluded)."""
+    out = set()
+    while body > 0:
+        out.add(body)
+        body = int(model.body_parentid[body])
+    return out
+
+
+def _joint_at(model, qposadr: int) -> int:
+    return int(np.flatnonzero(model.jnt_qposadr == qposadr)[0])
+
+
 class JointSpace:
     """The sampled joints of a compiled model: their qpos addresses and ranges (a continuous
     hinge over one turn), the mimic couplings (joint equalities), the named poses (keyframes)."""
@@ -314,6 +381,9 @@ def classify(sampler: Sampler, settings: Settings) -> Matrix:
     np.minimum.at(closest, key, dist)
     untouched = {(a, b) for a, b in _pairs(sampler) if not np.isfinite(closest[a * nb + b])}
     near = sampler.near(samples, untouched) if untouched else set()
+    for a, b in sorted(untouched - near):  # never near in the samples: search their closest approach
+        if Approach(sampler, a, b).closest(samples) < CLEARANCE:
+            near.add((a, b))
     at_zero = sampler.colliding(space.zero())
     allow = {frozenset(p[:2]): p[2] for p in settings.allow}
     check = {frozenset(p) for p in settings.check}
