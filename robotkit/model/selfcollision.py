@@ -44,6 +44,8 @@ same at 10,000 and 100,000 samples and for seeds 0 to 4 (docs/selfcollision.md).
 TOUCH = 1e-4
 """m: the penetration below which two geoms resting on each other count as touching, not in
 collision (the interference check's tolerance)."""
+SEARCH_ONLY = 20
+"""Up to this many pairs never in contact, each is searched (:class:`Approach`) without a second sweep."""
 REASONS = ("Adjacent", "User", "Default", "Always", "Never")
 
 
@@ -380,8 +382,10 @@ def classify(sampler: Sampler, settings: Settings) -> Matrix:
     closest = np.full(nb * nb, np.inf)
     np.minimum.at(closest, key, dist)
     untouched = {(a, b) for a, b in _pairs(sampler) if not np.isfinite(closest[a * nb + b])}
-    near = sampler.near(samples, untouched) if untouched else set()
-    for a, b in sorted(untouched - near):  # never near in the samples: search their closest approach
+    # pairs never in contact: near in a sample (a second sweep with the clearance as margin, worth
+    # its cost when many pairs would otherwise each be searched), else by a searched closest approach
+    near = sampler.near(samples, untouched) if len(untouched) > SEARCH_ONLY else set()
+    for a, b in sorted(untouched - near):
         if Approach(sampler, a, b).closest(samples) < CLEARANCE:
             near.add((a, b))
     at_zero = sampler.colliding(space.zero())
