@@ -17,7 +17,7 @@ from pathlib import Path
 from robotkit import urdfxml
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.equivalence import equivalence
-from robotkit.check.selfcollision import interference
+from robotkit.check.selfcollision import interference, mjcf_interference
 from robotkit.check.findings import Finding
 from robotkit.check.kinematics import read_mjcf, read_sdf
 from robotkit.check.lints import LinkFacts, lint, lint_link, read_urdf_facts
@@ -211,7 +211,9 @@ def check_model_file(path: Path, kind: str, motion: dict | None = None) -> list[
     if invalid:
         return locate(invalid, path)
     started = start_motion(path, None, {})
-    findings = _inertial_lints(path, kind) + finish_motion(started, f"robot '{path.stem}'", path.stem, motion)
+    findings = _inertial_lints(path, kind)
+    findings += _stage("self-collision", f"robot '{path.stem}'", lambda: mjcf_interference(path))
+    findings += finish_motion(started, f"robot '{path.stem}'", path.stem, motion)
     return locate(findings, path)
 
 

@@ -53,6 +53,42 @@ def interference(robot_dir: Path) -> list[Finding]:
     return findings + fresh_sample(sampler, disabled, seed + 1, where)
 
 
+def mjcf_interference(path: Path) -> list[Finding]:
+    """Interference of a foreign MJCF: its own filter (contype/conaffinity, excludes, explicit
+    pairs, MuJoCo's parent filter) says which pairs are disabled; its keyframes are the poses."""
+    sampler = Sampler(path=str(path))
+    disabled = {p: "MJCF filter" for p in own_filter(path, sampler)}
+    return at_poses(sampler, disabled, str(path)) + sweeps(sampler, disabled)
+
+
+def own_filter(path: Path, sampler: Sampler) -> set[frozenset]:
+    """The link pairs (of bodies with colliding geoms) MuJoCo never collides in the file as written."""
+    from robotkit.mj import load
+
+    mujoco = load()
+    m = mujoco.MjModel.from_xml_path(str(path))
+    weld, parent = m.body_weldid, m.body_parentid
+    excluded = {int(s) for s in m.exclude_signature}
+    paired = {frozenset((int(m.geom_bodyid[a]), int(m.geom_bodyid[b]))) for a, b in zip(m.pair_geom1, m.pair_geom2)}
+    filterparent = not m.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
+
+    def collides(a: int, b: int) -> bool:
+        if frozenset((a, b)) in paired:
+            return True
+        wa, wb = int(weld[a]), int(weld[b])
+        if wa == wb or ((min(a, b) << 16) + max(a, b)) in excluded:
+            return False
+        if filterparent and wa and wb and (wa == weld[parent[wb]] or wb == weld[parent[wa]]):
+            return False
+        ga, gb = np.flatnonzero(m.geom_bodyid == a), np.flatnonzero(m.geom_bodyid == b)
+        return any((m.geom_contype[g] & m.geom_conaffinity[h]) or (m.geom_contype[h] & m.geom_conaffinity[g])
+                   for g in ga for h in gb)
+
+    bodies = sorted(sampler.has_geoms)
+    return {frozenset((sampler.names[a], sampler.names[b])) for i, a in enumerate(bodies) for b in bodies[i + 1:]
+            if not collides(a, b)}
+
+
 def _mm(depth: float) -> str:
     return f"{depth * 1000:.3g} mm"
 

@@ -125,7 +125,10 @@ class Sampler:
             g.contype, g.conaffinity, g.margin, g.gap = int(on), int(on), 0.0, 0.0
         for b in spec.bodies[1:]:  # geometry only: any positive mass compiles
             b.explicitinertial, b.mass, b.ipos = True, 1.0, [0, 0, 0]
-            b.fullinertia = [1e-3, 1e-3, 1e-3, 0, 0, 0]
+            if np.isnan(b.fullinertia[0]):  # the file's own form: a diagonal, or a full tensor
+                b.inertia = [1e-3] * 3
+            else:
+                b.fullinertia = [1e-3, 1e-3, 1e-3, 0, 0, 0]
         model = spec.compile()
         self.names = [model.body(i).name for i in range(model.nbody)]
         self.has_geoms = {int(b) for b in model.geom_bodyid[(model.geom_contype | model.geom_conaffinity) > 0]}
