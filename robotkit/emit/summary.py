@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 
 from robotkit.emit import layout, mjcf, ros, sdf
-from robotkit.emit.controllers import armature_losses, gravcomp_losses
+from robotkit.emit.controllers import armature_losses, gravcomp_losses, joints_phrase
 from robotkit.emit.formats import Format
 from robotkit.emit.sensors import host_of
 from robotkit.emit.urdf import massless_mass, typed_transmissions
@@ -28,7 +28,21 @@ def urdf_losses(robot: Robot) -> list[str]:
 
 def losses(robot: Robot, facts: dict) -> dict[str, list[str]]:
     return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts),
-            "package": ros.losses(robot) + gravcomp_losses(robot, "the ros_control controllers (controllers.yaml)")}
+            "package": ros.losses(robot) + gravcomp_losses(robot, "the ros_control controllers (controllers.yaml)")
+            + matrix_losses(robot)}
+
+
+def matrix_losses(robot: Robot) -> list[str]:
+    """The links whose URDF and SDF collision geometry is not the MJCF's, on which the
+    self-collision matrix was sampled (robotkit.model.selfcollision)."""
+    if robot.collision_matrix is None:
+        return []
+    differ = [link.name for link in robot.links
+              if any(link.collisions_for(fmt) != link.collisions_for("mjcf") for fmt in ("urdf", "sdf"))]
+    if not differ:
+        return []
+    return [f"link{joints_phrase(differ)[len('joint'):]}: the self-collision matrix (srdf, model.sdf's masks) "
+            "was sampled on the MJCF's collision geometry, which differs from the URDF's and SDF's here"]
 
 
 def consumers(robot: Robot) -> dict:
