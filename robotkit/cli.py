@@ -240,6 +240,9 @@ def _add_build(sub) -> None:
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
     b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
                                                            "recipes' `ros` key)")
+    b.add_argument("--moveit", action="store_true",
+                   help="also write the MoveIt 2 configuration (config/moveit/, launch/moveit.launch.py) of every "
+                        "robot (as the recipes' `moveit: true`)")
     b.add_argument("--no-report", action="store_true",
                    help="do not write the picture report (<robot>/report/report.html)")
     _add_arg_option(b)

@@ -27,6 +27,7 @@ def run(args) -> int:
         return 2
     start = time.perf_counter()
     extra = {**({"ros": args.ros} if args.ros else {}), **({"no_report": True} if args.no_report else {}),
+             **({"moveit": True} if args.moveit else {}),
              **({"args": dict(args.arg)} if args.arg else {})}
     opts = stamp.options(args.recipes, args.out, extra or None)
     done = stamp.up_to_date(args.out, opts)  # nothing changed since the last successful build?
@@ -37,7 +38,8 @@ def run(args) -> int:
     echo = (lambda line: print(line, file=sys.stderr)) if args.verbose else None
     with scheduler(args) as jobs, cache_messages():
         result = build(args.recipes, args.out, jobs=jobs, echo=echo, progress=sys.stderr, ros=args.ros,
-                       report=not args.no_report, stamp_options=opts, args=dict(args.arg))
+                       report=not args.no_report, stamp_options=opts, args=dict(args.arg),
+                       moveit=args.moveit)
     if result.ran or args.verbose:
         for w in result.warning_lines:
             print(w, file=sys.stderr)  # file:line: key: warning: ...

@@ -15,7 +15,8 @@ READS = {
     "robot": "the finalized robot: geometry with its recentering offsets, collision pieces, inertials",
     "summary": "the finalized robot and every mesh fact (keyword facts)",
     "rviz": "the resolved robot without inertials, and the facts of its shown meshes (keyword facts)",
-    "ros-package": "name, metadata, ros, gazebo, sensors, actuators, worlds, whether there are meshes",
+    "ros-package": "name, metadata, ros, gazebo, sensors, actuators, worlds, whether there are meshes, whether "
+                   "it has a MoveIt configuration",
     "structure": "name, ros, gazebo, actuators",
     "groups": "name, base, joints, link names, poses, and the self-collision matrix",
     "metadata": "name and metadata",

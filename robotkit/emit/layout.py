@@ -29,6 +29,14 @@ GAZEBO_LAUNCH = {"ros1": "launch/gazebo.launch", "ros2": "launch/gazebo.launch.p
 RVIZ = "rviz/{name}.rviz"
 SRDF = "srdf/{name}.srdf"
 CONTROLLERS = "config/controllers.yaml"
+# the MoveIt 2 configuration (robotkit.emit.moveit): inside the robot's own package (docs/ros.md, MoveIt)
+MOVEIT = "config/moveit"
+MOVEIT_KINEMATICS = "config/moveit/kinematics.yaml"
+MOVEIT_JOINT_LIMITS = "config/moveit/joint_limits.yaml"
+MOVEIT_CONTROLLERS = "config/moveit/moveit_controllers.yaml"
+ROS2_CONTROLLERS = "config/moveit/ros2_controllers.yaml"
+MOVEIT_RVIZ = "config/moveit/moveit.rviz"
+MOVEIT_LAUNCH = "launch/moveit.launch.py"
 PICTURES = "report"  # the picture report's folder
 REPORT_HTML = "report/report.html"
 MESHES = "meshes"

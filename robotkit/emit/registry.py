@@ -3,11 +3,11 @@
 
 from __future__ import annotations
 
-from robotkit.emit import controllers, gazebo, mjcf, ros, sdf, srdf, summary, urdf, xacro_macro
+from robotkit.emit import controllers, gazebo, mjcf, moveit, ros, sdf, srdf, summary, urdf, xacro_macro
 from robotkit.emit.formats import Format
 
 # in the order of their tasks
 FORMATS: dict[str, Format] = {
-    f.name: f for module in (urdf, xacro_macro, sdf, mjcf, srdf, summary, gazebo, ros, controllers)
+    f.name: f for module in (urdf, xacro_macro, sdf, mjcf, srdf, summary, gazebo, ros, controllers, moveit)
     for f in module.FORMATS
 }

@@ -22,6 +22,7 @@ from robotkit.emit.controllers import controllers
 from robotkit.emit.env import fmt, render
 from robotkit.emit.formats import Format
 from robotkit.emit.sensors import ros_topics
+from robotkit.emit.srdf import moving_joints
 from robotkit.model.resolve import recenter_offset
 from robotkit.model.robot import Robot
 
@@ -44,14 +45,25 @@ def flavour(robot: Robot) -> str:
     return "ros1" if is_ros1(robot) else "ros2"
 
 
+def has_moveit(robot: Robot) -> bool:
+    """The package holds a MoveIt 2 configuration (:mod:`robotkit.emit.moveit`): asked for
+    (``moveit``), ROS 2, and a planning group (a joint that moves)."""
+    return robot.moveit and not is_ros1(robot) and bool(moving_joints(robot))
+
+
+# what launch/moveit.launch.py starts and loads (the controller packages come with the actuators)
+MOVEIT_PACKAGES = {"moveit_ros_move_group", "moveit_kinematics", "moveit_planners_ompl", "moveit_ros_visualization",
+                   "moveit_simple_controller_manager", "python3-yaml"}
+
+
 def folders(robot: Robot) -> list[str]:
     """The folders of the package, as the build writes them (CMakeLists installs each)."""
     out = [top(layout.URDF)]
     if robot.meshes():
         out.append(layout.MESHES)
     out += [top(layout.MJCF), top(layout.DISPLAY_LAUNCH["ros2"]), top(layout.RVIZ), top(layout.SRDF)]
-    if robot.actuators:
-        out.append(top(layout.CONTROLLERS))
+    if robot.actuators or has_moveit(robot):
+        out.append(top(layout.CONTROLLERS))  # config/ (and config/moveit/)
     if robot.worlds:
         out.append(layout.WORLDS)
     return out
@@ -108,6 +120,8 @@ def exec_depends(robot: Robot) -> list[str]:
             deps.add("gazebo_ros2_control")
     if robot.actuators:
         deps |= {"controller_manager"} | _controller_packages(robot)
+    if has_moveit(robot):
+        deps |= MOVEIT_PACKAGES | ({"joint_trajectory_controller"} if robot.actuators else set())
     return sorted(deps)
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 
-from robotkit.emit import layout, mjcf, ros, sdf
+from robotkit.emit import layout, mjcf, moveit, ros, sdf
 from robotkit.emit.controllers import armature_losses, gravcomp_losses, joints_phrase
 from robotkit.emit.formats import Format
 from robotkit.emit.sensors import host_of
@@ -29,7 +29,8 @@ def urdf_losses(robot: Robot) -> list[str]:
 def losses(robot: Robot, facts: dict) -> dict[str, list[str]]:
     return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts),
             "package": ros.losses(robot) + gravcomp_losses(robot, "the ros_control controllers (controllers.yaml)")
-            + matrix_losses(robot)}
+            + matrix_losses(robot),
+            **({"moveit": moveit.losses(robot)} if robot.moveit else {})}
 
 
 def matrix_losses(robot: Robot) -> list[str]:

@@ -42,9 +42,9 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
 
 
 def load_robots(recipe_files, ros: str | None = None, args: dict[str, str] | None = None,
-                ignore_unknown_args: bool = False) -> list[tuple[object, Robot]]:
-    """Load and resolve every recipe (every variant of each; ``ros`` overrides their ``ros`` key);
-    all problems of all recipes together.
+                ignore_unknown_args: bool = False, moveit: bool = False) -> list[tuple[object, Robot]]:
+    """Load and resolve every recipe (every variant of each; ``ros`` overrides their ``ros`` key,
+    ``moveit`` turns their ``moveit`` key on); all problems of all recipes together.
 
     ``args``: ``--arg`` overrides (name -> text); with ``ignore_unknown_args`` a recipe ignores the
     ones it does not declare (doit builds many recipes with one set of arguments)."""
@@ -56,7 +56,7 @@ def load_robots(recipe_files, ros: str | None = None, args: dict[str, str] | Non
         for loaded in read_recipes(f, args, ignore_unknown_args):
             declared.update(loaded.arg_names)
             try:
-                robot = resolve_checked(loaded, ros)
+                robot = resolve_checked(loaded, ros, moveit)
             except RobotkitError as exc:
                 problems.extend(p for p in exc.problems if p not in problems)
                 continue

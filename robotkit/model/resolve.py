@@ -52,10 +52,10 @@ def _t(v) -> tuple[float, ...]:
     return tuple(float(x) for x in v)
 
 
-def resolve_checked(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
+def resolve_checked(loaded: LoadedRecipe, ros: str | None = None, moveit: bool = False) -> Robot:
     """The resolved robot; RecipeError with the loading problems and resolution's own, all together."""
     if not loaded.problems:
-        return resolve(loaded, ros)
+        return resolve(loaded, ros, moveit)
     problems = list(loaded.problems)
     if loaded.recipe is not None:
         try:
@@ -130,8 +130,9 @@ class _Context:
         return None
 
 
-def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
-    """The structural robot of a loaded recipe; ``ros`` overrides the recipe's ``ros``.
+def resolve(loaded: LoadedRecipe, ros: str | None = None, moveit: bool = False) -> Robot:
+    """The structural robot of a loaded recipe; ``ros`` overrides the recipe's ``ros``, ``moveit``
+    turns its ``moveit`` on.
 
     Every problem is collected (links, joints, sensors, actuators, worlds, the ROS and Gazebo
     pair, the kinematic tree) and raised together as one RecipeError."""
@@ -164,7 +165,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None) -> Robot:
         raise RecipeError(cx.problems)
     return Robot(r.robot, tuple(links), tuple(joints), materials, _metadata(r.metadata), r.self_collide,
                  tuple(r.urdf_extras), tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base, tuple(poses),
-                 self_collision=collision)
+                 self_collision=collision, moveit=r.moveit or moveit)
 
 
 def _safe_name(src: str) -> str:

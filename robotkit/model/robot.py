@@ -297,6 +297,7 @@ class Robot:
     drive_report: str = ""  # JSON: robotkit.model.gains.tune's report, once the build has tuned the drives
     self_collision: Settings = Settings()
     collision_matrix: Matrix | None = None  # once the build has sampled it (robotkit.model.selfcollision)
+    moveit: bool = False  # write the MoveIt 2 configuration (robotkit.emit.moveit)
 
     def home(self) -> NamedPose | None:
         """The pose the robot starts in: ``home``, else the first pose, else None (all zero)."""

@@ -114,7 +114,7 @@ def _at(loaded, path: tuple) -> dict:
 
 def _losses(loaded, robot, out: Path, where: dict) -> list[tuple[str, str]]:
     """What each output format could not express (from the robot's report.json)."""
-    names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF", "package": "ROS package"}
+    names = {"urdf": "URDF", "sdf": "SDF", "mjcf": "MJCF", "package": "ROS package", "moveit": "MoveIt"}
     try:
         data = json.loads(layout.robot_layout(out / robot.name).report_json.read_text(encoding="utf-8"))
     except (OSError, ValueError):

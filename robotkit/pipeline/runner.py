@@ -137,9 +137,11 @@ def to_doit(task: dict) -> dict:
 
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
           echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None,
-          report: bool = False, args: dict[str, str] | None = None, keep_going: bool = False) -> BuildResult:
+          report: bool = False, args: dict[str, str] | None = None, keep_going: bool = False,
+          moveit: bool = False) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
-    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key; ``args`` sets recipe arguments (``--arg``).
+    ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key, ``moveit`` turns their ``moveit``
+    key on; ``args`` sets recipe arguments (``--arg``).
     ``report`` also writes each robot's picture report (``<robot>/report/report.html``); the
     command line does unless ``--no-report``.
 
@@ -155,7 +157,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         stamp_options = stamp.options(recipes, out_dir, None if report else {"no_report": True})
     stamp.remove(out_dir, stamp_options)
     out = Path(out_dir).absolute()
-    robots = load_robots(recipes, ros, args)  # raises before anything is written
+    robots = load_robots(recipes, ros, args, moveit=moveit)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
     tasks = [t for loaded, robot in robots for t in robot_tasks(robot, out, mesh_locations(loaded, robot),
                                                                  report=report)]

@@ -31,6 +31,7 @@ from robotkit.emit.registry import FORMATS
 from robotkit.emit.env import template_dirs
 from robotkit.emit.formats import Format
 from robotkit.emit.meshfiles import conversions
+from robotkit.emit.ros import has_moveit
 from robotkit.geometry import rpy_quat
 from robotkit.mesh.io import companions
 from robotkit.model.load import load_robots, mesh_locations
@@ -341,7 +342,7 @@ def readings(place: Place) -> dict[str, Reading]:
     recentered = sorted({g.shape.mesh.key for link in robot.links for g in robot.all_geoms(link)
                          if g.shape.mesh is not None and g.recenter != "none"})
     package = {k: structure.get(k) for k in ("name", "metadata", "ros", "gazebo", "sensors", "actuators", "poses")}
-    package.update(worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds], meshes=bool(robot.meshes()))
+    package.update(moveit=has_moveit(robot), worlds=[(w.name, w.spawn and asdict(w.spawn)) for w in robot.worlds], meshes=bool(robot.meshes()))
     no_inertials = {**structure, "links": [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
                                            for link in structure["links"]]}
     drives, matrix = place.drives, place.matrix

@@ -827,6 +827,8 @@ class Recipe(Strict):
     """How the root link sits in MuJoCo: ``fixed`` (welded to the world, as MuJoCo imports a URDF) or ``free`` (a free joint: a mobile robot). In Gazebo a model without a ``world`` link is always free."""
     ros: Literal["ros2", "ros1"] = "ros2"
     """Which ROS the package is for, and so everything that depends on it: ``ros2`` (ament_cmake package, ``<ros2_control>`` tags, launch/*.launch.py, ros_gz) or ``ros1`` (catkin package, ``<transmission>`` + gazebo_ros_control, roslaunch XML, gazebo_ros). ``robotkit build --ros`` overrides it."""
+    moveit: bool = False
+    """Also write a MoveIt 2 configuration into the ROS package (ROS 2 only): ``config/moveit/`` (kinematics.yaml, joint_limits.yaml, moveit_controllers.yaml, ros2_controllers.yaml, moveit.rviz) and ``launch/moveit.launch.py`` (move_group and RViz with the URDF and ``srdf/<robot>.srdf``). Accelerations: each joint's velocity limit reached in 0.1 s. ``robotkit build --moveit`` turns it on for every recipe built."""
     gazebo: Literal["sim", "classic"] | None = None
     """Which Gazebo the URDF's sensor and control plugins and launch/gazebo target: ``sim`` (Gazebo Sim, gz-sim systems; ROS 2 only) or ``classic`` (gazebo_ros plugins). Default: ``sim`` for ROS 2, ``classic`` for ROS 1."""
     worlds: dict[Name, World] = {}

@@ -22,6 +22,7 @@ from tests.conftest import RECIPES, write_recipe
 
 RECIPE = """
 robot: bot
+moveit: true  # every registered format is written
 units: m
 density: 1000
 materials:
@@ -124,7 +125,7 @@ def test_config_changed_holds_exactly_what_each_output_reads(bot):
     assert set(config(t["bot:model.config"])["robot"]) == {"name", "metadata"}  # no geometry, no inertial
     assert config(t["bot:model.config"])["options"] == {"sdf": "model.sdf"}
     assert set(config(t["bot:package.xml"])["robot"]) == {"name", "metadata", "ros", "gazebo", "sensors",
-                                                           "actuators", "poses", "worlds", "meshes"}
+                                                           "actuators", "poses", "worlds", "meshes", "moveit"}
     controllers = config(t["bot:controllers"])["robot"]
     assert set(controllers) == {"name", "ros", "gazebo", "actuators", "poses"}
     assert {k: controllers["actuators"][0][k] for k in ("joint", "interface", "p", "i", "d", "auto")} == {
