@@ -165,16 +165,20 @@ class Sampler:
 
     def near(self, samples: np.ndarray, pairs: set[tuple[int, int]]) -> set[tuple[int, int]]:
         """Which of ``pairs`` (body ids, sorted) come within :data:`CLEARANCE` in any of ``samples``:
-        the other bodies' geoms switched off and the margin set for this sweep only."""
+        the other bodies' geoms switched off and a margin set for this sweep only.  MuJoCo's
+        midphase keeps the bounding boxes compiled without the margin (it is switched off here), and
+        reports contacts up to the two geoms' margins added (those farther than CLEARANCE are dropped)."""
         m = self.model
         keep = np.isin(m.geom_bodyid, sorted({b for p in pairs for b in p})) & (m.geom_contype > 0)
-        saved = m.geom_contype.copy(), m.geom_conaffinity.copy(), m.geom_margin.copy()
+        saved = m.geom_contype.copy(), m.geom_conaffinity.copy(), m.geom_margin.copy(), m.opt.disableflags
         m.geom_contype[:], m.geom_conaffinity[:] = keep, keep
         m.geom_margin[keep] = CLEARANCE
+        m.opt.disableflags |= int(self._mujoco.mjtDisableBit.mjDSBL_MIDPHASE)
         try:
-            rows, _ = self.sweep(samples)
+            rows, dist = self.sweep(samples)
         finally:
-            m.geom_contype[:], m.geom_conaffinity[:], m.geom_margin[:] = saved
+            m.geom_contype[:], m.geom_conaffinity[:], m.geom_margin[:], m.opt.disableflags = saved
+        rows = rows[dist < CLEARANCE]
         return {(int(a), int(b)) for a, b in np.unique(rows[:, 1:], axis=0)} & pairs
 
     def sweep(self, samples: np.ndarray):
@@ -230,14 +234,17 @@ class Approach:
         return min(s._mujoco.mj_geomDistance(s.model, s.data, g1, g2, 10.0, None) for g1, g2 in self.pairs)
 
     def closest(self, samples: np.ndarray) -> float:
-        """The smallest distance found (negative: a collision exists)."""
+        """The smallest distance found (negative: a collision exists); ``self.at`` is where."""
+        self.at = None
         if not self.pairs or not self.cols:
             return float("inf")
         first = samples[: self.FIRST]
         ranked = sorted(range(len(first)), key=lambda i: self.distance(first[i]))
-        return min(self._descend(first[i].copy()) for i in ranked[: self.STARTS])
+        found = [self._descend(first[i].copy()) for i in ranked[: self.STARTS]]
+        best, self.at = min(found, key=lambda f: f[0])
+        return best
 
-    def _descend(self, q: np.ndarray) -> float:
+    def _descend(self, q: np.ndarray) -> tuple[float, np.ndarray]:
         space = self.sampler.space
         best = self.distance(q)
         step = 0.1 * (space.hi - space.lo)
@@ -255,7 +262,7 @@ class Approach:
                         break
             if not moved:
                 step = step / 2
-        return best
+        return best, self.sampler.space.follow(q)
 
 
 def _path_bodies(model, body: int) -> set[int]:

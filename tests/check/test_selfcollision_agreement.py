@@ -5,8 +5,8 @@
   is disabled as Adjacent; the MJCF excludes exactly the SRDF's disabled pairs; no checked pair
   is in collision at a named pose (SRDF group_state).
 - The 1 cm clearance, replayed at the build's own samples with coal's distances: a Never pair never
-  comes within it, a checked pair no sample put in contact does (xfail for ur5 and
-  quadruped_compact: :data:`CLEARANCE_BUG`).
+  comes within it, a checked pair no sample put in contact does (in a sample, or where the build's
+  closest-approach search put it).
 - Pinocchio (URDF + SRDF) and MuJoCo (the built MJCF, its excludes) report the same colliding
   link pairs at 1000 random configurations, but for pairs less than :data:`DEPTH_TOLERANCE` deep.
 - Gazebo reads model.sdf (``self_collide``, ``collide_bitmask``), and the masks robotkit solves
@@ -14,10 +14,9 @@
 
 The convex collision pieces are given to coal as convex shapes (GJK/EPA, as MuJoCo collides a mesh
 as its convex hull); Pinocchio's URDF reader loads them as BVH triangle meshes otherwise.
-Measured (2 cores, load 2, 2026-11-26): 20,000 configurations over the quadruped's 56 (compact) and
-51 (explorer) Never pairs take 0.5-0.6 s each; ur5 has no Never pair (14 of its 15 pairs of links
-that are not adjacent collide in some sample; the 15th is the clearance bug's), so that test has
-nothing to check on it.  At 1000
+Measured (2 cores, load 2, 2026-11-26): 20,000 configurations over the quadrupeds' 50 Never pairs
+take 0.5-0.6 s each; ur5 has one Never pair (wrist_1_link-wrist_3_link, 13.9 mm apart at the
+closest; 14 of its 15 pairs of links that are not adjacent collide in some sample).  At 1000
 configurations Pinocchio and MuJoCo agree exactly on every one (ur5: 259 with a collision,
 quadruped_compact 17, quadruped_explorer 120); depths differ by at most 3 mm."""
 
@@ -247,30 +246,31 @@ def test_never_pairs_never_collide_in_an_independent_sampler(built, robot):
                        f"depth m): {found}; {len(never)} Never pairs, {SAMPLES} samples in {seconds:.1f} s")
 
 
-CLEARANCE_BUG = ("Sampler.near sets geom_margin on the compiled model: MuJoCo's midphase keeps the boxes compiled "
-                 "without it (a Never pair 9 mm apart is missed: quadruped body-front_right_shin), and both "
-                 "geoms' margins add up (a pair 13.9 mm apart is checked: ur5 wrist_1_link-wrist_3_link)")
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("robot", [pytest.param(r, marks=pytest.mark.xfail(strict=True, reason=CLEARANCE_BUG))
-                                   for r in ROBOTS[:2]] + ROBOTS[2:])
+@pytest.mark.parametrize("robot", ROBOTS)
 def test_the_clearance_rule_holds_at_the_builds_own_samples(built, robot):
     """Never means never within :data:`CLEARANCE`, and a checked pair no sample put in contact came
-    within it: coal's distances at the build's own samples (robotkit's JointSpace replaying them)."""
-    from robotkit.model.selfcollision import CLEARANCE, Sampler
+    within it, in a sample or where the build's closest-approach search put it: coal's distances at
+    the build's own samples (robotkit's JointSpace replaying them) and at the searched configuration."""
+    from robotkit.model.selfcollision import CLEARANCE, Approach, Sampler
 
     report = json.loads((built / robot / "report.json").read_text())["self_collision"]
     never = {pair(q["a"], q["b"]) for q in report["pairs"] if q["reason"] == "Never"}
     untouched = {pair(q["a"], q["b"]) for q in report["pairs"] if not q["reason"] and not q.get("hits")}
-    space = Sampler(path=str(built / robot / "mjcf" / f"{robot}.xml")).space
+    sampler = Sampler(path=str(built / robot / "mjcf" / f"{robot}.xml"))
+    space = sampler.space
     samples = space.random(report["samples"], report["seed"])
     p = Pin(built, robot)
     p.keep(never | untouched)
-    qs = np.tile(p.pin.neutral(p.model), (len(samples), 1))
-    for name in p.joints:  # the examples' joints are revolute with limits: one coordinate each
-        j = p.model.getJointId(name)
-        qs[:, p.model.idx_qs[j]] = samples[:, space.addr[space.names.index(name)]]
+
+    def pin_q(mj_samples):
+        qs = np.tile(p.pin.neutral(p.model), (len(mj_samples), 1))
+        for name in p.joints:  # the examples' joints are revolute with limits: one coordinate each
+            j = p.model.getJointId(name)
+            qs[:, p.model.idx_qs[j]] = mj_samples[:, space.addr[space.names.index(name)]]
+        return qs
+
+    qs = pin_q(samples)
     keys = [pair(p.link[cp.first], p.link[cp.second]) for cp in p.geom.collisionPairs]
     closest = dict.fromkeys(never | untouched, np.inf)
     for q in qs:
@@ -278,6 +278,13 @@ def test_the_clearance_rule_holds_at_the_builds_own_samples(built, robot):
         for k, r in zip(keys, p.gdata.distanceResults):
             closest[k] = min(closest[k], r.min_distance)
     tolerance = 1e-4
+    ids = {n: i for i, n in enumerate(sampler.names)}
+    for k in [k for k in untouched if closest[k] > CLEARANCE + tolerance]:  # the search found them near
+        a, b = sorted(ids[n] for n in k)
+        search = Approach(sampler, a, b)
+        search.closest(samples)
+        p.pin.computeDistances(p.model, p.data, p.geom, p.gdata, pin_q(search.at[None, :])[0])
+        closest[k] = min(r.min_distance for key, r in zip(keys, p.gdata.distanceResults) if key == k)
     assert ({k: round(closest[k], 4) for k in never if closest[k] < CLEARANCE - tolerance},
             {k: round(closest[k], 4) for k in untouched if closest[k] > CLEARANCE + tolerance}) == ({}, {})
 
