@@ -192,3 +192,63 @@ def test_masks_make_exactly_the_enabled_pairs_share_a_bit():
     many = [f"l{i}" for i in range(17)]
     assert solve_masks(many, set(), set()) is None
     assert Settings().samples == 10000
+
+
+def chain_robot(tmp_path, n: int, extra: str = ""):
+    from robotkit.model.load import load_robots
+
+    links = "\n".join(f"  l{i}: {{collision: {{box: {{size: [0.1, 0.1, 0.1]}}}}, "
+                      f"inertial: {{mass: 1, inertia: {{ixx: 0.01, iyy: 0.01, izz: 0.01}}}}}}" for i in range(n))
+    joints = "\n".join(f"  j{i}: {{type: revolute, parent: l{i}, child: l{i + 1}, origin: {{xyz: [0, 0, 0.2]}}, "
+                       "axis: [0, 1, 0], limit: {lower: -1, upper: 1, effort: 1, velocity: 1}}" for i in range(n - 1))
+    recipe = write_recipe(tmp_path, f"robot: chain\n{extra}links:\n{links}\njoints:\n{joints}\n", "chain.yaml")
+    [(_, robot)] = load_robots([recipe])
+    return robot
+
+
+def with_matrix(robot, enabled: set):
+    from dataclasses import replace
+
+    from robotkit.model.selfcollision import Matrix, Pair
+
+    names = [link.name for link in robot.links]
+    adjacent = {frozenset((j.parent, j.child)) for j in robot.joints}
+    pairs = tuple(Pair(a, b, "" if frozenset((a, b)) in enabled else
+                       "Adjacent" if frozenset((a, b)) in adjacent else "Never")
+                  for i, a in enumerate(names) for b in names[i + 1:])
+    return replace(robot, collision_matrix=Matrix(10000, 0, 0.1, pairs))
+
+
+def test_a_matrix_that_16_masks_cannot_express_leaves_the_sdf_without_self_collision(tmp_path):
+    from robotkit.emit.sdf import losses, render_sdf
+
+    # 34 links, 17 checked pairs that share no link: each needs a bit of its own
+    robot = chain_robot(tmp_path, 34)
+    matrix = with_matrix(robot, {frozenset((f"l{i}", f"l{i + 17}")) for i in range(17)})
+    assert "<self_collide>" not in render_sdf(matrix) and "collide_bitmask" not in render_sdf(matrix)
+    [loss] = [x for x in losses(matrix) if "self-collision" in x]
+    assert loss == "self-collision is off in model.sdf: 16 collide bit masks cannot express the self-collision matrix"
+    # 16 such pairs fit, the two links left over each sharing a bit with a pair it never comes near
+    fits = with_matrix(robot, {frozenset((f"l{i}", f"l{i + 17}")) for i in range(16)})
+    assert "<self_collide>true</self_collide>" in render_sdf(fits)
+    assert [x.split(":")[0] for x in losses(fits) if "bit masks" in x] == [
+        "model.sdf's collide bit masks also check 4 pairs the matrix calls Never (16 masks cannot separate them; "
+        "they never come within 1 cm)"]
+    asked = with_matrix(chain_robot(tmp_path / "on", 34, "self_collide: true\n"),
+                        {frozenset((f"l{i}", f"l{i + 17}")) for i in range(17)})
+    assert "<self_collide>true</self_collide>" in render_sdf(asked) and "collide_bitmask" not in render_sdf(asked)
+    assert [x for x in losses(asked) if "self_collide" in x] == [
+        "self_collide: 16 collide bit masks cannot express the self-collision matrix; on with Gazebo's own filter"]
+
+
+def test_self_collide_false_turns_it_off_in_the_mjcf_and_the_sdf(tmp_path):
+    from robotkit.emit.mjcf import self_contacts
+    from robotkit.emit.sdf import render_sdf
+    from robotkit.emit.srdf import render_srdf
+
+    robot = with_matrix(chain_robot(tmp_path, 4, "self_collide: false\n"), {frozenset(("l0", "l2"))})
+    assert self_contacts(robot) == (False, [])
+    assert "<self_collide>" not in render_sdf(robot)
+    assert render_srdf(robot).count("<disable_collisions") == 5  # the SRDF still carries the matrix
+    on = with_matrix(chain_robot(tmp_path / "on", 4), {frozenset(("l0", "l2"))})
+    assert self_contacts(on) == (True, [("l0", "l1"), ("l0", "l3"), ("l1", "l2"), ("l1", "l3"), ("l2", "l3")])
