@@ -30,12 +30,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import RECIPES
 from validators import IN_CI, ign_sdf_check
 
 pytestmark = pytest.mark.consumers
 
 ROBOTS = ["ur5", "quadruped_compact", "quadruped_explorer"]
+EXAMPLES = ROBOTS + ["turret_bot", "rover", "turtlebot3_burger", "lidar_mast"]
 SAMPLES = 20000
 """Independent samples: twice MoveIt's (and the build's) 10,000."""
 SEED = 20261126
@@ -57,14 +57,9 @@ def need(module: str):
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory) -> Path:
-    """ur5 and the quadruped's two variants built once for this module (folders OUT/<robot>)."""
-    from robotkit.pipeline.runner import build
-
-    out = tmp_path_factory.mktemp("selfcollision")
-    result = build([RECIPES / "ur5.yaml", RECIPES / "quadruped.yaml"], out, report=False)
-    assert not result.errors, result.errors
-    return out
+def built(examples) -> Path:
+    """The examples, built once per session (folders OUT/<robot>)."""
+    return examples
 
 
 # ---------------------------------------------------------------------------------------- readers
@@ -290,7 +285,7 @@ def test_the_clearance_rule_holds_at_the_builds_own_samples(built, robot):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", EXAMPLES)
 def test_links_joined_by_a_joint_are_disabled_as_adjacent(built, robot):
     disabled = srdf_disabled(built, robot)
     adjacent = urdf_adjacent(built, robot)
@@ -299,7 +294,7 @@ def test_links_joined_by_a_joint_are_disabled_as_adjacent(built, robot):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", EXAMPLES)
 def test_mjcf_excludes_exactly_the_srdf_disabled_pairs(built, robot):
     disabled = set(srdf_disabled(built, robot))
     excludes = mjcf_excludes(built, robot)
