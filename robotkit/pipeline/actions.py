@@ -144,7 +144,9 @@ def with_drives(robot, path: str | None, matrix: str | None = None):
     the record at ``matrix`` (None: as it is)."""
     if matrix:
         with open(matrix, encoding="utf-8") as f:
-            robot = selfcollision.apply(robot, selfcollision.Matrix.from_json(json.load(f)))
+            record = json.load(f)
+        if "unavailable" not in record:  # else MuJoCo could not load the robot: no matrix
+            robot = selfcollision.apply(robot, selfcollision.Matrix.from_json(record))
     if not path:
         return robot
     with open(path, encoding="utf-8") as f:
@@ -171,11 +173,15 @@ def self_collision(robot, fact_paths: dict[str, str], meshes: str, target: str):
               "clearance": selfcollision.CLEARANCE}
 
     def compute():
-        matrix = selfcollision.classify(selfcollision.Sampler(xml, meshdir=meshes), settings)
-        return [], matrix.to_json()
+        try:
+            sampler = selfcollision.Sampler(xml, meshdir=meshes)
+        except ValueError as exc:  # MuJoCo refuses the robot: the MJCF's task says why
+            return [], {"unavailable": str(exc).strip().splitlines()[0]}
+        return [], selfcollision.classify(sampler, settings).to_json()
 
     inputs = [geometry] + [Path(meshes, rel).read_bytes() for rel in files]
-    _, info = _cache().get_or_compute("self-collision", params, inputs, compute)
+    # computed here, never on a cluster's workers: it reads the mesh files of this build
+    _, info = Cache().get_or_compute("self-collision", params, inputs, compute)
     write_if_changed(target, dump_json(info))
 
 

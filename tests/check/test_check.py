@@ -229,10 +229,18 @@ def test_examples_check_clean(tmp_path, name):
     # base), so its hip rolls, stepped with the base held, sag 0.2 degree under the leg's weight, as
     # gravity torque / kp predicts (report.json: actuators)
     motion = {"quadruped": "sags under gravity"}
+    # the interference check's known answers: joints whose limits reach past where their links meet
+    # on the collision geometry: the UR5's +-180 degree elbow folds the wrist into the upper arm at
+    # 165 degrees and its +-360 degree wrists swing wrist_2 into the forearm (the decomposition's
+    # pieces stand up to 24 mm off the surface); the explorer's +-90 degree hip pitch swings one
+    # leg's shin into the other's thigh at 67 degrees
+    reach = name in ("ur5", "quadruped")
     expected = next((text for robot, text in motion.items() if name.startswith(robot)), None)
     assert [f for f in data["findings"] if f["check"] != "build"
             and not (f["check"] == "motion" and f["severity"] == "warning" and expected
                      and f["message"].startswith(expected))
             and not (f["check"] == "equivalence" and "not compared" in f["message"])
             and not (f["check"] == "simulation" and "inside the floor" in f["message"])
-            and not (f["check"] in allowed and f["severity"] == "warning")] == []
+            and not (f["check"] in allowed and f["severity"] == "warning")
+            and not (reach and f["check"] == "self-collision" and f["severity"] == "warning"
+                     and f["message"].endswith("the limit is wider than the mechanism allows"))] == []
