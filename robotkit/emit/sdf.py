@@ -81,15 +81,21 @@ def self_collide(robot: Robot) -> tuple[bool, dict[str, int], list[str]]:
         shared = sorted(f"{p.a}-{p.b}" for p in m.pairs if p.reason == "Never" and frozenset((p.a, p.b)) not in free
                         and masks[p.a] & masks[p.b])
         return True, masks, [f"model.sdf's collide bit masks also check {len(shared)} pairs the matrix calls Never "
-                             f"(16 masks cannot separate them; they never come within 1 cm): {', '.join(shared)}"]
+                             f"(16 masks cannot separate them; they never come within 1 cm): {_few(shared)}"]
     fight = sorted(f"{p.a}-{p.b}" for p in m.disabled() if p.reason in ("Default", "Always", "User")
                    and frozenset((p.a, p.b)) not in free)
     why = ("16 collide bit masks cannot express the self-collision matrix" if not enabled & free else
            "the matrix checks links Gazebo never collides (joined by a joint)")
-    pairs = f" (Gazebo would make these disabled pairs fight: {', '.join(fight)})" if fight else ""
+    pairs = f" (Gazebo would make these disabled pairs fight: {_few(fight)})" if fight else ""
     if robot.self_collide:
         return True, {}, [f"self_collide: {why}; on with Gazebo's own filter{pairs}"]
     return False, {}, [f"self-collision is off in model.sdf: {why}{pairs}"]
+
+
+def _few(pairs: list[str], most: int = 5) -> str:
+    """At most ``most`` pairs named, then how many more (report.json: self_collision has them all)."""
+    more = f" and {len(pairs) - most} more (report.json: self_collision)" if len(pairs) > most else ""
+    return ", ".join(pairs[:most]) + more
 
 
 def extras_losses(robot: Robot, where: str) -> list[str]:

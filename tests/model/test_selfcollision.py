@@ -252,3 +252,13 @@ def test_self_collide_false_turns_it_off_in_the_mjcf_and_the_sdf(tmp_path):
     assert render_srdf(robot).count("<disable_collisions") == 5  # the SRDF still carries the matrix
     on = with_matrix(chain_robot(tmp_path / "on", 4), {frozenset(("l0", "l2"))})
     assert self_contacts(on) == (True, [("l0", "l1"), ("l0", "l3"), ("l1", "l2"), ("l1", "l3"), ("l2", "l3")])
+
+
+def test_a_long_list_of_pairs_is_cut_to_five_in_the_loss(tmp_path):
+    from robotkit.emit.sdf import losses
+
+    robot = with_matrix(chain_robot(tmp_path, 40), {frozenset((f"l{i}", f"l{i + 20}")) for i in range(16)})
+    [loss] = [x for x in losses(robot) if "bit masks" in x]
+    head, names = loss.split(": ", 1)
+    assert head.startswith("model.sdf's collide bit masks also check 37 pairs the matrix calls Never")
+    assert names.count("-") == 5 and names.endswith(" and 32 more (report.json: self_collision)")
