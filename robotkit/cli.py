@@ -91,17 +91,22 @@ def _add_check(sub) -> None:
                    help="recipe .yaml, build folder, or .urdf/.xacro/.sdf/.xml file")
     c.add_argument("--format", choices=["text", "json", "junit", "github"], default="text",
                    help="report format: text for people, json, junit (CI test reporters), github (annotations)")
-    c.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
-                   help="folder of ROS package PKG: package://PKG/ meshes of a URDF, $(find PKG) in a xacro "
-                        "file (repeatable)")
     c.add_argument("--fail-on", choices=["error", "warning"], default="error",
                    help="lowest severity that makes the exit status 1 (default: error)")
     c.add_argument("--junit", metavar="FILE", help="also write the JUnit report to FILE (whatever --format says)")
     out = c.add_mutually_exclusive_group()
-    out.add_argument("--out", "-o", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    out.add_argument("--out", "-o", default="build", metavar="DIR",
+                     help="output folder: where a recipe is built (default: build)")
     out.add_argument("--temp-out", action="store_true",
                      help="build recipes in a temporary folder, removed afterwards (pre-commit: never the user's tree)")
-    _add_arg_option(c)
+    _add_recipe_options(c, "check only this variant of a recipe (default: every variant)", "xacro")
+    c.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
+                   help=f"build a recipe with N tasks in parallel processes (default: the {cores()} cores this "
+                        "process may use)")
+    _add_ros_option(c)
+    c.add_argument("--no-report", action="store_true",
+                   help="do not write a recipe's picture report (<robot>/report/report.html), as on build; "
+                        "never written with --temp-out")
     _add_root_option(c)
 
 
@@ -110,8 +115,7 @@ def _add_expand(sub) -> None:
                                       "parts, conditions and variants expand to",
                        description="Print RECIPE expanded (one YAML document per variant).")
     e.add_argument("recipe", metavar="RECIPE", help="recipe YAML file")
-    e.add_argument("--variant", metavar="NAME", help="print only this variant")
-    _add_arg_option(e)
+    _add_recipe_options(e, "print only this variant (default: every variant)")
     _add_root_option(e)
 
 
@@ -121,13 +125,14 @@ def _add_report(sub) -> None:
                                    "joints at their limits) and write DIR/report.html with the pictures "
                                    "beside it and a table per link and joint.")
     r.add_argument("path", metavar="PATH", help="recipe .yaml, build folder, or .urdf/.sdf/.xml file")
-    r.add_argument("-o", "--output", metavar="DIR",
-                   help="folder for report.html and its pictures (default: <build folder>/report)")
-    r.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    r.add_argument("-o", "--out", metavar="DIR",
+                   help="output folder: where report.html and its pictures are written (default: <build "
+                        "folder>/report; for a file written elsewhere, <file>-report beside it)")
+    r.add_argument("--output", dest="out", help=argparse.SUPPRESS)  # its name before -o/--out meant this
+    r.add_argument("--build-dir", default="build", metavar="DIR",
+                   help="where a recipe is built first (default: build; -o/--out is the report's folder)")
+    _add_recipe_options(r, "report this variant of a recipe (default: its first)", "urdf")
     _add_root_option(r)
-    r.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
-                   help="folder of ROS package PKG: package://PKG/ meshes of a URDF, $(find PKG) in a xacro "
-                        "file (repeatable)")
 
 
 def _add_view(sub) -> None:
@@ -137,7 +142,9 @@ def _add_view(sub) -> None:
     v.add_argument("path", metavar="PATH", help="recipe .yaml, build folder, or .urdf file")
     v.add_argument("--port", type=int, default=8080, metavar="N", help="port to serve on (default: 8080)")
     v.add_argument("--no-browser", action="store_true", help="do not open a web browser")
-    v.add_argument("--out", default="build", metavar="DIR", help="where a recipe is built (default: build)")
+    v.add_argument("--out", "-o", default="build", metavar="DIR",
+                   help="output folder: where a recipe is built (default: build)")
+    _add_recipe_options(v, "show only this variant of a recipe (default: every variant)", "urdf")
     _add_root_option(v)
 
 
@@ -146,11 +153,17 @@ def _add_new(sub) -> None:
                        description="Write NAME.yaml, meshes/NAME/arm.stl and recipe.schema.json (for the editor "
                                    "modeline) into DIR; no existing file is overwritten.")
     n.add_argument("name", metavar="NAME", help="the robot's name (letters, digits, '_', '.', '-')")
-    n.add_argument("--dir", "-C", default=".", metavar="DIR", help="folder to write into (default: .)")
+    n.add_argument("--dir", "-C", "--out", "-o", default=".", metavar="DIR",
+                   help="output folder: the folder to write into (default: .)")
 
 
 def _add_schema(sub) -> None:
-    s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)")
+    s = sub.add_parser("schema", help="print the recipe JSON Schema (for editors)",
+                       description="Print the JSON Schema of a recipe on stdout, for an editor's completion and "
+                                   "checking of keys: save it as recipe.schema.json beside the recipes, whose first "
+                                   "line '# yaml-language-server: $schema=recipe.schema.json' points at it (robotkit "
+                                   "new writes both). --part prints a part file's schema, --markdown the recipe "
+                                   "reference (docs/recipe.md).")
     s.add_argument("--markdown", action="store_true", help="print the recipe reference as Markdown instead")
     s.add_argument("--part", action="store_true", help="print the JSON Schema of a part file instead")
 
@@ -178,7 +191,9 @@ def _add_import(subparsers) -> argparse.ArgumentParser:
                     "above its link) unless --recompute-inertials; <gazebo>, <transmission> and other "
                     "elements the recipe cannot express are carried verbatim in urdf_extras.")
     p.add_argument("file", metavar="FILE", help="URDF or xacro file")
-    p.add_argument("-o", "--output", required=True, metavar="RECIPE.yaml", help="recipe file to write")
+    p.add_argument("-o", "--out", "--output", dest="output", required=True, metavar="RECIPE.yaml",
+                   help="the recipe file written: -o/--out is a file here, the one command whose output is a "
+                        "file (the others' -o/--out is a folder); its meshes are referenced from there")
     p.add_argument("--package-path", action="append", type=_package_path, default=[], metavar="PKG=DIR",
                    help="folder of ROS package PKG (repeatable)")
     p.add_argument("--arg", action="append", type=_xacro_arg, default=[], metavar="NAME:=VALUE",
@@ -205,9 +220,26 @@ def _recipe_arg(text: str) -> tuple[str, str]:
     return name, value
 
 
-def _add_arg_option(p: argparse.ArgumentParser) -> None:
+def _add_recipe_options(p: argparse.ArgumentParser, variant_help: str, inputs: str = "") -> None:
+    """The options of every command that reads a recipe (build, check, report, view, expand):
+    ``--arg`` (dest ``arg``: (name, value) pairs), ``--variant`` (``variant``: a name or None) and
+    ``--package-path`` (``package_path``: the raw PKG=DIR texts, read by
+    :func:`robotkit.commands.inputs.package_paths`). ``inputs``: "urdf" or "xacro" when the
+    command also reads URDF (and xacro) files, the ones package paths are for."""
     p.add_argument("--arg", action="append", type=_recipe_arg, default=[], metavar="NAME:=VALUE",
-                   help="set a recipe argument (repeatable; see the recipe's args:)")
+                   help="set an argument of the recipe (see its args:" + ("; or of a xacro file" if inputs == "xacro"
+                                                                        else "") + "; repeatable)")
+    p.add_argument("--variant", metavar="NAME", help=f"{variant_help}; see the recipe's variants:")
+    where = {"urdf": "the package://PKG/ meshes of a URDF", "xacro": "the package://PKG/ meshes of a URDF, "
+             "$(find PKG) in a xacro file"}.get(inputs, "package://PKG/ in a URDF given to check, report or view")
+    p.add_argument("--package-path", action="append", default=[], metavar="PKG=DIR",
+                   help=f"folder of ROS package PKG: {where} (repeatable); a recipe names its files by path, "
+                        "relative to itself, and needs none")
+
+
+def _add_ros_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
+                                                           "recipes' `ros` key)")
 
 
 ROOT_ENV = "ROBOTKIT_ROOT"  # robotkit.paths.ROOT_ENV, not imported: the no-op build stays light
@@ -231,6 +263,7 @@ def _add_build(sub) -> None:
                        description="Build each RECIPE into OUT/<robot>/ (incremental: only what changed reruns).")
     b.add_argument("recipes", nargs="+", metavar="RECIPE", help="recipe YAML file(s)")
     b.add_argument("--out", "-o", default="build", metavar="DIR", help="output folder (default: build)")
+    _add_recipe_options(b, "build only this variant of each recipe (default: every variant)")
     b.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
                    help=f"run N tasks in parallel processes (default: the {cores()} cores this process may use; "
                         "with --scheduler, the cluster's threads)")
@@ -238,14 +271,12 @@ def _add_build(sub) -> None:
                    help="send the expensive mesh work (CoACD, hulls, decimation) to this Dask scheduler "
                         "(default: $DASK_SCHEDULER_ADDRESS); 'local' starts one worker per core")
     b.add_argument("-v", "--verbose", action="store_true", help="name every task that runs")
-    b.add_argument("--ros", choices=["ros1", "ros2"], help="build the ROS package for this ROS (overrides the "
-                                                           "recipes' `ros` key)")
+    _add_ros_option(b)
     b.add_argument("--moveit", action="store_true",
                    help="also write the MoveIt 2 configuration (config/moveit/, launch/moveit.launch.py) of every "
                         "robot (as the recipes' `moveit: true`)")
     b.add_argument("--no-report", action="store_true",
                    help="do not write the picture report (<robot>/report/report.html)")
-    _add_arg_option(b)
     _add_root_option(b)
 
 

@@ -26,10 +26,10 @@ def run(args) -> int:
         print("robotkit: error: -j must be at least 1", file=sys.stderr)
         return 2
     start = time.perf_counter()
-    extra = {**({"ros": args.ros} if args.ros else {}), **({"no_report": True} if args.no_report else {}),
-             **({"moveit": True} if args.moveit else {}),
-             **({"args": dict(args.arg)} if args.arg else {})}
-    opts = stamp.options(args.recipes, args.out, extra or None)
+    if args.package_path and not _package_paths_valid(args.package_path):
+        return 2
+    opts = stamp.build_options(args.recipes, args.out, args.ros, not args.no_report, args.moveit, dict(args.arg),
+                               args.variant)
     done = stamp.up_to_date(args.out, opts)  # nothing changed since the last successful build?
     if done is not None:
         return _up_to_date(args, done, start)
@@ -39,7 +39,7 @@ def run(args) -> int:
     with scheduler(args) as jobs, cache_messages():
         result = build(args.recipes, args.out, jobs=jobs, echo=echo, progress=sys.stderr, ros=args.ros,
                        report=not args.no_report, stamp_options=opts, args=dict(args.arg),
-                       moveit=args.moveit)
+                       moveit=args.moveit, variant=args.variant)
     if result.ran or args.verbose:
         for w in result.warning_lines:
             print(w, file=sys.stderr)  # file:line: key: warning: ...
@@ -58,6 +58,14 @@ def run(args) -> int:
     else:
         print(f"{names}: up to date ({len(result.uptodate)} tasks, {elapsed:.2f} s)")
     return 0
+
+
+def _package_paths_valid(items: list[str]) -> bool:
+    """``--package-path``: a recipe names its files by path and reads none, but a malformed one is
+    still bad input, as on every command (imported only when given: the no-op build stays light)."""
+    from robotkit.commands.inputs import package_paths
+
+    return package_paths(items) is not None
 
 
 def _names(out: str, robots: list[str]) -> str:

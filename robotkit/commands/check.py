@@ -14,17 +14,21 @@ from robotkit.check import check_build_dir, check_model_file, check_urdf_file, c
 from robotkit.check.findings import Finding, input_findings
 from robotkit.check.locate import element_lines, locate
 from robotkit.check.render import job_summary, render
+from robotkit.commands.build import cores
 from robotkit.commands.inputs import classify, package_paths
 from robotkit.emit.layout import RobotLayout, robot_layout
 from robotkit.errors import RobotkitError
 from robotkit.pipeline.buildwarn import parse
 from robotkit.pipeline.runner import build
-from robotkit.recipe.load import load_recipe, load_recipes
+from robotkit.recipe.load import load_recipes
 
 
 def run(args) -> int:
     packages = package_paths(args.package_path)
     if packages is None:
+        return 2
+    if args.jobs is not None and args.jobs < 1:
+        print("robotkit: error: -j must be at least 1", file=sys.stderr)
         return 2
     if args.temp_out:
         with tempfile.TemporaryDirectory(prefix="robotkit-check-") as out:
@@ -38,10 +42,11 @@ def _check_paths(args, packages: dict[str, str]) -> int:
     report never comes out empty, and its lines go to stderr as always."""
     findings, status, ran, motion = [], 0, [], {}
     for path in args.paths:
-        try:  # github: the job summary points at the picture report, so a recipe's build writes it
+        try:  # a recipe is built as `robotkit build` builds it: with its picture report unless told
             findings += check(path, args.out, packages, args=dict(args.arg),
-                              report=args.format == "github" and not args.temp_out, motion=motion)
-            ran += cases(path, args.out, dict(args.arg))
+                              report=not args.no_report and not args.temp_out, motion=motion,
+                              variant=args.variant, ros=args.ros, jobs=args.jobs or cores())
+            ran += cases(path, args.out, dict(args.arg), args.variant)
         except RobotkitError as exc:
             for line in exc.lines():
                 print(line, file=sys.stderr)
@@ -64,19 +69,22 @@ def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[
         Path(args.junit).write_text(render(findings, "junit", source, args.fail_on, ran), encoding="utf-8")
     if args.format == "github" and os.environ.get("GITHUB_STEP_SUMMARY"):
         # a temporary build folder is gone when the summary is read: no report to point at
-        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, None if args.temp_out else args.out)
+        _job_summary(os.environ["GITHUB_STEP_SUMMARY"], findings, args.paths, None if args.temp_out else args.out,
+                     dict(args.arg), args.variant)
 
 
 def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
-          args: dict[str, str] | None = None, report: bool = False, motion: dict | None = None) -> list[Finding]:
+          args: dict[str, str] | None = None, report: bool = False, motion: dict | None = None,
+          variant: str | None = None, ros: str | None = None, jobs: int = 1) -> list[Finding]:
     """The findings on PATH.  ``report``: a recipe's build also writes its picture report (as
-    ``robotkit build`` does).  ``motion``: gets each robot's motion results by name."""
+    ``robotkit build`` does).  ``motion``: gets each robot's motion results by name.  ``variant``,
+    ``ros`` and ``jobs``: a recipe's build (``--variant``, ``--ros``, ``-j``)."""
     what = classify(path)
     package_paths = package_paths or {}
     if what.kind == "build":  # a build folder's findings point at its URDF
         return [f for d in what.robots for f in locate(check_build_dir(d.root, motion=motion), d.urdf)]
     if what.kind == "recipe":
-        return check_recipe(what.path, out_dir, args, report, motion)
+        return check_recipe(what.path, out_dir, args, report, motion, variant, ros, jobs)
     if what.kind == "urdf":
         return check_urdf_file(what.path, package_paths)
     if what.kind == "xacro":
@@ -85,13 +93,14 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
 
 
 def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False,
-                 motion: dict | None = None) -> list[Finding]:
-    """Build the recipe, then check each of its robots (one per variant), the build's warnings
-    and the findings placed on the recipe's lines."""
+                 motion: dict | None = None, variant: str | None = None, ros: str | None = None,
+                 jobs: int = 1) -> list[Finding]:
+    """Build the recipe, then check each of its robots (one per variant, or ``variant``), the
+    build's warnings and the findings placed on the recipe's lines."""
     located = []
-    result = build([path], out_dir, args=args, report=report)
+    result = build([path], out_dir, jobs=jobs, args=args, report=report, ros=ros, variant=variant)
     warnings = [parse(w) for w in result.warning_lines]  # (file, line, key, text)
-    for i, loaded in enumerate(load_recipes(path, args)):  # one per variant
+    for i, loaded in enumerate(load_recipes(path, args, variant)):  # one per variant
         name = loaded.recipe.robot
         others = [r for r in result.robots if r != name]
         # a warning naming another variant's robot belongs to that one; the rest to the first
@@ -120,7 +129,8 @@ def _check_variant(loaded, warnings: list[tuple], out_dir: str, motion: dict | N
             for f in build_findings] + located
 
 
-def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None) -> list[tuple[str, str]]:
+def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None,
+          variant: str | None = None) -> list[tuple[str, str]]:
     """Every (check, subject) that a check of ``path`` ran, named as its findings name them, so
     CI reports list what passed too: each validator on each file, the equivalence, consumer and
     simulation stages on the robot, and the physics lints (``lints``) on each link and joint."""
@@ -129,7 +139,8 @@ def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None)
     if what.kind == "build":
         return [c for d in what.robots for c in _folder_cases(d)]
     if what.kind == "recipe":
-        return [c for loaded in load_recipes(p, args) for c in _folder_cases(robot_layout(Path(out_dir) / loaded.recipe.robot))]
+        return [c for loaded in load_recipes(p, args, variant)
+                for c in _folder_cases(robot_layout(Path(out_dir) / loaded.recipe.robot))]
     if what.kind == "urdf":
         return [("check_urdf", str(p)), ("consumer", f"robot '{p.stem}'")] + _described(p)
     if what.kind == "xacro":
@@ -151,14 +162,15 @@ def _folder_cases(d: RobotLayout) -> list[tuple[str, str]]:
             + _described(d.urdf))
 
 
-def _job_summary(summary_file: str, findings, paths: list[str], out: str | None) -> None:
+def _job_summary(summary_file: str, findings, paths: list[str], out: str | None, args: dict[str, str] | None = None,
+                 variant: str | None = None) -> None:
     """Append the check's summary, pointing at the picture report, to GitHub's job summary."""
     folders: list[RobotLayout] = []
     for path in paths:
         try:
             what = classify(path)
             if what.kind == "recipe" and out is not None:
-                folders.append(robot_layout(Path(out) / load_recipe(what.path).recipe.robot))
+                folders += [robot_layout(Path(out) / one.recipe.robot) for one in load_recipes(what.path, args, variant)]
             elif what.kind == "build":
                 folders += what.robots
         except RobotkitError:

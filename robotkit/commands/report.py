@@ -1,4 +1,4 @@
-"""``robotkit report PATH [-o DIR]``: the picture report of a recipe (built first), a build
+"""``robotkit report PATH [-o DIR] [--build-dir DIR]``: the picture report of a recipe (built first), a build
 folder, a URDF (imported and built in a temporary folder for its pictures: meshes of any format,
 DAE among them, become what MuJoCo reads) or an SDF/MJCF file."""
 
@@ -26,14 +26,17 @@ def run(args) -> int:
     if packages is None:
         return 2
     start = time.perf_counter()
-    page = write_report(args.path, args.output, args.out, packages)
+    page = write_report(args.path, args.out, args.build_dir, packages, dict(args.arg), args.variant)
     print(f"wrote {os.path.relpath(page)} ({time.perf_counter() - start:.2f} s)")
     return 0
 
 
 def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = None, build_out: str = "build",
-                 package_paths: dict[str, str] | None = None) -> Path:
-    """Write ``out_dir/report.html`` and its pictures for PATH; return the page's path."""
+                 package_paths: dict[str, str] | None = None, args: dict[str, str] | None = None,
+                 variant: str | None = None) -> Path:
+    """Write ``out_dir/report.html`` and its pictures for PATH; return the page's path.  A recipe
+    is built in ``build_out`` first, with its arguments ``args`` (``--arg``); ``variant``: the robot
+    of that variant (default: the first)."""
     what = classify(path, KINDS, "a recipe .yaml, .urdf, .sdf or MJCF .xml")
     p = what.path
     if what.kind == "build":
@@ -41,8 +44,8 @@ def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = No
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
                                 motion=step_responses(robot))
     if what.kind == "recipe":
-        loaded = load_recipe(p)
-        build([p], build_out, report=False)
+        loaded = load_recipe(p, args, variant)
+        build([p], build_out, report=False, args=args, variant=variant or loaded.variant)
         robot = robot_layout(Path(build_out) / loaded.recipe.robot)
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
                                 loaded.recipe.measured_mass, motion=step_responses(robot))

@@ -42,9 +42,10 @@ def mesh_locations(loaded, robot: Robot) -> dict[str, dict]:
 
 
 def load_robots(recipe_files, ros: str | None = None, args: dict[str, str] | None = None,
-                ignore_unknown_args: bool = False, moveit: bool = False) -> list[tuple[object, Robot]]:
-    """Load and resolve every recipe (every variant of each; ``ros`` overrides their ``ros`` key,
-    ``moveit`` turns their ``moveit`` key on); all problems of all recipes together.
+                ignore_unknown_args: bool = False, moveit: bool = False,
+                variant: str | None = None) -> list[tuple[object, Robot]]:
+    """Load and resolve every recipe (every variant of each, or only ``variant``; ``ros`` overrides
+    their ``ros`` key, ``moveit`` turns their ``moveit`` key on); all problems of all recipes together.
 
     ``args``: ``--arg`` overrides (name -> text); with ``ignore_unknown_args`` a recipe ignores the
     ones it does not declare (doit builds many recipes with one set of arguments)."""
@@ -53,7 +54,7 @@ def load_robots(recipe_files, ros: str | None = None, args: dict[str, str] | Non
     names: dict[str, str] = {}
     declared: set[str] = set()
     for f in recipe_files:
-        for loaded in read_recipes(f, args, ignore_unknown_args):
+        for loaded in read_recipes(f, args, ignore_unknown_args, variant):
             declared.update(loaded.arg_names)
             try:
                 robot = resolve_checked(loaded, ros, moveit)

@@ -138,10 +138,11 @@ def to_doit(task: dict) -> dict:
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
           echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None,
           report: bool = False, args: dict[str, str] | None = None, keep_going: bool = False,
-          moveit: bool = False) -> BuildResult:
+          moveit: bool = False, variant: str | None = None) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
     ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key, ``moveit`` turns their ``moveit``
-    key on; ``args`` sets recipe arguments (``--arg``).
+    key on; ``args`` sets recipe arguments (``--arg``); ``variant`` builds only that variant of
+    each recipe (``--variant``; a recipe without it is bad input).
     ``report`` also writes each robot's picture report (``<robot>/report/report.html``); the
     command line does unless ``--no-report``.
 
@@ -151,13 +152,13 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
 
     The stamp of the no-op fast path (:mod:`robotkit.pipeline.stamp`) is removed first and written
     again when the build succeeds; ``stamp_options`` are the options it is kept under
-    (default :func:`robotkit.pipeline.stamp.options` of the recipes and the output folder).
+    (default :func:`robotkit.pipeline.stamp.build_options` of these settings).
     """
     if stamp_options is None:  # a build without the report is another build than one with it
-        stamp_options = stamp.options(recipes, out_dir, None if report else {"no_report": True})
+        stamp_options = stamp.build_options(recipes, out_dir, ros, report, moveit, args, variant)
     stamp.remove(out_dir, stamp_options)
     out = Path(out_dir).absolute()
-    robots = load_robots(recipes, ros, args, moveit=moveit)  # raises before anything is written
+    robots = load_robots(recipes, ros, args, moveit=moveit, variant=variant)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
     tasks = [t for loaded, robot in robots for t in robot_tasks(robot, out, mesh_locations(loaded, robot),
                                                                  report=report)]

@@ -46,6 +46,16 @@ def options(recipes, out_dir, extra: dict | None = None) -> dict:
             **({"roots": roots} if roots else {}), **(extra or {})}
 
 
+def build_options(recipes, out_dir, ros: str | None = None, report: bool = True, moveit: bool = False,
+                  args: dict[str, str] | None = None, variant: str | None = None) -> dict:
+    """:func:`options` of a build with these settings (``robotkit build``'s, or a build that
+    another command runs: ``check`` and ``report`` of a recipe)."""
+    extra = {**({"ros": ros} if ros else {}), **({} if report else {"no_report": True}),
+             **({"moveit": True} if moveit else {}), **({"args": dict(args)} if args else {}),
+             **({"variant": variant} if variant is not None else {})}
+    return options(recipes, out_dir, extra or None)
+
+
 def path(out_dir, opts: dict) -> str:
     return os.path.join(os.path.abspath(os.fspath(out_dir)), STATE, f"stamp-{_key(opts)}.json")
 

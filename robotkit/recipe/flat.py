@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 
-from robotkit.errors import Problem, RecipeError
 from robotkit.recipe.load import load_recipes
 
 
@@ -35,14 +34,7 @@ def flat_data(loaded) -> dict:
 def flat_yaml(file: str, args: dict[str, str] | None = None, variant: str | None = None) -> str:
     import yaml
 
-    loaded = load_recipes(file, args)
-    if variant is not None:
-        chosen = [one for one in loaded if one.variant == variant]
-        if not chosen:
-            names = ", ".join(str(one.variant) for one in loaded if one.variant is not None) or "none"
-            raise RecipeError(Problem(f"no variant named '{variant}' (variants: {names})", file=file,
-                                      key="--variant"))
-        loaded = chosen
+    loaded = load_recipes(file, args, variant)
     class Dumper(yaml.SafeDumper):
         pass
 

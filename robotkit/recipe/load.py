@@ -439,12 +439,13 @@ class LoadedRecipe:
 
 
 def read_recipes(file: str | os.PathLike, args: dict[str, str] | None = None,
-                 ignore_unknown_args: bool = False) -> list[LoadedRecipe]:
+                 ignore_unknown_args: bool = False, variant: str | None = None) -> list[LoadedRecipe]:
     """Read, expand and validate a recipe: one LoadedRecipe per variant (one when it has none).
 
     Never raises for bad input: each result carries its ``problems`` and, when it can, a
     recipe with the invalid parts neutralised, so later stages can add their own problems
-    (robotkit.model.resolve.resolve_checked).  ``args``: ``--arg`` overrides, name -> text.
+    (robotkit.model.resolve.resolve_checked).  ``args``: ``--arg`` overrides, name -> text;
+    ``variant`` (``--variant``): only that variant (a recipe without it: one result, its problem).
     """
     file = Path(file).absolute()
     problems: list[Problem] = []
@@ -466,7 +467,24 @@ def read_recipes(file: str | os.PathLike, args: dict[str, str] | None = None,
         loaded.arg_names = exp.arg_names
         loaded.files = sorted(set(loaded.files) | set(exp.files))
         out.append(loaded)
-    return out
+    return out if variant is None else _one_variant(out, variant, file)
+
+
+def _one_variant(loaded: list[LoadedRecipe], variant: str, file: Path) -> list[LoadedRecipe]:
+    """The results of ``variant`` alone; when the recipe has no such variant, one result without
+    a recipe whose problems are that one, after the recipe's own."""
+    chosen = [one for one in loaded if one.variant == variant]
+    if chosen:
+        return chosen
+    names = [one.variant for one in loaded if one.variant is not None]
+    close = difflib.get_close_matches(variant, names, n=1)
+    known = f"variants: {', '.join(names)}" if names else "the recipe has no variants"
+    hint = f"did you mean '{close[0]}'? " if close else ""
+    problems = [p for one in loaded for p in one.problems]
+    problems = [p for i, p in enumerate(problems) if p not in problems[:i]]
+    problems.insert(0, Problem(f"no variant named '{variant}' ({hint}{known})", file=str(file), key="--variant"))
+    files = sorted({f for one in loaded for f in one.files})
+    return [LoadedRecipe(file=file, recipe=None, marks=loaded[0].marks, files=files, partial=True, problems=problems)]
 
 
 def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], variant) -> LoadedRecipe:
@@ -497,9 +515,10 @@ def sort_problems(problems: list[Problem], file) -> list[Problem]:
     return sorted(problems, key=lambda p: (p.file != str(file), p.file or "", p.line or 0))
 
 
-def load_recipes(file: str | os.PathLike, args: dict[str, str] | None = None) -> list[LoadedRecipe]:
+def load_recipes(file: str | os.PathLike, args: dict[str, str] | None = None,
+                 variant: str | None = None) -> list[LoadedRecipe]:
     """:func:`read_recipes`, raising RecipeError with every loading problem."""
-    loaded = read_recipes(file, args)
+    loaded = read_recipes(file, args, variant=variant)
     problems = [p for one in loaded for p in one.problems]
     if problems:
         unique = []
@@ -510,9 +529,10 @@ def load_recipes(file: str | os.PathLike, args: dict[str, str] | None = None) ->
     return loaded
 
 
-def load_recipe(file: str | os.PathLike, args: dict[str, str] | None = None) -> LoadedRecipe:
-    """The recipe (its first variant), raising RecipeError with every loading problem."""
-    return load_recipes(file, args)[0]
+def load_recipe(file: str | os.PathLike, args: dict[str, str] | None = None,
+                variant: str | None = None) -> LoadedRecipe:
+    """The recipe (its first variant, or ``variant``), raising RecipeError with every loading problem."""
+    return load_recipes(file, args, variant)[0]
 
 
 def _salvage(data: dict, exc):
