@@ -28,7 +28,8 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def _parser() -> argparse.ArgumentParser:
+def parser() -> argparse.ArgumentParser:
+    """Every verb's parser (robotkit --help; the tests read the options of each)."""
     p = _Parser(prog="robotkit", description="Declarative build system for robot description assets.")
     p.add_argument("--version", action="store_true", help="print the version and exit")
     sub = p.add_subparsers(dest="command", parser_class=_Parser)
@@ -280,7 +281,7 @@ def _add_build(sub) -> None:
     _add_root_option(b)
 
 
-def _build_parser() -> argparse.ArgumentParser:
+def build_parser() -> argparse.ArgumentParser:
     """Only ``build``: a no-op build does not import the other commands' modules."""
     p = _Parser(prog="robotkit", description="Declarative build system for robot description assets.")
     p.add_argument("--version", action="store_true", help="print the version and exit")
@@ -290,12 +291,12 @@ def _build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = (_build_parser() if argv[:1] == ["build"] else _parser()).parse_args(argv)
+    args = (build_parser() if argv[:1] == ["build"] else parser()).parse_args(argv)
     if args.version:
         print(f"robotkit {__version__}")
         return 0
     if args.command is None:
-        _parser().print_help()
+        parser().print_help()
         return 2
     _widen_roots(getattr(args, "root", []))
     try:
