@@ -834,7 +834,7 @@ class Recipe(Strict):
     worlds: dict[Name, World] = {}
     """Worlds made from occupancy maps, by name (``robotkit world`` does the same from the command line)."""
     args: dict[str, Arg | Scalar] = {}
-    """Arguments with their defaults, set with ``--arg NAME:=VALUE`` (``robotkit build``, ``check``, ``expand``; ``doit args='NAME:=VALUE ...'``) or by ``variants``; used as ``${NAME}``."""
+    """Arguments with their defaults, set with ``--arg NAME:=VALUE`` (``robotkit build``, ``check``, ``report``, ``view``, ``expand``; ``doit args='NAME:=VALUE ...'``) or by ``variants``; used as ``${NAME}``."""
     values: dict[str, Scalar] = {}
     """Named values, in order, each may use the arguments and the values before it: ``${NAME}``."""
     parts: dict[str, Part | str] = {}
@@ -842,7 +842,7 @@ class Recipe(Strict):
     instances: dict[str, Instance] = {}
     """Uses of parts, by instance name."""
     variants: dict[str, dict[str, Scalar]] = {}
-    """Named sets of argument values; each builds its own robot folder ``<robot>_<variant>`` (the recipe's defaults alone are then not built)."""
+    """Named sets of argument values; each builds its own robot folder ``<robot>_<variant>`` (the recipe's defaults alone are then not built); ``--variant NAME`` builds, checks, reports or shows only one."""
 
     @field_validator("robot")
     @classmethod
