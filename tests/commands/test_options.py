@@ -119,8 +119,8 @@ def test_build_variant_builds_only_that_variant(tmp_path):
 
 def test_a_malformed_package_path_is_bad_input_on_every_verb(tmp_path):
     recipe = cart(tmp_path)
-    for verb in ("build", "check", "report"):
-        proc = run_cli(verb, recipe, "--package-path", "nodir", "-o", tmp_path / "out")
+    for verb in ("build", "check", "report", "expand"):
+        proc = run_cli(verb, recipe, "--package-path", "nodir", *(["-o", tmp_path / "out"] if verb != "expand" else []))
         assert (proc.returncode, proc.stderr) == (2, "robotkit: error: --package-path takes PKG=DIR (got 'nodir')\n")
     assert not (tmp_path / "out").exists()
     proc = run_cli("check", recipe, "-j", "0")
