@@ -106,8 +106,8 @@ def _add_check(sub) -> None:
                         "process may use)")
     _add_ros_option(c)
     c.add_argument("--no-report", action="store_true",
-                   help="do not write a recipe's picture report (<robot>/report/report.html), as on build; "
-                        "never written with --temp-out")
+                   help="do not write a recipe's picture report (<robot>/report/report.html); check draws "
+                        "it only for --format github, and keeps one an earlier build wrote; never with --temp-out")
     _add_root_option(c)
 
 

@@ -42,9 +42,10 @@ def _check_paths(args, packages: dict[str, str]) -> int:
     report never comes out empty, and its lines go to stderr as always."""
     findings, status, ran, motion = [], 0, [], {}
     for path in args.paths:
-        try:  # a recipe is built as `robotkit build` builds it: with its picture report unless told
-            findings += check(path, args.out, packages, args=dict(args.arg),
-                              report=not args.no_report and not args.temp_out, motion=motion,
+        try:  # a recipe is built as `robotkit build` builds it; its picture report for GitHub's summary,
+            # or kept when an earlier build wrote one (None), never drawn anew only for a check
+            report = False if args.no_report or args.temp_out else (True if args.format == "github" else None)
+            findings += check(path, args.out, packages, args=dict(args.arg), report=report, motion=motion,
                               variant=args.variant, ros=args.ros, jobs=args.jobs or cores())
             ran += cases(path, args.out, dict(args.arg), args.variant)
         except RobotkitError as exc:
@@ -74,10 +75,10 @@ def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[
 
 
 def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
-          args: dict[str, str] | None = None, report: bool = False, motion: dict | None = None,
+          args: dict[str, str] | None = None, report: bool | None = False, motion: dict | None = None,
           variant: str | None = None, ros: str | None = None, jobs: int = 1) -> list[Finding]:
     """The findings on PATH.  ``report``: a recipe's build also writes its picture report (as
-    ``robotkit build`` does).  ``motion``: gets each robot's motion results by name.  ``variant``,
+    ``robotkit build`` does); None: when the build folder has one already.  ``motion``: gets each robot's motion results by name.  ``variant``,
     ``ros`` and ``jobs``: a recipe's build (``--variant``, ``--ros``, ``-j``)."""
     what = classify(path)
     package_paths = package_paths or {}
@@ -92,12 +93,25 @@ def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | Non
     return check_model_file(what.path, what.kind, motion)
 
 
-def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool = False,
+def _has_report(path: Path, out_dir: str, args: dict[str, str] | None, variant: str | None) -> bool:
+    """Whether a robot of the recipe has a picture report in ``out_dir`` (an earlier build's:
+    check's build keeps it, as publishing would remove it); a recipe that does not load has none
+    (the build says why)."""
+    try:
+        return any(robot_layout(Path(out_dir) / loaded.recipe.robot).pictures.joinpath("report.html").is_file()
+                   for loaded in load_recipes(path, args, variant))
+    except RobotkitError:
+        return False
+
+
+def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool | None = False,
                  motion: dict | None = None, variant: str | None = None, ros: str | None = None,
                  jobs: int = 1) -> list[Finding]:
     """Build the recipe, then check each of its robots (one per variant, or ``variant``), the
     build's warnings and the findings placed on the recipe's lines."""
     located = []
+    if report is None:
+        report = _has_report(path, out_dir, args, variant)
     result = build([path], out_dir, jobs=jobs, args=args, report=report, ros=ros, variant=variant)
     warnings = [parse(w) for w in result.warning_lines]  # (file, line, key, text)
     for i, loaded in enumerate(load_recipes(path, args, variant)):  # one per variant

@@ -150,8 +150,8 @@ def test_report_o_is_the_report_folder_and_build_dir_the_build(tmp_path):
 @pytest.mark.slow
 @pytest.mark.consumers
 def test_check_builds_a_recipe_as_build_does(tmp_path):
-    """--variant, --ros, -j and --no-report reach check's build; by default it writes the
-    picture report as build does, so a check after a build rebuilds nothing."""
+    """--variant, --ros, -j and --no-report reach check's build; check draws no picture report
+    of its own, but keeps the one a build wrote (a check after a build rebuilds nothing)."""
     recipe = cart(tmp_path)
     out = tmp_path / "out"
     proc = run_cli("check", recipe, "-o", out, "--variant", "small", "--ros", "ros1", "-j", "2", "--no-report",
@@ -160,6 +160,8 @@ def test_check_builds_a_recipe_as_build_does(tmp_path):
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["cart_small"]
     assert "<buildtool_depend>catkin</buildtool_depend>" in (out / "cart_small/package.xml").read_text()
     assert not (out / "cart_small/report").exists()
+    proc = run_cli("check", recipe, "-o", out, "--variant", "small", "--format", "json")
+    assert not (out / "cart_small/report").exists()  # not drawn for a check
     proc = run_cli("build", recipe, "-o", out, "--variant", "small")
     assert (out / "cart_small/report/report.html").is_file()
     proc = run_cli("check", recipe, "-o", out, "--variant", "small", "--format", "json")
