@@ -141,7 +141,7 @@ class RendererUnavailable(RobotkitError):
         """MuJoCo's exception in words: its first line; PyOpenGL's AttributeError on a GL library it
         could not load (``'NoneType' object has no attribute 'glGetError'``) as what it means."""
         text = str(exc).strip()
-        if isinstance(exc, AttributeError) and "'NoneType' object has no attribute 'gl" in text:
+        if isinstance(exc, AttributeError) and "'NoneType' object has no attribute '" in text:
             return {"osmesa": "libOSMesa", "egl": "libEGL"}.get(gl, "its OpenGL library") + " is not installed"
         return text.splitlines()[0] if text else type(exc).__name__
 

@@ -1,9 +1,10 @@
-"""A machine where MuJoCo cannot draw offscreen because Debian's libosmesa6 is not installed.
+"""A machine where MuJoCo cannot draw offscreen because Debian's libosmesa6 (or, for MUJOCO_GL=egl,
+libEGL) is not installed.
 
 The library cannot be removed from the test machine, so the robotkit processes are started with a
-``sitecustomize`` on PYTHONPATH that makes loading libOSMesa fail as it does where the file is
-missing (``OSError: ... cannot open shared object file``); everything else is real: MuJoCo's and
-PyOpenGL's imports, the build and its worker processes, the report command."""
+``sitecustomize`` on PYTHONPATH that makes loading it fail as it does where the file is missing
+(``OSError: ... cannot open shared object file``); everything else is real: MuJoCo's and PyOpenGL's
+imports, the build and its worker processes, the report command."""
 
 from __future__ import annotations
 
@@ -17,14 +18,14 @@ import pytest
 
 from conftest import RECIPES
 
-NO_OSMESA = '''\
+MISSING = '''\
 import ctypes
 
 _load = ctypes.CDLL.__init__
 
 
 def _missing(self, name, *args, **kwargs):
-    if name and "OSMesa" in str(name):
+    if name and "{library}" in str(name):
         raise OSError(f"{name}: cannot open shared object file: No such file or directory")
     _load(self, name, *args, **kwargs)
 
@@ -36,11 +37,15 @@ WHY = ("no pictures: MuJoCo cannot draw offscreen with MUJOCO_GL=osmesa (libOSMe
        "install libosmesa6: sudo apt-get install libosmesa6")
 
 
-def run_without_osmesa(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
+def run_without_osmesa(tmp_path: Path, *args: str, library: str = "OSMesa", gl: str | None = None):
+    """robotkit ``args`` in a process (and its workers) that cannot load ``library`` (libOSMesa,
+    libEGL), with ``MUJOCO_GL`` unset (robotkit's default: osmesa) or ``gl``."""
     fake = tmp_path / "no-osmesa"
     fake.mkdir(exist_ok=True)
-    (fake / "sitecustomize.py").write_text(NO_OSMESA, encoding="utf-8")
-    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}  # robotkit's default: osmesa
+    (fake / "sitecustomize.py").write_text(MISSING.replace("{library}", library), encoding="utf-8")
+    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+    if gl is not None:
+        env["MUJOCO_GL"] = gl
     env["PYTHONPATH"] = os.pathsep.join([str(fake)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
     return subprocess.run([sys.executable, "-m", "robotkit", *args], capture_output=True, text=True,
                           cwd=tmp_path, env=env)
@@ -74,3 +79,21 @@ def test_without_osmesa_a_build_writes_everything_warns_once_and_report_stops(tm
         assert (robot / rel).is_file(), rel
     assert not list((robot / "report").glob("*.png"))
     assert (report.returncode, report.stderr.splitlines()) == (2, [WHY])
+
+
+MJCF = """<mujoco><worldbody><body name="box"><freejoint/><geom type="box" size="0.1 0.1 0.1" group="2"/>
+</body></worldbody></mujoco>
+"""
+
+
+@pytest.mark.parametrize("gl, library, why", [
+    (None, "OSMesa", WHY),
+    ("egl", "EGL", "no pictures: MuJoCo cannot draw offscreen with MUJOCO_GL=egl (libEGL is not installed); install "
+                   "an EGL driver (sudo apt-get install libegl1 libegl-mesa0), or unset MUJOCO_GL to draw with OSMesa "
+                   "(sudo apt-get install libosmesa6)"),
+])
+def test_report_of_an_mjcf_says_which_library_the_backend_lacks(tmp_path, gl, library, why):
+    (tmp_path / "box.xml").write_text(MJCF, encoding="utf-8")
+    done = run_without_osmesa(tmp_path, "report", "box.xml", library=library, gl=gl)
+    assert (done.returncode, done.stdout, done.stderr) == (2, "", why + "\n")
+    assert not (tmp_path / "box-report").exists()
