@@ -43,7 +43,8 @@ def run_without_osmesa(tmp_path: Path, *args: str, library: str = "OSMesa", gl: 
     fake = tmp_path / "no-osmesa"
     fake.mkdir(exist_ok=True)
     (fake / "sitecustomize.py").write_text(MISSING.replace("{library}", library), encoding="utf-8")
-    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+    # PYOPENGL_PLATFORM: set in this process by an earlier test's MuJoCo import, not in a user's shell
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
     if gl is not None:
         env["MUJOCO_GL"] = gl
     env["PYTHONPATH"] = os.pathsep.join([str(fake)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
