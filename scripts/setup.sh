@@ -53,5 +53,10 @@ fi
 
 [ -x .venv/bin/python ] || python3 -m venv .venv
 extra=""; [ "${1:-}" = "--test" ] && extra="[test]"
-.venv/bin/python -m pip install -q --disable-pip-version-check -e ".${extra}" 2>&1 | grep -v "^WARNING: Location" || true
+if ! log=$(.venv/bin/python -m pip install -q --disable-pip-version-check -e ".${extra}" 2>&1); then
+  [ -z "$log" ] || grep -v "^WARNING: Location" <<<"$log" >&2 || true
+  echo "setup.sh: pip could not install robotkit (its error above); run: .venv/bin/python -m pip install -e '.${extra}'" >&2
+  exit 1
+fi
+[ -z "$log" ] || grep -v "^WARNING: Location" <<<"$log" || true
 .venv/bin/python -c "import robotkit" # fail loudly if the install did not work

@@ -1,6 +1,6 @@
 """scripts/setup.sh where apt-get cannot install (the dpkg lock held by another apt): it fails with
 one line saying what to run when the quick start's build would need the package, and under CI when
-a test would.  The script is run from a scratch copy of scripts/ (it works in the folder above it) with
+a test would; and where pip cannot install robotkit (it used to carry on).  The script is run from a scratch copy of scripts/ (it works in the folder above it) with
 PATH limited to the tools it calls and fakes of ``ldconfig`` (what is installed) and ``apt-get``
 (which refuses as apt does with the lock held) and ``python3`` (one with venv), so it never reaches
 the venv or pip."""
@@ -59,3 +59,16 @@ def test_setup_check_fails_under_ci_when_a_validator_cannot_be_installed(tmp_pat
         f"installing Debian packages: {packages}",
         f"setup.sh: could not install {packages} ({LOCKED[3:]}); run: {sudo()}apt-get install -y {packages}"]
     assert not (tmp_path / ".venv").exists()
+
+
+def test_setup_fails_with_what_to_run_when_pip_cannot_install_robotkit(tmp_path):
+    venv = tmp_path / ".venv" / "bin"
+    venv.mkdir(parents=True)
+    (venv / "python").write_text('#!/bin/sh\n[ "$2" = pip ] || exit 0\n'
+                                 'echo "ERROR: No matching distribution found for mujoco>=3" >&2\nexit 1\n')
+    (venv / "python").chmod(0o755)
+    done = run_setup(tmp_path, True)
+    assert done.returncode == 1
+    assert done.stderr.splitlines() == [
+        "ERROR: No matching distribution found for mujoco>=3",
+        "setup.sh: pip could not install robotkit (its error above); run: .venv/bin/python -m pip install -e '.'"]
