@@ -27,7 +27,7 @@ from robotkit.model.load import load_robots, mesh_locations
 from robotkit.pipeline import stamp
 from robotkit.pipeline.buildwarn import build_warnings, no_pictures
 from robotkit.pipeline.progress import Progress
-from robotkit.pipeline.publish import STAGE, STATE, publish, staged_files
+from robotkit.pipeline.publish import STATE, publish, stage_dir, staged_files
 from robotkit.pipeline.tasks import robot_tasks
 
 
@@ -240,7 +240,7 @@ def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder
         try:
             written = [t for t in mine if t["name"] not in recorder.not_written]
             published += publish(out, robot.name, staged_files(written, out))
-            left = _stage_paths([t for t in mine if t["name"] in recorder.not_written], out / STATE / STAGE)
+            left = _stage_paths([t for t in mine if t["name"] in recorder.not_written], stage_dir(out))
             if left:
                 result.left_out[robot.name] = left
         except OSError as exc:
