@@ -120,16 +120,32 @@ class MapError(RobotkitError):
 class RendererUnavailable(RobotkitError):
     """MuJoCo cannot draw offscreen here (no OSMesa, or a ``MUJOCO_GL`` that cannot work): the
     picture report has no pictures.  A build still writes everything else and warns; ``robotkit
-    report`` stops on it (exit 2).  The message says what to install."""
+    report`` stops on it (exit 2).  The message says what to install, for the backend asked for."""
 
-    def __init__(self, reason: str):
-        gl = os.environ.get("MUJOCO_GL", "")
-        super().__init__(Problem(
-            f"no pictures: MuJoCo cannot draw offscreen with MUJOCO_GL={gl!r} ({reason}); install Debian's "
-            "libosmesa6 (sudo apt-get install libosmesa6) and leave MUJOCO_GL unset or set to osmesa"))
+    def __init__(self, reason: "str | BaseException"):
+        gl = os.environ.get("MUJOCO_GL") or "osmesa"  # robotkit's default (robotkit/__init__.py)
+        if isinstance(reason, BaseException):
+            reason = self.reason(reason, gl)
+        if gl == "osmesa":
+            advice = "install libosmesa6: sudo apt-get install libosmesa6"
+        elif gl == "egl":
+            advice = ("install an EGL driver (sudo apt-get install libegl1 libegl-mesa0), or unset MUJOCO_GL "
+                      "to draw with OSMesa (sudo apt-get install libosmesa6)")
+        else:
+            advice = "unset MUJOCO_GL to draw with OSMesa (sudo apt-get install libosmesa6)"
+        super().__init__(Problem(f"no pictures: MuJoCo cannot draw offscreen with MUJOCO_GL={gl} ({reason}); "
+                                 + advice))
+
+    @staticmethod
+    def reason(exc: BaseException, gl: str) -> str:
+        """MuJoCo's exception in words: its first line; PyOpenGL's AttributeError on a GL library it
+        could not load (``'NoneType' object has no attribute 'glGetError'``) as what it means."""
+        text = str(exc).strip()
+        if isinstance(exc, AttributeError) and "'NoneType' object has no attribute '" in text:
+            return {"osmesa": "libOSMesa", "egl": "libEGL"}.get(gl, "its OpenGL library") + " is not installed"
+        return text.splitlines()[0] if text else type(exc).__name__
 
     @classmethod
     def because(cls, exc: BaseException) -> "RendererUnavailable":
-        """The error for MuJoCo's own exception (its first line)."""
-        text = str(exc).strip()
-        return cls(text.splitlines()[0] if text else type(exc).__name__)
+        """The error for MuJoCo's own exception."""
+        return cls(exc)

@@ -13,9 +13,9 @@ import sys
 
 from robotkit.ioutil import environ
 
-GL_FAILURE: list[str] = []
-"""Why MuJoCo was imported with rendering off (its import error's first line), if it was: the
-picture report gives that reason rather than the disabled backend's."""
+GL_FAILURE: list[BaseException] = []
+"""Why MuJoCo was imported with rendering off (its import error), if it was: the picture report
+gives that reason (robotkit.errors.RendererUnavailable) rather than the disabled backend's."""
 
 
 def load():
@@ -25,8 +25,9 @@ def load():
     os.environ.setdefault("MUJOCO_GL", "osmesa")  # software GL, no display: what the pictures use
     try:
         import mujoco
-    except RuntimeError as exc:  # "invalid value for environment variable MUJOCO_GL", no OSMesa...
-        GL_FAILURE.append((str(exc).strip().splitlines() or [type(exc).__name__])[0])
+    except Exception as exc:  # noqa: BLE001  (RuntimeError: "invalid value for environment variable
+        # MUJOCO_GL"; AttributeError: PyOpenGL found no libOSMesa/libEGL; ImportError, OSError...)
+        GL_FAILURE.append(exc)
         for name in [n for n in sys.modules if n == "mujoco" or n.startswith("mujoco.")]:
             del sys.modules[name]
         with environ({"MUJOCO_GL": "disable"}):

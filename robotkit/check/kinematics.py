@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from robotkit import urdfxml
+from robotkit import mj, urdfxml
 
 WORLD = "world"
 NEGLIGIBLE = 1e-200  # kg: robotkit's URDF writes massless links as 1e-300 kg (see emit/urdf.py)
@@ -135,7 +135,7 @@ def _quat_R(q) -> np.ndarray:
 
 
 def from_mujoco(model, source: str) -> KModel:
-    import mujoco
+    mujoco = mj.load()  # rendering off where MUJOCO_GL cannot work: reading needs no GL
 
     links: dict[str, KLink] = {}
     joints: dict[str, KJoint] = {}
@@ -185,7 +185,7 @@ def from_mujoco(model, source: str) -> KModel:
 
 
 def read_mjcf(path) -> KModel:
-    import mujoco
+    mujoco = mj.load()  # rendering off where MUJOCO_GL cannot work: reading needs no GL
 
     return from_mujoco(mujoco.MjModel.from_xml_path(str(path)), f"MJCF {path}")
 
@@ -193,7 +193,7 @@ def read_mjcf(path) -> KModel:
 def read_urdf(path) -> KModel:
     """Our URDF through MuJoCo's URDF compiler (fixed joints kept), plus velocity limits
     and names from the XML, which MuJoCo ignores."""
-    import mujoco
+    mujoco = mj.load()  # rendering off where MUJOCO_GL cannot work: reading needs no GL
 
     text = open(path, encoding="utf-8").read()
     # geometry plays no part in the comparison; meshes (DAE among them) need not load

@@ -8,6 +8,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
+from robotkit import mj
 from robotkit.check.findings import Finding
 
 
@@ -60,8 +61,8 @@ def validate_sdf(path: Path) -> list[Finding]:
 
 
 def validate_mjcf(path: Path) -> list[Finding]:
-    try:  # heavy and optional: imported when an MJCF is validated
-        import mujoco
+    try:  # heavy and optional: imported when an MJCF is validated (rendering off where it cannot work)
+        mujoco = mj.load()
     except ImportError:
         return [Finding("warning", "mujoco", str(path), "mujoco is not installed", "pip install mujoco")]
     try:

@@ -103,4 +103,5 @@ def has_actuators(robot: Robot) -> bool:
     return bool(robot.actuators)
 
 
-FORMATS = [Format("controllers", render_controllers, layout.CONTROLLERS, reads="structure", when=has_actuators)]
+FORMATS = [Format("controllers", render_controllers, layout.CONTROLLERS, reads="structure", needs=("urdf",),
+                   when=has_actuators)]

@@ -42,6 +42,10 @@ class Format:
     """A program loads it as a robot: not written for a robot that a program would refuse."""
     options: Mapping[str, object] = field(default_factory=dict)
     """Keyword arguments of ``render``."""
+    needs: tuple[str, ...] = ()
+    """The formats whose files it names or describes (a launch file reads the URDF; model.config names
+    model.sdf): not written when one of them is not (a consumer would refuse it), so that a build
+    folder holds no file naming a missing one."""
     when: Callable[[Robot], bool] | None = None
     """Written only for the robots this accepts (default: every robot)."""
     points: Callable[[Robot], list[str]] | None = None

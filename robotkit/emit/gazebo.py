@@ -13,4 +13,4 @@ def render_model_config(robot: Robot, sdf: str) -> str:
 
 
 FORMATS = [Format("model.config", render_model_config, layout.MODEL_CONFIG, ("gazebo/model.config.j2",),
-                  reads="metadata", options={"sdf": layout.SDF})]
+                  reads="metadata", options={"sdf": layout.SDF}, needs=("sdf",))]

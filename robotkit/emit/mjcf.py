@@ -407,5 +407,5 @@ def render_scene(robot: Robot) -> str:
 
 FORMATS = [
     Format("mjcf", render_mjcf, layout.MJCF, ("mjcf/robot.xml.j2",), consumed=True, points=collision_meshes),
-    Format("mjcf-scene", render_scene, layout.SCENE, ("mjcf/scene.xml.j2",), reads="metadata"),
+    Format("mjcf-scene", render_scene, layout.SCENE, ("mjcf/scene.xml.j2",), reads="metadata", needs=("mjcf",)),
 ]

@@ -166,14 +166,17 @@ def has_controllers(robot: Robot) -> bool:
     return has_moveit(robot) and bool(robot.actuators)
 
 
+MOVEIT_NEEDS = ("urdf", "srdf")  # MoveIt reads the robot from both
 FORMATS = [
-    Format("moveit-kinematics", render_kinematics, layout.MOVEIT_KINEMATICS, reads="groups", when=has_moveit),
-    Format("moveit-joint-limits", render_joint_limits, layout.MOVEIT_JOINT_LIMITS, reads="groups", when=has_moveit),
+    Format("moveit-kinematics", render_kinematics, layout.MOVEIT_KINEMATICS, reads="groups", needs=MOVEIT_NEEDS,
+           when=has_moveit),
+    Format("moveit-joint-limits", render_joint_limits, layout.MOVEIT_JOINT_LIMITS, reads="groups",
+           needs=MOVEIT_NEEDS, when=has_moveit),
     Format("moveit-controllers", render_moveit_controllers, layout.MOVEIT_CONTROLLERS, reads="structure",
-           when=has_controllers),
+           needs=MOVEIT_NEEDS, when=has_controllers),
     Format("ros2-controllers", render_ros2_controllers, layout.ROS2_CONTROLLERS, reads="structure",
-           when=has_controllers),
-    Format("moveit-rviz", render_moveit_rviz, layout.MOVEIT_RVIZ, reads="rviz", when=has_moveit),
+           needs=MOVEIT_NEEDS, when=has_controllers),
+    Format("moveit-rviz", render_moveit_rviz, layout.MOVEIT_RVIZ, reads="rviz", needs=MOVEIT_NEEDS, when=has_moveit),
     Format("moveit-launch", render_moveit_launch, layout.MOVEIT_LAUNCH, ("ros/moveit.launch.py.j2",),
-           reads="ros-package", when=has_moveit),
+           reads="ros-package", needs=MOVEIT_NEEDS, when=has_moveit),
 ]

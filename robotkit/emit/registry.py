@@ -11,3 +11,7 @@ FORMATS: dict[str, Format] = {
     f.name: f for module in (urdf, xacro_macro, sdf, mjcf, srdf, summary, gazebo, ros, controllers, moveit)
     for f in module.FORMATS
 }
+
+for _f in FORMATS.values():  # a format waits for the ones it names: a typo would silently not
+    if unknown := [n for n in _f.needs if n not in FORMATS]:
+        raise ValueError(f"format '{_f.name}' needs unknown formats: {', '.join(unknown)}")

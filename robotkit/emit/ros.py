@@ -327,12 +327,16 @@ def losses(robot: Robot) -> list[str]:
 
 
 FORMATS = [
-    Format("package.xml", render_package_xml, layout.PACKAGE_XML, ("ros/package.xml.j2",), reads="ros-package"),
-    Format("CMakeLists.txt", render_cmakelists, layout.CMAKELISTS, ("ros/CMakeLists.txt.j2",), reads="ros-package"),
-    Format("env-hook", render_env_hook, layout.ENV_HOOK, tuple(ENV_HOOK.values()), reads="ros-package"),
+    # a ROS package is its URDF's: without it, none of it (a package naming a missing file)
+    Format("package.xml", render_package_xml, layout.PACKAGE_XML, ("ros/package.xml.j2",), reads="ros-package",
+           needs=("urdf",)),
+    Format("CMakeLists.txt", render_cmakelists, layout.CMAKELISTS, ("ros/CMakeLists.txt.j2",), reads="ros-package",
+           needs=("package.xml", "urdf", "sdf", "model.config", "env-hook")),  # it installs them
+    Format("env-hook", render_env_hook, layout.ENV_HOOK, tuple(ENV_HOOK.values()), reads="ros-package",
+           needs=("package.xml",)),
     Format("display-launch", render_display_launch, layout.DISPLAY_LAUNCH, tuple(DISPLAY_LAUNCH.values()),
-           reads="ros-package"),
+           reads="ros-package", needs=("urdf", "rviz")),
     Format("gazebo-launch", render_gazebo_launch, layout.GAZEBO_LAUNCH, tuple(GAZEBO_LAUNCH.values()),
-           reads="ros-package"),
-    Format("rviz", render_rviz, layout.RVIZ, reads="rviz"),
+           reads="ros-package", needs=("urdf", "controllers")),
+    Format("rviz", render_rviz, layout.RVIZ, reads="rviz", needs=("urdf",)),
 ]

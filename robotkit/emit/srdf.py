@@ -74,4 +74,4 @@ def render_srdf(robot: Robot) -> str:
                   virtual=virtual, disabled=disabled, summary=summary)
 
 
-FORMATS = [Format("srdf", render_srdf, layout.SRDF, ("srdf/robot.srdf.j2",), reads="groups")]
+FORMATS = [Format("srdf", render_srdf, layout.SRDF, ("srdf/robot.srdf.j2",), reads="groups", needs=("urdf",))]

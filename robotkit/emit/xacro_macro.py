@@ -107,4 +107,5 @@ def render_xacro_macro(robot: Robot) -> str:
                   root=p.root, root_name=robot.root, mount_joint=PREFIX + mount)
 
 
-FORMATS = [Format("xacro", render_xacro_macro, layout.XACRO, ("urdf/robot.urdf.xacro.j2", *TEMPLATES))]
+FORMATS = [Format("xacro", render_xacro_macro, layout.XACRO, ("urdf/robot.urdf.xacro.j2", *TEMPLATES),
+                  needs=("urdf",))]  # the URDF as a macro: refused with it

@@ -355,8 +355,8 @@ class Robot:
     def consumer_problems(self) -> list[tuple[str, str, tuple[str, ...]]]:
         """(link, message, formats) for what a program loading a format refuses: a moving
         link without mass (MuJoCo rejects the model; libsdformat drops the link and everything
-        below it; an SDF link without inertial weighs 1 kg), a massless root whose children all
-        move (libsdformat's URDF conversion gives an empty model), and a chain nested deeper
+        below it; an SDF link without inertial weighs 1 kg), a massless root with no mass welded to
+        it (libsdformat's URDF conversion gives an empty model), and a chain nested deeper
         than MuJoCo's XML reader goes."""
         out = []
         moving = {"revolute", "continuous", "prismatic", "planar", "floating"}
@@ -366,24 +366,38 @@ class Robot:
                             "to load it and Gazebo drops it with everything below it; give it an inertial "
                             f"(links.{j.child}.inertial: {{mass: ...}}, or geometry and a density)",
                             ("urdf", "sdf", "mjcf")))
+        root = self.root
+        welded = self.welded(root)  # the root and the links fixed to it: one body in a simulator
+        empty = (root != "world" and self.link(root).inertial is None and self.anchor() is None
+                 and any(j.parent == root for j in self.joints))
         for link in self.links:  # libsdformat weighs a welded link with the links welded below it only
             up = next((j for j in self.joints if j.child == link.name), None)
             moves = next((j for j in self.joints if j.parent == link.name and j.type in moving), None)
-            if up is not None and up.type == "fixed" and moves is not None and not self.body_mass(link.name) > 0:
+            if (up is not None and up.type == "fixed" and moves is not None and not self.body_mass(link.name) > 0
+                    and not (empty and link.name in welded)):  # that is the root's problem, below
                 out.append((link.name, f"link '{link.name}' has no mass, nor the links welded below it, and joint "
                             f"'{moves.name}' moves below it: Gazebo's URDF conversion drops everything that moves "
                             f"below it; give links.{link.name} an inertial", ("urdf",)))
-        root = self.root
-        if (root != "world" and self.link(root).inertial is None and self.anchor() is None
-                and any(j.parent == root for j in self.joints)):
-            out.append((root, f"link '{root}' is the root, has no mass and only moving joints below it: Gazebo's "
-                        "URDF conversion drops it and everything below it (an empty model); name the root "
-                        f"'world' to fix the robot to the world, or give links.{root} an inertial", ("urdf", "sdf")))
+        if empty:
+            what = (f"link '{root}' is the root and has no mass, nor the links welded to it "
+                    f"({', '.join(repr(n) for n in welded[1:])})" if len(welded) > 1 else
+                    f"link '{root}' is the root, has no mass and only moving joints below it")
+            out.append((root, f"{what}: Gazebo's URDF conversion drops it and everything below it (an empty model); "
+                        f"name the root 'world' to fix the robot to the world, or give links.{root} an inertial",
+                        ("urdf", "sdf")))
         depth, deepest = self.depth()
         if depth > MJCF_MAX_DEPTH:
             out.append((deepest, f"link '{deepest}' sits {depth} links deep: MuJoCo's XML reader stops at "
                         f"{MJCF_MAX_DEPTH} nested bodies, so it could not load the MJCF (a body per link); "
                         "make the chain shorter", ("mjcf",)))
+        return out
+
+    def welded(self, name: str) -> list[str]:
+        """``name`` and the links fixed to it below, breadth first."""
+        out, i = [name], 0
+        while i < len(out):
+            out += [j.child for j in self.joints if j.parent == out[i] and j.type == "fixed"]
+            i += 1
         return out
 
     def depth(self) -> tuple[int, str]:

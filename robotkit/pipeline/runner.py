@@ -27,7 +27,7 @@ from robotkit.model.load import load_robots, mesh_locations
 from robotkit.pipeline import stamp
 from robotkit.pipeline.buildwarn import build_warnings, no_pictures
 from robotkit.pipeline.progress import Progress
-from robotkit.pipeline.publish import STATE, publish, staged_files
+from robotkit.pipeline.publish import STATE, publish, stage_dir, staged_files
 from robotkit.pipeline.tasks import robot_tasks
 
 
@@ -40,6 +40,7 @@ class BuildResult:
     warnings: list[str] = field(default_factory=list)
     warning_lines: list[str] = field(default_factory=list)  # the same, located: file:line: key: warning: ...
     robots: list[str] = field(default_factory=list)
+    left_out: dict[str, list[str]] = field(default_factory=dict)  # robot -> files not published (exit 1)
     exit_status: int = 0  # of the failed tasks: 2 bad input, 1 a robot a consumer refuses
 
 
@@ -215,6 +216,8 @@ def _failure(result: BuildResult) -> RobotkitError:
         for line in msg.splitlines():
             if line not in lines:
                 lines.append(line)
+    for robot, files in result.left_out.items():
+        lines.append(f"{robot}: left out (refused by a consumer, or naming a file that is): " + ", ".join(files))
     error = RobotkitError([Problem(line) for line in lines])
     error.exit_status = result.exit_status or 2
     return error
@@ -223,8 +226,8 @@ def _failure(result: BuildResult) -> RobotkitError:
 def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder) -> list[str]:
     """Publish each robot whose tasks all succeeded (robotkit.pipeline.publish): a failed robot keeps its
     previous complete output.  A file a consumer would refuse (exit 1: the MJCF of a chain too
-    deep for MuJoCo) is left out of an otherwise complete output, as the build says.
-    Returns the published files."""
+    deep for MuJoCo) is left out of an otherwise complete output with every file that names it
+    (robotkit.emit.formats.Format.needs), and listed (``result.left_out``).  Returns the published files."""
     if recorder.runtime_errors:
         return []
     owner = {f"world:{w.name}": robot.name for _, robot in robots for w in robot.worlds}
@@ -238,9 +241,24 @@ def _publish(out: Path, robots, tasks: list[dict], result: BuildResult, recorder
         try:
             written = [t for t in mine if t["name"] not in recorder.not_written]
             published += publish(out, robot.name, staged_files(written, out))
+            left = _stage_paths([t for t in mine if t["name"] in recorder.not_written], stage_dir(out))
+            if left:
+                result.left_out[robot.name] = left
         except OSError as exc:
             result.errors.append((f"{robot.name}:publish", f"cannot publish {robot.name}: {exc}"))
     return published
+
+
+def _stage_paths(tasks: list[dict], stage: Path) -> list[str]:
+    """The targets of ``tasks`` below the ``stage`` folder, relative to it (as below the output
+    folder once published: ``<robot>/urdf/<robot>.urdf``), in task order."""
+    out = []
+    for task in tasks:
+        for target in task.get("targets", []):
+            p = Path(target)
+            if stage in p.parents and p.relative_to(stage).as_posix() not in out:
+                out.append(p.relative_to(stage).as_posix())
+    return out
 
 
 def _input_stats(robots, tasks) -> dict:

@@ -389,8 +389,9 @@ def output_task(place: Place, fmt: Format, reading: Reading, written: list[str])
         + (written if fmt.points is not None else []) + [r for r in (reading.drives, reading.matrix) if r],
         "targets": [target],
         "uptodate": [config_changed({"robot": reading.config, "options": options})],
-        # no output is written while any mesh of the robot fails
-        "task_dep": [f"{robot.name}:mesh:{k}" for k in place.facts],
+        # no output is written while any mesh of the robot fails, nor while a file it names is not
+        "task_dep": [f"{robot.name}:mesh:{k}" for k in place.facts]
+        + [f"{robot.name}:{n}" for n in fmt.needs if FORMATS[n].wanted(robot)],
         "clean": True,
     }
 
@@ -450,6 +451,8 @@ def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
             "file_dep": deps,
             "targets": [str(t) for t in targets],
             "uptodate": [config_changed({**config, "spawn": spawn, "templates": world_templates()})],
+            # a world with the robot in it names its model.sdf (model://) and its MJCF
+            "task_dep": [f"{robot.name}:{n}" for n in ("sdf", "model.config", "mjcf") if spawn is not None],
             "clean": True,
         })
         tasks.append({

@@ -177,7 +177,12 @@ def test_a_robot_a_consumer_refuses_fails_the_build_naming_the_link(tmp_path):
     assert proc.stderr.splitlines() == [
         "robot.yaml:5: links.forearm: link 'forearm' moves (joint 'elbow') but has no mass: MuJoCo refuses to "
         "load it and Gazebo drops it with everything below it; give it an inertial (links.forearm.inertial: "
-        "{mass: ...}, or geometry and a density)"]
+        "{mass: ...}, or geometry and a density)",
+        "arm: left out (refused by a consumer, or naming a file that is): " + ", ".join(
+            f"arm/{f}" for f in ("urdf/arm.urdf", "urdf/arm.urdf.xacro", "model.sdf", "mjcf/arm.xml", "mjcf/scene.xml",
+                                 "srdf/arm.srdf", "model.config", "package.xml", "CMakeLists.txt", "hooks/arm.dsv.in",
+                                 "launch/display.launch.py", "launch/gazebo.launch.py", "rviz/arm.rviz",
+                                 "report/report.html"))]
     for rel in ("urdf/arm.urdf", "model.sdf", "mjcf/arm.xml"):
         assert not (tmp_path / "out" / "arm" / rel).exists(), rel
 
@@ -201,9 +206,11 @@ def test_a_chain_of_1000_links(tmp_path):
     problems = [line for line in proc.stderr.splitlines() if not line.startswith(("warning", "  "))]  # timings
     assert problems == [
         "chain.yaml:1002: links.l999: link 'l999' sits 1000 links deep: MuJoCo's XML reader stops at 496 nested "
-        "bodies, so it could not load the MJCF (a body per link); make the chain shorter"]
+        "bodies, so it could not load the MJCF (a body per link); make the chain shorter",
+        "chain: left out (refused by a consumer, or naming a file that is): chain/mjcf/chain.xml, "
+        "chain/mjcf/scene.xml, chain/report/report.html"]
     b = build_of(tmp_path / "out", "chain")
-    assert b.urdf.is_file() and b.sdf.is_file() and not b.mjcf.exists()
+    assert b.urdf.is_file() and b.sdf.is_file() and not b.mjcf.exists() and not b.dir.joinpath("mjcf").exists()
     findings, summary = consumer_findings(b, ["Gazebo (URDF)", "Gazebo (model.sdf)", "Drake (URDF)",
                                               "Drake (model.sdf)", "Pinocchio (URDF)", "PyBullet (URDF)"], configs=3)
     assert {k for k, s in summary.items() if s["loaded"] and s["agrees"]} == {

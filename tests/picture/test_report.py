@@ -311,8 +311,8 @@ def test_where_mujoco_cannot_draw_a_build_writes_everything_and_warns_once(tmp_p
 
     shutil.copytree(RECIPES, tmp_path / "recipes", ignore=shutil.ignore_patterns("*.yaml"))
     shutil.copy(RECIPES / "turret_bot.yaml", tmp_path / "recipes")
-    why = (f"no pictures: MuJoCo cannot draw offscreen with MUJOCO_GL='{gl}' ({NO_GL[gl]}); install Debian's "
-           "libosmesa6 (sudo apt-get install libosmesa6) and leave MUJOCO_GL unset or set to osmesa")
+    why = (f"no pictures: MuJoCo cannot draw offscreen with MUJOCO_GL={gl} ({NO_GL[gl]}); unset MUJOCO_GL "
+           "to draw with OSMesa (sudo apt-get install libosmesa6)")
     with environ({"MUJOCO_GL": gl}):
         built = run_cli("build", "recipes/turret_bot.yaml", "--out", "out", cwd=tmp_path)
         report = run_cli("report", "out/turret_bot", "-o", "elsewhere", cwd=tmp_path)

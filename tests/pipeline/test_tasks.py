@@ -106,8 +106,12 @@ def test_file_deps_name_the_records_templates_and_mesh_files_each_output_reads(b
     assert mjcf[-4:] == (t["bot:copy:slider.stl"]["targets"] + t["bot:convert:collision/slider.obj"]["targets"]
                          + t["bot:drives"]["targets"] + [matrix])
     assert t["bot:convert:collision/slider.obj"]["file_dep"] == [robot.meshes()[key].source, facts]
-    for fmt in FORMATS.values():  # no output before every mesh task succeeded
-        assert t[f"bot:{fmt.name}"]["task_dep"] == [f"bot:mesh:{key}"]
+    for fmt in FORMATS.values():  # no output before every mesh task succeeded, nor before the files it names
+        assert t[f"bot:{fmt.name}"]["task_dep"] == [f"bot:mesh:{key}"] + [f"bot:{n}" for n in fmt.needs if
+                                                                         f"bot:{n}" in t]
+    assert t["bot:display-launch"]["task_dep"][1:] == ["bot:urdf", "bot:rviz"]
+    assert t["bot:model.config"]["task_dep"][1:] == ["bot:sdf"]
+    assert t["bot:mjcf-scene"]["task_dep"][1:] == ["bot:mjcf"]
 
 
 def config(task: dict) -> dict:

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from robotkit import mj
 from robotkit.check.consumers import Missing, Refused, View
 
 
 def from_mjcf(build) -> View:
-    try:  # heavy: imported when MuJoCo is asked
-        import mujoco
+    try:  # heavy: imported when MuJoCo is asked (rendering off where MUJOCO_GL cannot work)
+        mujoco = mj.load()
     except ImportError:
         raise Missing("MuJoCo is not installed (pip install mujoco)") from None
     if build.mjcf is None:
