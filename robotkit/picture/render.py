@@ -211,10 +211,11 @@ class Painter:
             if m.body_mass[b] > 0:
                 self._add(scn, mujoco.mjtGeom.mjGEOM_SPHERE, [r, r, r], d.xipos[b], np.eye(3), (*self.colour(b), 1))
 
-    def frames(self, scn):
+    def frames(self, scn, bodies=None, scale: float = 0.12):
+        """The frames of ``bodies`` (default: every body), ``scale`` times the robot's radius long."""
         m, d = self.model, self.data
-        length, width = self.radius * 0.12, self.radius * 0.006
-        for b in range(1, m.nbody):
+        length, width = self.radius * scale, self.radius * scale / 20
+        for b in range(1, m.nbody) if bodies is None else bodies:
             R = d.xmat[b].reshape(3, 3)
             for k, rgb in enumerate(((0.9, 0.1, 0.1), (0.1, 0.8, 0.1), (0.1, 0.2, 0.95))):
                 self._line(scn, d.xpos[b], d.xpos[b] + R[:, k] * length, width, (*rgb, 1))
@@ -413,13 +414,16 @@ def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
             small.points = np.concatenate(points)
             lo, hi = small.points.min(0), small.points.max(0)
             small.center, small.radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.05)
+            moved = [int(small.model.joint(name).bodyid[0])]  # its frame turns even where a round link looks the same
             for _, q in poses:
                 small.pose(q)
-                images.append(small._draw(135.0, -25.0, visual, ghost=False, overlays=(small.joint_axes,)))
+                images.append(small._draw(135.0, -25.0, visual, ghost=False,
+                                          overlays=(small.joint_axes, lambda scn: small.frames(scn, moved, 0.3))))
             small.pose()
             file = "joint-" + re.sub(r"[^A-Za-z0-9_.-]", "_", name) + ".png"
             _save(_strip(images, [label for label, _ in poses]), out / file)
-            pics.append(Picture(file, f"Joint {name}", f"{kind} joint {caption}", "joint"))
+            pics.append(Picture(file, f"Joint {name}", f"{kind} joint {caption}; the link it moves shows its frame "
+                                "(x red, y green, z blue)", "joint"))
     finally:
         small.renderer.close()
     return pics

@@ -240,9 +240,10 @@ def test_joints_without_limits_or_whole_turns_are_drawn_at_labelled_samples(tmp_
     report = tmp_path / "build" / "spinner" / "report"
     html = (report / "report.html").read_text()
     samples = "drawn at the sample positions -1.57 rad (-90°), zero, +0.6 rad (+34°), +1.57 rad (+90°)"
-    assert f"<b>Joint spin</b>: hinge joint with no limits (continuous), {samples}</figcaption>" in html
+    moved = "; the link it moves shows its frame (x red, y green, z blue)</figcaption>"
+    assert f"<b>Joint spin</b>: hinge joint with no limits (continuous), {samples}{moved}" in html
     assert (f"<b>Joint turn</b>: hinge joint with limits -6.28 rad (-360°) and 6.28 rad (+360°), a full turn "
-            f"or more apart, {samples}</figcaption>") in html
+            f"or more apart, {samples}{moved}") in html
     assert "lower -1.57" not in html and "upper 1.57" not in html
     assert '<td class="num">–</td><td class="num">–</td>' in row(html, "joint", "spin")
 
