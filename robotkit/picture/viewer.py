@@ -91,6 +91,24 @@ def paint_flagged(urdf, flagged: set[str]) -> None:
             mesh.visual = trimesh.visual.ColorVisuals(mesh, face_colors=[*FLAGGED, 255])
 
 
+def slider_scale(joint) -> tuple[str, float, float, float, float]:
+    """(label, slider units per radian or metre, min, max, step) of a joint's slider: degrees
+    for a hinge, millimetres for a slide, its limits rounded inwards to the step (a continuous
+    joint: a turn either way of zero)."""
+    lo, hi = -np.pi, np.pi
+    limit = joint.limit
+    if limit is not None and joint.type != "continuous" and limit.lower is not None and limit.upper is not None \
+            and limit.lower < limit.upper:
+        lo, hi = float(limit.lower), float(limit.upper)
+    unit, per, step = UNITS.get(joint.type, ("", 1.0, None))
+    if step is None:
+        return joint.name, per, lo, hi, (hi - lo) / 1000
+    low, high = math.ceil(lo * per / step - 1e-9) * step, math.floor(hi * per / step + 1e-9) * step
+    if low >= high:  # a range narrower than a step
+        low, high = lo * per, hi * per
+    return f"{joint.name} ({unit})", per, low, high, step
+
+
 def length(metres: float) -> str:
     """A grid's cell size in words: 1 mm, 10 cm, 1 m."""
     if metres >= 1:
@@ -263,18 +281,11 @@ class Viewer:
         with gui.add_folder("Joints", order=2) as folder:
             self.joint_folder = folder
             for name in urdf.actuated_joint_names:
-                j = urdf.joint_map[name]
-                lo, hi = -np.pi, np.pi
-                if j.limit is not None and j.type != "continuous" and j.limit.lower is not None \
-                        and j.limit.upper is not None and j.limit.lower < j.limit.upper:
-                    lo, hi = float(j.limit.lower), float(j.limit.upper)
-                unit, per, step = UNITS.get(j.type, ("", 1.0, None))
-                low, high = math.ceil(lo * per / (step or 1) - 1e-9), math.floor(hi * per / (step or 1) + 1e-9)
-                low, high = (low * step, high * step) if step and low < high else (lo * per, hi * per)
-                step = step or (high - low) / 1000
-                value = float(np.clip(self.values.get(name, 0.0 if lo <= 0 <= hi else lo) * per, low, high))
-                slider = gui.add_slider(f"{name} ({unit})" if unit else name, min=round(low, 6), max=round(high, 6),
-                                        step=step, initial_value=round(value / step) * step)
+                label, per, low, high, step = slider_scale(urdf.joint_map[name])
+                si_low, si_high = low / per, high / per
+                value = float(np.clip(self.values.get(name, 0.0 if si_low <= 0 <= si_high else si_low) * per, low, high))
+                slider = gui.add_slider(label, min=round(low, 6), max=round(high, 6), step=step,
+                                        initial_value=float(np.clip(round(value / step) * step, low, high)))
                 slider.on_update(lambda _: self._update_cfg())
                 self.sliders[name], self.per_si[name] = slider, per
 

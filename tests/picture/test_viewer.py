@@ -246,3 +246,20 @@ def test_view_bad_input(tmp_path):
                            "folder or a .urdf)\n")
     done = run_cli("view", tmp_path / "missing.yaml", "--no-browser")
     assert (done.returncode, done.stderr) == (2, f"{tmp_path / 'missing.yaml'}: no such file or folder\n")
+
+
+def test_slider_units():
+    """Degrees for a hinge, millimetres for a slide; the limits rounded inwards to the step."""
+    import yourdfpy
+
+    from robotkit.picture.viewer import slider_scale
+
+    def joint(kind, lower=None, upper=None):
+        return yourdfpy.Joint(name="j", type=kind, limit=yourdfpy.Limit(effort=1, velocity=1, lower=lower, upper=upper))
+
+    label, per, low, high, step = slider_scale(joint("revolute", -1.0, 1.0))
+    assert (label, step) == ("j (°)", 0.1) and per == pytest.approx(57.29578)
+    assert (low, high) == pytest.approx((-57.2, 57.2))  # +-57.2958 degrees, inside the limits
+    assert slider_scale(joint("continuous"))[:4] == ("j (°)", pytest.approx(57.29578), pytest.approx(-180.0),
+                                                     pytest.approx(180.0))
+    assert slider_scale(joint("prismatic", 0.0, 0.25)) == ("j (mm)", 1000.0, 0.0, pytest.approx(250.0), 0.1)
