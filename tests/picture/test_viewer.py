@@ -199,14 +199,17 @@ def test_viewer_of_a_recipe_with_variants(tmp_path):
 
 
 def test_viewer_of_one_variant_and_an_unknown_one(tmp_path):
+    """--variant NAME shows that one, with the --arg values; an unknown one is one line."""
     from robotkit.commands.view import resolve
 
     recipe = tmp_path / "quadruped.yaml"
     shutil.copyfile(RECIPES / "quadruped.yaml", recipe)
     shutil.copytree(RECIPES / "parts", tmp_path / "parts")
-    kind, make = resolve(recipe, str(tmp_path / "build"), variant="explorer")
+    kind, make = resolve(recipe, str(tmp_path / "build"), variant="compact", args={"lidar": "true"})
     assert kind == "recipe"
-    assert [b.name for b in make()] == ["quadruped_explorer"]
+    shown = make()
+    assert [b.name for b in shown] == ["quadruped_compact"]
+    assert '<sensor name="scan" type="gpu_lidar">' in shown[0].urdf.read_text()  # --arg lidar:=true
     with pytest.raises(RobotkitError) as exc:
         resolve(recipe, str(tmp_path / "build"), variant="tall")
     assert exc.value.lines() == [f"{recipe}: --variant: no variant named 'tall' (variants: compact, explorer)"]
