@@ -90,8 +90,7 @@ def _pictures(mjcf: Path, out: Path, findings) -> list:
     except Exception as exc:  # noqa: BLE001  (MuJoCo's GL backend fails at import: MUJOCO_GL, no OSMesa)
         raise RendererUnavailable.because(exc) from None
 
-    flagged = {f.subject[6:-1] for f in findings if f.subject.startswith("link '")}
-    pictures = render_pictures(mjcf, out, flagged)
+    pictures = render_pictures(mjcf, out, page.flagged_links(findings))
     keep = {p.file for p in pictures}
     for old in out.glob("*.png"):  # pictures of joints that are gone
         if old.name not in keep:

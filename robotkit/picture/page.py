@@ -119,6 +119,11 @@ def names_joint(item: str, name: str) -> bool:
     return bool(m) and f"'{name}'" in m.group(1)
 
 
+def flagged_links(findings: list[Finding]) -> set[str]:
+    """The links a lint fired on: drawn red in the report's pictures and in the viewer."""
+    return {f.subject[6:-1] for f in findings if f.subject.startswith("link '")}
+
+
 def other_findings(findings: list[Finding], rows: list[LinkRow], joints: list[JointRow]) -> list[Finding]:
     named = {f"link '{r.name}'" for r in rows} | {f"joint '{j.name}'" for j in joints}
     return [f for f in findings if f.subject not in named]

@@ -56,16 +56,44 @@ def bounds(model, data) -> tuple[np.ndarray, float]:
 def box(model, data) -> tuple[np.ndarray, np.ndarray]:
     """World bounding box of the drawn robot: the corners of its visual geoms' boxes (all
     geoms when it has none)."""
+    pts = corners(model, data)
+    return pts.min(0), pts.max(0)
+
+
+def corners(model, data) -> np.ndarray:
+    """The corners of the drawn geoms' boxes and the body origins, in the world (N x 3)."""
     ids = [i for i in range(model.ngeom) if model.geom_group[i] == VISUAL] or list(range(model.ngeom))
     ids = [i for i in ids if int(model.geom_type[i]) != int(mujoco.mjtGeom.mjGEOM_PLANE)]
-    corners = [data.xpos[b] for b in range(1, model.nbody)] or [np.zeros(3)]
+    pts = [data.xpos[b] for b in range(1, model.nbody)] or [np.zeros(3)]
     signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
     for i in ids:
         centre, half = model.geom_aabb[i][:3], model.geom_aabb[i][3:]
         R = data.geom_xmat[i].reshape(3, 3)
-        corners.extend(data.geom_xpos[i] + (centre + signs * half) @ R.T)
-    pts = np.asarray(corners)
-    return pts.min(0), pts.max(0)
+        pts.extend(data.geom_xpos[i] + (centre + signs * half) @ R.T)
+    return np.asarray(pts, dtype=float)
+
+
+def fit(points: np.ndarray, azimuth: float, elevation: float, fovy: float, aspect: float,
+        margin: float = 0.9) -> tuple[np.ndarray, float]:
+    """(look-at point, distance) of MuJoCo's free camera at ``azimuth``/``elevation`` (degrees)
+    that frames ``points`` with a ``margin`` of the picture to spare: the robot fills the
+    picture from every side, whatever its shape."""
+    az, el = math.radians(azimuth), math.radians(elevation)
+    forward = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    up = np.array([-math.sin(el) * math.cos(az), -math.sin(el) * math.sin(az), math.cos(el)])
+    right = np.cross(forward, up)
+    ty = math.tan(math.radians(fovy) / 2) * margin
+    tx = ty * aspect
+    x, y, z = points @ right, points @ up, points @ forward
+    # the camera (cx, cy, cz in the right/up/forward basis) is behind each side plane of the
+    # picture through the point furthest out on that side: both sides touched, centred
+    lo_x, hi_x = np.max(x - tx * z), np.min(x + tx * z)
+    lo_y, hi_y = np.max(y - ty * z), np.min(y + ty * z)
+    cx, cy = (lo_x + hi_x) / 2, (lo_y + hi_y) / 2
+    cz = min((hi_x - lo_x) / (2 * tx), (hi_y - lo_y) / (2 * ty))
+    distance = max(float((z.min() + z.max()) / 2 - cz), 0.05)
+    lookat = cx * right + cy * up + (cz + distance) * forward
+    return lookat, distance
 
 
 def load_model(mjcf: str | os.PathLike):
@@ -103,8 +131,10 @@ class Painter:
         model.vis.headlight.specular[:] = 0.1
         self.renderer = renderer(model, height, width)
         self.flagged: set[str] = set()
+        self.aspect = width / height
         mujoco.mj_forward(model, self.data)
         self.center, self.radius = bounds(model, self.data)
+        self.points = corners(model, self.data)  # what the camera frames
 
     def close(self):
         self.renderer.close()
@@ -113,8 +143,8 @@ class Painter:
     def _camera(self, azimuth: float, elevation: float):
         cam = mujoco.MjvCamera()
         cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-        cam.lookat[:] = self.center
-        cam.distance = self.radius / math.sin(math.radians(self.model.vis.global_.fovy) / 2) * 0.9
+        lookat, cam.distance = fit(self.points, azimuth, elevation, self.model.vis.global_.fovy, self.aspect)
+        cam.lookat[:] = lookat
         cam.azimuth, cam.elevation = azimuth, elevation
         return cam
 
@@ -181,10 +211,11 @@ class Painter:
             if m.body_mass[b] > 0:
                 self._add(scn, mujoco.mjtGeom.mjGEOM_SPHERE, [r, r, r], d.xipos[b], np.eye(3), (*self.colour(b), 1))
 
-    def frames(self, scn):
+    def frames(self, scn, bodies=None, scale: float = 0.12):
+        """The frames of ``bodies`` (default: every body), ``scale`` times the robot's radius long."""
         m, d = self.model, self.data
-        length, width = self.radius * 0.12, self.radius * 0.006
-        for b in range(1, m.nbody):
+        length, width = self.radius * scale, self.radius * scale / 20
+        for b in range(1, m.nbody) if bodies is None else bodies:
             R = d.xmat[b].reshape(3, 3)
             for k, rgb in enumerate(((0.9, 0.1, 0.1), (0.1, 0.8, 0.1), (0.1, 0.2, 0.95))):
                 self._line(scn, d.xpos[b], d.xpos[b] + R[:, k] * length, width, (*rgb, 1))
@@ -237,9 +268,11 @@ class Painter:
         mujoco.mj_comPos(self.model, d)
         mujoco.mj_camlight(self.model, d)
 
-    def joint_poses(self) -> list[tuple[str, str, list[tuple[str, np.ndarray]]]]:
-        """(joint, kind, [(label, qpos)]) for each hinge and slide joint: at its lower limit,
-        zero and its upper limit (a continuous joint at -90 and +90 degrees); mimic joints follow."""
+    def joint_poses(self) -> list[tuple[str, str, list[tuple[str, np.ndarray]], str]]:
+        """(joint, kind, [(label, qpos)], caption) for each hinge and slide joint: at its lower
+        limit, zero and its upper limit; a joint with no limits, or limits a full turn or more
+        apart (each limit the same pose as zero), at sample angles of -90 and +90 degrees instead,
+        labelled as samples. Mimic joints follow."""
         m = self.model
         out = []
         followers = self._mimics()
@@ -248,19 +281,8 @@ class Painter:
             if t not in (HINGE, SLIDE) or j in followers:
                 continue
             adr = m.jnt_qposadr[j]
-            if m.jnt_limited[j]:
-                lo, hi = (float(v) for v in m.jnt_range[j])
-            elif t == HINGE:
-                lo, hi = -math.pi / 2, math.pi / 2
-            else:
-                lo, hi = -self.radius / 2, self.radius / 2
-            unit = "rad" if t == HINGE else "m"
-            # a small positive move shows the direction even when the limits are whole turns
-            step = min(hi, 0.6 if t == HINGE else (hi - lo) / 4) if hi > 0 else None
-            values = [(f"lower {lo:.3g} {unit}", lo), ("zero", 0.0)]
-            if step is not None and step < hi:
-                values.append((f"+{step:.3g} {unit}", step))
-            values.append((f"upper {hi:.3g} {unit}", hi))
+            values, caption = joint_samples(t == HINGE, bool(m.jnt_limited[j]), *(float(v) for v in m.jnt_range[j]),
+                                            self.radius)
             poses = []
             for label, value in values:
                 q = m.qpos0.copy()
@@ -268,7 +290,7 @@ class Painter:
                 for f, (leader, coef) in followers.items():
                     q[m.jnt_qposadr[f]] = sum(c * q[m.jnt_qposadr[leader]] ** k for k, c in enumerate(coef))
                 poses.append((label, q))
-            out.append((m.joint(j).name, "hinge" if t == HINGE else "slide", poses))
+            out.append((m.joint(j).name, "hinge" if t == HINGE else "slide", poses, caption))
         return out
 
     def _mimics(self) -> dict[int, tuple[int, np.ndarray]]:
@@ -280,6 +302,39 @@ class Painter:
         return out
 
 
+def _amount(value: float, hinge: bool, sign: bool = False) -> str:
+    """A joint position as the page writes it: radians and degrees, or metres."""
+    if not hinge:
+        return f"{value:{'+' if sign else ''}.3g} m"
+    degrees = f"{math.degrees(value):+.0f}°" if round(math.degrees(value)) else "0°"
+    return f"{value:{'+' if sign else ''}.3g} rad ({degrees})"
+
+
+def joint_samples(hinge: bool, limited: bool, lo: float, hi: float, radius: float) -> tuple[list, str]:
+    """([(label, value)], caption) of the positions a joint is drawn at: its limits, zero and a
+    small positive move (the direction, when the upper limit is further); a joint without limits,
+    or a hinge whose limits are a full turn or more apart, at labelled sample positions."""
+    full_turn = hinge and limited and hi - lo >= 2 * math.pi - 1e-6
+    if limited and not full_turn:
+        step = min(hi, 0.6 if hinge else (hi - lo) / 4) if hi > 0 else None
+        values = [(f"lower {_amount(lo, hinge)}", lo), ("zero", 0.0)]
+        if step is not None and step < hi:
+            values.append((f"{_amount(step, hinge, True)}", step))
+        values.append((f"upper {_amount(hi, hinge)}", hi))
+        return values, "at its lower limit, zero, a small positive move (when the upper limit is further) and its " \
+                       "upper limit"
+    if full_turn:
+        why = f"with limits {_amount(lo, True)} and {_amount(hi, True)}, a full turn or more apart,"
+        samples = sorted({min(max(v, lo), hi) for v in (-math.pi / 2, 0.0, 0.6, math.pi / 2)})
+    elif hinge:
+        why, samples = "with no limits (continuous),", [-math.pi / 2, 0.0, 0.6, math.pi / 2]
+    else:
+        why, samples = "with no limits,", [-radius / 2, 0.0, radius / 2]
+    values = [("zero" if v == 0 else f"sample {_amount(v, hinge, True)}", v) for v in samples]
+    shown = ", ".join("zero" if v == 0 else _amount(v, hinge, True) for v in samples)
+    return values, f"{why} drawn at the sample positions {shown}"
+
+
 def _save(img: np.ndarray, path: Path) -> None:
     from PIL import Image  # only when a picture is saved
 
@@ -288,17 +343,23 @@ def _save(img: np.ndarray, path: Path) -> None:
     write_if_changed(path, buf.getvalue())
 
 
+LABEL_BAND = 28  # pixels above each picture of a strip, for its label
+LABEL_FONT = 17
+
+
 def _strip(images: list[np.ndarray], labels: list[str]) -> np.ndarray:
-    """Images side by side, each labelled at its top left."""
-    from PIL import Image, ImageDraw  # only when a picture is saved
+    """Images side by side, each under its label (on a band of its own: it hides nothing)."""
+    from PIL import Image, ImageDraw, ImageFont  # only when a picture is saved
 
     h, w = images[0].shape[:2]
-    out = Image.new("RGB", (w * len(images), h))
+    out = Image.new("RGB", (w * len(images), h + LABEL_BAND), (255, 255, 255))
     draw = ImageDraw.Draw(out)
+    font = ImageFont.load_default(size=LABEL_FONT)
     for i, (img, label) in enumerate(zip(images, labels)):
-        out.paste(Image.fromarray(img), (i * w, 0))
-        draw.rectangle([i * w, 0, i * w + 8 + 7 * len(label), 18], fill=(255, 255, 255))
-        draw.text((i * w + 4, 3), label, fill=(0, 0, 0))
+        out.paste(Image.fromarray(img), (i * w, LABEL_BAND))
+        draw.text((i * w + 6, LABEL_BAND // 2), label, fill=(0, 0, 0), font=font, anchor="lm")
+        if i:
+            draw.line([(i * w, 0), (i * w, LABEL_BAND - 1)], fill=(200, 200, 200))
     return np.asarray(out)
 
 
@@ -344,22 +405,25 @@ def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
     small = Painter(p.model, 320, 240, data=p.data)  # the same model, smaller pictures for the strips
     small.flagged = p.flagged
     try:
-        for name, kind, poses in p.joint_poses():
+        for name, kind, poses, caption in p.joint_poses():
             images = []
-            corners = []
+            points = []
             for _, q in poses:  # frame the joint's whole motion
                 small.pose(q)
-                corners += list(box(small.model, small.data))
-            lo, hi = np.min(corners, axis=0), np.max(corners, axis=0)
+                points.append(corners(small.model, small.data))
+            small.points = np.concatenate(points)
+            lo, hi = small.points.min(0), small.points.max(0)
             small.center, small.radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.05)
+            moved = [int(small.model.joint(name).bodyid[0])]  # its frame turns even where a round link looks the same
             for _, q in poses:
                 small.pose(q)
-                images.append(small._draw(135.0, -25.0, visual, ghost=False, overlays=(small.joint_axes,)))
+                images.append(small._draw(135.0, -25.0, visual, ghost=False,
+                                          overlays=(small.joint_axes, lambda scn: small.frames(scn, moved, 0.3))))
             small.pose()
             file = "joint-" + re.sub(r"[^A-Za-z0-9_.-]", "_", name) + ".png"
             _save(_strip(images, [label for label, _ in poses]), out / file)
-            pics.append(Picture(file, f"Joint {name}", f"{kind} joint at its lower limit, zero, a small positive "
-                                "move (when the upper limit is further) and its upper limit", "joint"))
+            pics.append(Picture(file, f"Joint {name}", f"{kind} joint {caption}; the link it moves shows its frame "
+                                "(x red, y green, z blue)", "joint"))
     finally:
         small.renderer.close()
     return pics

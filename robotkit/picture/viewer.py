@@ -3,14 +3,19 @@
 viser's ViserUrdf (through yourdfpy) draws the built URDF's visual and collision geometry;
 on top of it, one frame per link carries the overlays the report draws too: the equivalent
 inertia box, the centre of mass, the link frame and joint axis, sensor frames and camera
-fields of view. A slider per joint moves it within its limits (yourdfpy moves mimic joints
-with their leader). A recipe and every file it reads (includes, meshes) are watched: on a
-save the recipe is rebuilt through the same build (robotkit.pipeline.runner) and the view updated in
-place; a build error is shown in the page, and the last good robot stays on screen.
+fields of view. A slider per joint moves it within its limits, in degrees for a hinge and
+millimetres for a slide (the robot is posed in radians and metres; yourdfpy moves mimic joints
+with their leader). A floor grid under the robot (its cell size in the status line) and the
+world axes give scale and orientation; the links a lint fires on are red, as in the report.
+A recipe and every file it reads (includes, meshes) are watched: on a save the recipe is
+rebuilt through the same build (robotkit.pipeline.runner) and the view updated in place; a
+build error is shown in the page, and the last good robot stays on screen. A recipe with
+variants shows each (a "Robot" selector switches between them).
 """
 
 from __future__ import annotations
 
+import math
 import sys
 import threading
 import time
@@ -22,11 +27,15 @@ from pathlib import Path
 import numpy as np
 
 from robotkit import urdfxml
-from robotkit.check.lints import equivalent_box, resolve_uri
+from robotkit.check.lints import equivalent_box, lint, read_urdf_facts, resolve_uri
 from robotkit.errors import RobotkitError
+from robotkit.picture.page import flagged_links
 
 POLL = 0.3  # seconds between looks at the watched files
 CAMERA_TYPES = {"camera", "depth", "depth_camera", "rgbd_camera", "multicamera", "wideanglecamera"}
+FLAGGED = (230, 25, 25)  # links a lint fired on (the report's red)
+UNITS = {"revolute": ("°", 180 / np.pi, 0.1), "continuous": ("°", 180 / np.pi, 0.1),
+         "prismatic": ("mm", 1000.0, 0.1)}  # slider unit, per SI unit, step
 
 
 @dataclass
@@ -35,6 +44,7 @@ class Built:
     urdf: Path
     packages: dict[str, str]
     watch: list[Path] = field(default_factory=list)
+    name: str = ""  # the robot's (a recipe's variants are told apart by it)
 
 
 def load_urdf(built: Built):
@@ -64,6 +74,48 @@ def sensors_of(urdf_file: Path) -> list[tuple[str, str, str, float, float]]:
     return out
 
 
+def lint_flagged(built: Built) -> set[str]:
+    """The links the report's lints fire on (robotkit.check.lints), drawn red."""
+    links, joints, notes = read_urdf_facts(built.urdf, built.packages)
+    return flagged_links(notes + lint(links, joints))
+
+
+def paint_flagged(urdf, flagged: set[str]) -> None:
+    """Colour the visual meshes of the ``flagged`` links red (before viser draws them)."""
+    import trimesh  # heavy: see load_urdf
+
+    scene = urdf.scene
+    parents = scene.graph.transforms.parents
+    for name, mesh in scene.geometry.items():
+        if parents.get(name) in flagged:
+            mesh.visual = trimesh.visual.ColorVisuals(mesh, face_colors=[*FLAGGED, 255])
+
+
+def slider_scale(joint) -> tuple[str, float, float, float, float]:
+    """(label, slider units per radian or metre, min, max, step) of a joint's slider: degrees
+    for a hinge, millimetres for a slide, its limits rounded inwards to the step (a continuous
+    joint: a turn either way of zero)."""
+    lo, hi = -np.pi, np.pi
+    limit = joint.limit
+    if limit is not None and joint.type != "continuous" and limit.lower is not None and limit.upper is not None \
+            and limit.lower < limit.upper:
+        lo, hi = float(limit.lower), float(limit.upper)
+    unit, per, step = UNITS.get(joint.type, ("", 1.0, None))
+    if step is None:
+        return joint.name, per, lo, hi, (hi - lo) / 1000
+    low, high = math.ceil(lo * per / step - 1e-9) * step, math.floor(hi * per / step + 1e-9) * step
+    if low >= high:  # a range narrower than a step
+        low, high = lo * per, hi * per
+    return f"{joint.name} ({unit})", per, low, high, step
+
+
+def length(metres: float) -> str:
+    """A grid's cell size in words: 1 mm, 10 cm, 1 m."""
+    if metres >= 1:
+        return f"{metres:g} m"
+    return f"{metres * 100:.3g} cm" if metres >= 0.01 else f"{metres * 1000:.3g} mm"
+
+
 def _wxyz(R: np.ndarray) -> np.ndarray:
     import viser.transforms as tf  # heavy: see load_urdf
 
@@ -79,8 +131,15 @@ class Viewer:
         self.lock = threading.RLock()
         self.urdf = None
         self.viser_urdf = None
+        self.robots: list[Built] = []  # what make() returned: a recipe's variants, or one robot
+        self.choice: str | None = None  # the robot shown, among several
+        self.selector = None
+        self.flagged: set[str] = set()
+        self.grid = None
+        self.notes: list[str] = []  # below the status line: the grid's scale, the flagged links
         self.sliders: dict[str, object] = {}
-        self.values: dict[str, float] = {}
+        self.per_si: dict[str, float] = {}  # slider units per radian or metre
+        self.values: dict[str, float] = {}  # radians and metres
         self.joint_folder = None
         self.overlay_nodes: dict[str, list] = {"inertia": [], "com": [], "frames": [], "sensors": []}
         self.link_frames: dict[str, object] = {}
@@ -91,6 +150,7 @@ class Viewer:
             self.toggles = {
                 "visual": gui.add_checkbox("Visual", True),
                 "collision": gui.add_checkbox("Collision", False),
+                "grid": gui.add_checkbox("Floor grid and world axes", True),
                 "inertia": gui.add_checkbox("Inertia boxes", False),
                 "com": gui.add_checkbox("Centres of mass", False),
                 "frames": gui.add_checkbox("Frames and joint axes", False),
@@ -104,8 +164,10 @@ class Viewer:
         """Build and show; on a build error keep the last robot and show the error."""
         start = time.perf_counter()
         try:
-            built = self.make()
-            urdf = load_urdf(built)
+            robots = self.make()
+            robots = [robots] if isinstance(robots, Built) else list(robots)
+            built = next((b for b in robots if b.name == self.choice), robots[0])
+            urdf, flagged = load_urdf(built), lint_flagged(built)
         except RobotkitError as exc:
             self._watch(getattr(exc, "watch", None) or [])
             self._error("\n".join(exc.lines()))
@@ -114,12 +176,44 @@ class Viewer:
             self._error(f"{type(exc).__name__}: {exc}")
             return False
         self._watch(built.watch)
+        self.robots = robots
+        self._selector()
+        self._present(built, urdf, flagged, start)
+        return True
+
+    def select(self, name: str) -> None:
+        """Show robot ``name`` of the last build (the "Robot" selector)."""
+        start = time.perf_counter()
+        built = next((b for b in self.robots if b.name == name), None)
+        if built is None or name == self.choice:
+            return
+        try:
+            urdf, flagged = load_urdf(built), lint_flagged(built)
+        except Exception as exc:  # noqa: BLE001  (a broken file must not end the viewer)
+            self._error("\n".join(exc.lines()) if isinstance(exc, RobotkitError) else f"{type(exc).__name__}: {exc}")
+            return
+        self._present(built, urdf, flagged, start)
+
+    def _present(self, built: Built, urdf, flagged: set[str], start: float) -> None:
         with self.lock:
+            self.choice, self.flagged = built.name or None, flagged
             self._show(urdf, built)
         name = urdf.robot.name
-        self.status.content = f"**{name}**: {len(self.sliders)} joints; shown in {time.perf_counter() - start:.2f} s"
+        self.status.content = (f"**{name}**: {len(self.sliders)} joints; shown in {time.perf_counter() - start:.2f} s"
+                               + "".join(f"\n\n{note}" for note in self.notes))
         print(f"view: {name} updated ({time.perf_counter() - start:.2f} s)", file=sys.stderr, flush=True)
-        return True
+
+    def _selector(self) -> None:
+        """The "Robot" selector when there are several robots (a recipe's variants)."""
+        names = [b.name for b in self.robots]
+        if self.selector is not None and (len(names) < 2 or list(self.selector.options) != names):
+            self.selector.remove()
+            self.selector = None
+        if self.selector is None and len(names) > 1:
+            initial = self.choice if self.choice in names else names[0]
+            self.selector = self.server.gui.add_dropdown("Robot", names, initial_value=initial, order=0.5,
+                                                         hint="the recipe's variants")
+            self.selector.on_update(lambda _: self.select(self.selector.value))
 
     def _error(self, text: str) -> None:
         self.status.content = "**Build failed** (the last good robot is shown):\n\n```\n" + text + "\n```"
@@ -144,8 +238,12 @@ class Viewer:
         self.overlay_nodes = {k: [] for k in self.overlay_nodes}
         self.link_frames = {}
         self.urdf = urdf
+        paint_flagged(urdf, self.flagged)
         self.viser_urdf = ViserUrdf(self.server, urdf, root_node_name="/robot", load_meshes=True,
                                     load_collision_meshes=urdf.collision_scene is not None)
+        self.notes = [self._floor(urdf)]
+        if self.flagged:
+            self.notes.append("Red: links a lint fired on (see the report): " + ", ".join(sorted(self.flagged)))
         self._overlays(urdf, built)
         self._joint_sliders(urdf)
         self._update_cfg()
@@ -158,31 +256,45 @@ class Viewer:
             self.server.initial_camera.position = centre + np.array([1.0, 0.8, 0.6]) * max(size, 0.1) * 1.5
             self._camera_set = True
 
+    def _floor(self, urdf) -> str:
+        """A grid on the floor (z = 0, or under the robot when it reaches below), centred on the
+        world origin and wide enough for the robot, with the world axes; its scale, in words."""
+        lo, hi = urdf.scene.bounds
+        size = max(float(np.linalg.norm(hi - lo)), 0.01)
+        cell = 10.0 ** math.floor(math.log10(size)) / 10
+        section = cell * 10
+        reach = max(float(np.max(np.abs(np.concatenate([lo[:2], hi[:2]])))) + size / 2, section)
+        width = 2 * math.ceil(reach / section) * section
+        self.grid = self.server.scene.add_grid("/floor", width=width, height=width, cell_size=cell,
+                                               section_size=section, position=(0.0, 0.0, min(0.0, float(lo[2]))))
+        axes = self.server.scene.world_axes
+        axes.axes_length, axes.axes_radius = size * 0.15, size * 0.004
+        return f"Floor grid: {length(cell)} squares, a line every {length(section)}; world axes x red, y green, z blue"
+
     def _joint_sliders(self, urdf) -> None:
         for name, s in self.sliders.items():
-            self.values[name] = s.value
+            self.values[name] = s.value / self.per_si[name]
         if self.joint_folder is not None:
             self.joint_folder.remove()
-        self.sliders = {}
+        self.sliders, self.per_si = {}, {}
         gui = self.server.gui
         with gui.add_folder("Joints", order=2) as folder:
             self.joint_folder = folder
             for name in urdf.actuated_joint_names:
-                j = urdf.joint_map[name]
-                lo, hi = -np.pi, np.pi
-                if j.limit is not None and j.type != "continuous" and j.limit.lower is not None \
-                        and j.limit.upper is not None and j.limit.lower < j.limit.upper:
-                    lo, hi = float(j.limit.lower), float(j.limit.upper)
-                value = float(np.clip(self.values.get(name, 0.0 if lo <= 0 <= hi else lo), lo, hi))
-                slider = gui.add_slider(name, min=lo, max=hi, step=(hi - lo) / 1000, initial_value=value)
+                label, per, low, high, step = slider_scale(urdf.joint_map[name])
+                si_low, si_high = low / per, high / per
+                value = float(np.clip(self.values.get(name, 0.0 if si_low <= 0 <= si_high else si_low) * per, low, high))
+                slider = gui.add_slider(label, min=round(low, 6), max=round(high, 6), step=step,
+                                        initial_value=float(np.clip(round(value / step) * step, low, high)))
                 slider.on_update(lambda _: self._update_cfg())
-                self.sliders[name] = slider
+                self.sliders[name], self.per_si[name] = slider, per
 
     def _update_cfg(self) -> None:
         with self.lock:
             if self.urdf is None:
                 return
-            cfg = np.array([self.sliders[n].value for n in self.urdf.actuated_joint_names], dtype=float)
+            cfg = np.array([self.sliders[n].value / self.per_si[n] for n in self.urdf.actuated_joint_names],
+                           dtype=float)  # radians and metres
             self.viser_urdf.update_cfg(cfg)  # also updates self.urdf (yourdfpy; mimic joints follow)
             for link, frame in self.link_frames.items():
                 T = self.urdf.get_transform(link)
@@ -198,6 +310,8 @@ class Viewer:
             elif key == "collision":
                 if self.urdf.collision_scene is not None:
                     self.viser_urdf.show_collision = on
+            elif key == "grid":
+                self.grid.visible = self.server.scene.world_axes.visible = on
             else:
                 for n in self.overlay_nodes[key]:
                     n.visible = on
@@ -230,7 +344,7 @@ class Viewer:
             I = T[:3, :3] @ np.asarray(inertial.inertia, dtype=float) @ T[:3, :3].T
             moments, axes_R = np.linalg.eigh(I)
             sides = np.maximum(equivalent_box(inertial.mass, moments), size * 0.002)
-            colour = palette[i % len(palette)]
+            colour = FLAGGED if name in self.flagged else palette[i % len(palette)]
             box = scene.add_box(f"/overlays/{name}/inertia", colour, tuple(sides), opacity=0.5,
                                 wxyz=_wxyz(axes_R), position=T[:3, 3], cast_shadow=False)
             self.overlay_nodes["inertia"].append(box)

@@ -195,8 +195,8 @@ def test_flipped_axis_shows_in_the_limit_pictures(arms):
     def panels(name):
         strip = pixels(arms / name / "report" / "joint-shoulder.png")
         w = 320  # lower, zero, +0.6 rad, upper
-        assert strip.shape[1] == 4 * w
-        return [strip[20:, i * w:(i + 1) * w] for i in (0, 1, 3)]  # below the labels
+        assert strip.shape == (240 + 28, 4 * w, 3)  # the labels on a band above the pictures
+        return [strip[28:, i * w:(i + 1) * w] for i in (0, 1, 3)]
 
     def differ(a, b):  # share of pixels that differ
         return (np.abs(a - b).max(axis=2) > 30).mean()
@@ -206,6 +206,54 @@ def test_flipped_axis_shows_in_the_limit_pictures(arms):
     assert differ(flipped[0], healthy[2]) < 0.002 and differ(flipped[2], healthy[0]) < 0.002
     assert differ(flipped[0], healthy[0]) > 0.02
     assert differ(healthy[0], healthy[2]) > 0.02  # the joint moves visibly
+
+
+SPINNER = """
+    robot: spinner
+    links:
+      base: {visual: {box: {size: [0.2, 0.2, 0.05]}}, inertial: {mass: 5}}
+      arm: {visual: {box: {size: [0.3, 0.04, 0.04]}, origin: {xyz: [0.15, 0, 0]}}, inertial: {mass: 1}}
+      hand: {visual: {box: {size: [0.1, 0.03, 0.03]}, origin: {xyz: [0.05, 0, 0]}}, inertial: {mass: 0.2}}
+    joints:
+      spin:
+        type: continuous
+        parent: base
+        child: arm
+        origin: {xyz: [0, 0, 0.05]}
+        axis: [0, 0, 1]
+        limit: {effort: 10, velocity: 2}
+      turn:
+        type: revolute
+        parent: arm
+        child: hand
+        origin: {xyz: [0.3, 0, 0]}
+        axis: [0, 0, 1]
+        limit: {lower: -6.283185307179586, upper: 6.283185307179586, effort: 10, velocity: 2}
+    """
+
+
+@pytest.mark.slow
+def test_joints_without_limits_or_whole_turns_are_drawn_at_labelled_samples(tmp_path):
+    """A continuous joint has no limits to draw (the table says "–"), a joint limited to +-2 pi
+    is at zero's pose at both limits: both are drawn at -90, 0, +34 and +90 degrees, said so."""
+    build_cli([write_recipe(tmp_path, SPINNER)], tmp_path / "build")
+    report = tmp_path / "build" / "spinner" / "report"
+    html = (report / "report.html").read_text()
+    samples = "drawn at the sample positions -1.57 rad (-90°), zero, +0.6 rad (+34°), +1.57 rad (+90°)"
+    moved = "; the link it moves shows its frame (x red, y green, z blue)</figcaption>"
+    assert f"<b>Joint spin</b>: hinge joint with no limits (continuous), {samples}{moved}" in html
+    assert (f"<b>Joint turn</b>: hinge joint with limits -6.28 rad (-360°) and 6.28 rad (+360°), a full turn "
+            f"or more apart, {samples}{moved}") in html
+    assert "lower -1.57" not in html and "upper 1.57" not in html
+    assert '<td class="num">–</td><td class="num">–</td>' in row(html, "joint", "spin")
+
+    def differ(a, b):
+        return (np.abs(a - b).max(axis=2) > 30).mean()
+
+    for joint in ("spin", "turn"):  # four poses, no two alike
+        strip = pixels(report / f"joint-{joint}.png")[28:]
+        panels = [strip[:, i * 320:(i + 1) * 320] for i in range(4)]
+        assert min(differ(a, b) for i, a in enumerate(panels) for b in panels[i + 1:]) > 0.002, joint
 
 
 @pytest.mark.slow
