@@ -19,13 +19,11 @@ from robotkit.recipe.load import read_recipes
 
 
 def run(args) -> int:
-    items = getattr(args, "package_path", None) or []
-    packages = dict(items) if items and not isinstance(items[0], str) else package_paths(items)
+    packages = package_paths(args.package_path)
     if packages is None:
         return 2
-    options = {"variant": getattr(args, "variant", None), "args": dict(getattr(args, "arg", None) or []),
-               "packages": packages}
-    kind, make = resolve(Path(args.path), getattr(args, "out", None) or "build", **options)
+    options = {"variant": args.variant, "args": dict(args.arg), "packages": packages}
+    kind, make = resolve(Path(args.path), args.out, **options)
     return serve(args.path, kind, make, args.port, open_browser=not args.no_browser)
 
 
@@ -47,35 +45,25 @@ def resolve(path: Path, build_out: str, variant: str | None = None, args: dict[s
 
 
 def check_variant(recipe: Path, variant: str, args: dict[str, str] | None) -> None:
-    """Raise (one line, exit 2) when the recipe has no variant ``variant``."""
-    loaded = read_recipes(recipe, args)
-    names = [one.variant for one in loaded if one.variant is not None]
-    if variant not in names and not any(one.problems for one in loaded):  # a broken recipe: the page says why
-        raise RobotkitError(Problem(f"no variant named '{variant}' (variants: {', '.join(names) or 'none'})",
-                                    file=str(recipe), key="--variant"))
+    """Raise (one line, exit 2) when the recipe has no variant ``variant`` (a recipe that does
+    not load otherwise opens: the page says why)."""
+    problems = read_recipes(recipe, args, variant=variant)[0].problems
+    if problems and problems[0].key == "--variant" and problems[0].message.startswith("no variant named"):
+        raise RobotkitError(problems[0])
 
 
 def _build_recipe(recipe: Path, build_out: str, variant: str | None, args: dict[str, str]) -> list[Built]:
-    """Build the recipe (every variant) and watch every file it reads; the robots to show: every
-    variant, or the one named."""
+    """Build the recipe (every variant, or the one named) and watch every file it reads."""
     watch = [recipe]
     try:
-        robots = load_robots([recipe], args=args)
+        robots = load_robots([recipe], args=args, variant=variant)
         watch = sorted({Path(f) for loaded, _ in robots for f in loaded.files}
                        | {Path(m.source) for _, robot in robots for m in robot.meshes().values()})
-        result = build([recipe], build_out, report=False, args=args)
+        result = build([recipe], build_out, report=False, args=args, variant=variant)
         if result.errors:  # a bug in a task: shown like a user error, the viewer stays up
             raise RobotkitError([Problem(f"internal error in task {name}: {msg}") for name, msg in result.errors])
     except RobotkitError as exc:
         exc.watch = watch  # still watched: fixing the recipe or a mesh rebuilds
         raise
-    shown = []
-    for loaded, robot in robots:
-        if variant is None or loaded.variant == variant:
-            layout = robot_layout(Path(build_out) / robot.name)
-            shown.append(Built(layout.urdf, {robot.name: str(layout.root)}, watch, robot.name))
-    if not shown:  # the variant was renamed while viewing
-        exc = RobotkitError(Problem(f"no variant named '{variant}'", file=str(recipe), key="--variant"))
-        exc.watch = watch
-        raise exc
-    return shown
+    layouts = [robot_layout(Path(build_out) / robot.name) for _, robot in robots]
+    return [Built(layout.urdf, {layout.name: str(layout.root)}, watch, layout.name) for layout in layouts]
