@@ -131,7 +131,7 @@ def test_check_on_the_original_reads_the_meshes_and_names_the_refusals(built):
     found = check(str(source), package_paths=packages)
     assert [(f.subject, f.message) for f in found if f.check == "inertia-box"] == [
         ("link 'base_link'", "the equivalent inertia box (0.245 x 0.245 x 0.245 m) is 2.45x larger than the "
-                             "geometry's at uniform density (0.3 x 0.2 x 0.1 m)")]
+                             "geometry's at uniform density (0.3 x 0.2 x 0.1 m), along x, y, z")]
     assert [(f.check, f.subject, f.message) for f in found if f.severity == "error"] == [
         ("mesh-uri", "link 'base_link'", "visual mesh 'package:///tpkg/meshes/body.stl' names no package "
                                          "('package:///' leaves the package name empty): ROS's resource retriever, "
