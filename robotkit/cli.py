@@ -194,7 +194,8 @@ def _add_import(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--density", type=float, metavar="KG_M3",
                    help="with --recompute-inertials: density in kg/m^3 instead of keeping the given masses")
     p.add_argument("--copy-meshes", action="store_true",
-                   help="copy the meshes below the recipe's folder (meshes/) instead of referencing them")
+                   help="copy every mesh below the recipe's folder (meshes/) instead of referencing them "
+                        "(those outside the project, which its build does not read, are always copied)")
     return p
 
 

@@ -14,8 +14,8 @@ class Problems:
         self.file = file
         self.items: list[Problem] = []
 
-    def add(self, message: str):
-        self.items.append(Problem(message, file=self.file))
+    def add(self, message: str, line: int | None = None):
+        self.items.append(Problem(message, file=self.file, line=line))
 
     def raise_if_any(self):
         if self.items:
