@@ -25,6 +25,7 @@ from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.fit import misfits
 from robotkit.importer.inertials import POLICIES, report_recomputed
 from robotkit.importer.meshes import mark_open_meshes
+from robotkit.importer.parsing import shown
 from robotkit.importer.package_xml import package_metadata, with_own_package
 from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
 from robotkit.importer.urdf_to_recipe import Converted, urdf_to_recipe
@@ -150,7 +151,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
 
 def _where(source: Path, lines: dict, link: str) -> str:
     line = lines.get(("links", link))
-    return f"{display_path(os.path.normpath(source))}{f':{line}' if line else ''}: "
+    return f"{shown(source)}{f':{line}' if line else ''}: "
 
 
 def _read_input(source: Path) -> str:

@@ -33,12 +33,12 @@ import numpy as np
 from robotkit import urdfxml
 from robotkit.emit.sdf import names_apart
 from robotkit.emit.urdf import MASSLESS
-from robotkit.errors import Problem, RobotkitError, display_path, short_number
+from robotkit.errors import Problem, RobotkitError, short_number
 from robotkit.importer.inertials import chosen_inertial, give_moving_links_mass, no_inertial_form, read_inertial
 from robotkit.importer import units as mesh_units
 from robotkit.importer.meshes import MeshResolver, MeshUse
 from robotkit.importer.names import material_name, name_hint, valid_frame_name, valid_name
-from robotkit.importer.parsing import (Problems, fmt_list, local_name, origin_dict, read_float, read_floats,
+from robotkit.importer.parsing import (Problems, fmt_list, shown, local_name, origin_dict, read_float, read_floats,
                                        read_origin)
 from robotkit.importer.recipe_writer import fmt
 from robotkit.geometry import rpy_matrix
@@ -85,7 +85,7 @@ class _Reading:
     def where(self, el) -> str:
         """``file:line: `` of an element of the input, for a warning."""
         line = self.line(el)
-        return f"{display_path(os.path.normpath(self.problems.file))}{f':{line}' if line else ''}: "
+        return f"{shown(self.problems.file)}{f':{line}' if line else ''}: "
 
 
 @dataclass
