@@ -92,7 +92,7 @@ onto the recipe; another format is another entry here."""
 
 def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_paths: dict[str, str] | None = None,
                 args: dict[str, str] | None = None, recompute_inertials: bool = False, copy_meshes: bool = False,
-                density: float | None = None, inertia_policy: str = "repair") -> ImportResult:
+                density: float | None = None, inertia_policy: str | None = None) -> ImportResult:
     """Import the URDF or xacro file ``path`` into the recipe ``out_recipe``.
 
     ``package_paths`` maps ROS package names to folders (``$(find PKG)``, ``package://PKG``);
@@ -101,10 +101,15 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     mass, or at ``density`` when given; the differences are reported per link.  Otherwise a
     physical inertial is kept as given and one that no real body has gets ``inertia_policy``
     (keep, repair, recompute, estimate; see robotkit.importer.inertials.chosen_inertial), with a
-    comment above its link saying what was wrong.
-    ``copy_meshes`` copies the meshes below the recipe's folder (``meshes/``) instead of
-    referencing them where they are.
+    comment above its link saying what was wrong; by default (None) the repair, and where the
+    repaired tensor does not fit the link's geometry by check's rule, a recompute
+    (robotkit.importer.fit).  ``copy_meshes`` copies every mesh below the recipe's folder
+    (``meshes/PKG/...``) instead of referencing it where it is; the meshes outside the recipe's
+    project, which its build may not read, are copied whatever it says, with their package's
+    licence files.
     """
+    fit = inertia_policy is None  # the default: a repair that does not fit the geometry is recomputed
+    inertia_policy = inertia_policy or "repair"
     if inertia_policy not in POLICIES:
         raise RobotkitError(Problem(f"inertia policy '{inertia_policy}' is not one of {', '.join(POLICIES)}"))
     if density is not None and not density > 0:
@@ -126,13 +131,13 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         warnings.extend(conv.warnings)
         inputs.extend(sorted({m.source for m in conv.meshes.values()}))
         recipe = _finished_recipe(conv, source, warnings, recompute_inertials)
-        header = _header(source, out, args, recompute_inertials, density, inertia_policy) + [
+        header = _header(source, out, args, recompute_inertials, density, inertia_policy, fit) + [
             line for note in conv.left_out for line in wrap(note)]
         text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
         copied = _copy_meshes(conv.copies, source, out)
         tmp, robot = _write_checked(text_out, out, source, lines, [m.recipe_path for m in conv.meshes.values()],
                                     warnings)
-        more, kept = misfits(robot, conv.explicit, inertia_policy)
+        more, kept = misfits(robot, conv.explicit, fit)
         if not set(more) - set(overrides):
             break
         tmp.unlink()
@@ -199,7 +204,7 @@ def _copy_meshes(copies: dict[str, str], source: Path, out: Path) -> list[str]:
 
 
 def _header(source: Path, out: Path, args: dict[str, str] | None, recompute_inertials: bool,
-            density: float | None, inertia_policy: str) -> list[str]:
+            density: float | None, inertia_policy: str, fit: bool = False) -> list[str]:
     """The recipe's header comment: where it came from and how its inertials were decided."""
     header = [f"Imported by robotkit from {Path(os.path.relpath(source, out.parent)).as_posix()}"]
     if args:
@@ -210,6 +215,9 @@ def _header(source: Path, out: Path, args: dict[str, str] | None, recompute_iner
     else:
         header.append("inertials as given in the original (explicit); those no real body has: "
                       f"{inertia_policy} (--inertia-policy)")
+        if fit:
+            header.append("a repair that does not fit the link's geometry (check's inertia-box rule): recompute, "
+                          "or estimate without a closed geometry")
     return header
 
 

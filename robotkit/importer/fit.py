@@ -9,6 +9,8 @@ a hand-typed tensor.  A physical one that does not fit is kept, with a warning.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from robotkit.importer.inertials import geometry_facts
@@ -17,6 +19,19 @@ from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
 from robotkit.model import massprops
 from robotkit.model.resolve import geom_mass_props
+
+
+_FACTS: dict[tuple, dict] = {}
+
+
+def _facts(mesh) -> dict:
+    """robotkit.importer.inertials.geometry_facts, once per file version (an import loads the
+    recipe twice when it recomputes a tensor)."""
+    st = os.stat(mesh.source)
+    key = (mesh.key, st.st_mtime_ns, st.st_size)
+    if key not in _FACTS:
+        _FACTS[key] = geometry_facts(mesh)
+    return _FACTS[key]
 
 
 def _points(geom) -> np.ndarray:
@@ -42,7 +57,7 @@ def link_fit(link) -> inertia_policy.BoxFit | None:
     given = link.inertial_spec.explicit
     closed = all(g.shape.kind != "mesh" or mesh_is_closed(g.shape.mesh.source, g.shape.mesh.scale) for g in geoms)
     if closed:
-        facts = {g.shape.mesh.key: geometry_facts(g.shape.mesh) for g in geoms if g.shape.kind == "mesh"}
+        facts = {g.shape.mesh.key: _facts(g.shape.mesh) for g in geoms if g.shape.kind == "mesh"}
         volume, _, I = massprops.combine([geom_mass_props(g, facts) for g in geoms])
         return inertia_policy.box_fit_geometry(given.mass, given.tensor(), volume, I)
     points = np.vstack([_points(g) for g in geoms])
@@ -56,9 +71,9 @@ def describe(fit: inertia_policy.BoxFit) -> str:
             f"than {than} ({sides[1]} m), along {fit.axes}")
 
 
-def misfits(robot, explicit: dict[str, dict], policy: str) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
-    """(link -> (policy, why) for the repaired tensors that do not fit, link -> why for the given
-    physical ones that do not fit), judged as check's errors."""
+def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
+    """(link -> (policy, why) for the repaired tensors that do not fit, when ``recompute``; link ->
+    why for the given physical ones that do not fit), judged as check's errors."""
     overrides, kept = {}, {}
     for link in robot.links:
         given = explicit.get(link.name)
@@ -69,7 +84,7 @@ def misfits(robot, explicit: dict[str, dict], policy: str) -> tuple[dict[str, tu
         tensor = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]],
                            [t["ixz"], t["iyz"], t["izz"]]])
         if inertia_policy.defects(given["mass"], tensor):
-            if policy == "repair":
+            if recompute:
                 overrides[link.name] = ("recompute" if fit.slack == 1 else "estimate",
                                         f"repaired, {describe(fit)}")
         else:

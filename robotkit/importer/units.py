@@ -21,23 +21,32 @@ from robotkit.recipe.schema import UNITS
 
 UNIT_WORDS = {"m": "metres", "cm": "centimetres", "mm": "millimetres", "in": "inches"}
 
-_SIZES: dict[tuple, tuple[float, float | None]] = {}
+_EXTENTS: dict[tuple, float] = {}
 
 
-def mesh_size(source: str) -> tuple[float, float | None]:
-    """(largest extent, closed volume or None) of a mesh file at scale 1."""
+def _key(source: str) -> tuple:
     st = os.stat(source)
-    key = (source, st.st_mtime_ns, st.st_size)
-    if key not in _SIZES:
+    return (source, st.st_mtime_ns, st.st_size)
+
+
+def mesh_extent(source: str) -> float:
+    """The largest extent of a mesh file at scale 1."""
+    key = _key(source)
+    if key not in _EXTENTS:
         m = load_mesh(source, (1.0, 1.0, 1.0))
-        extent = float((m.bounds[1] - m.bounds[0]).max())
-        try:
-            vol = volume_mesh(m, "error", os.path.basename(source))[0]
-            volume = float(mesh_mass_properties(vol.vertices, vol.faces).volume)
-        except MeshError:
-            volume = None
-        _SIZES[key] = (extent, volume if volume and volume > 0 else None)
-    return _SIZES[key]
+        _EXTENTS[key] = float((m.bounds[1] - m.bounds[0]).max())
+    return _EXTENTS[key]
+
+
+def mesh_volume(source: str) -> float | None:
+    """The volume of a mesh file at scale 1, None when it is not closed."""
+    m = load_mesh(source, (1.0, 1.0, 1.0))
+    try:
+        vol = volume_mesh(m, "error", os.path.basename(source))[0]
+    except MeshError:
+        return None
+    volume = float(mesh_mass_properties(vol.vertices, vol.faces).volume)
+    return volume if volume > 0 else None
 
 
 def plausible_units(extent: float, volume: float | None, mass: float | None) -> list[str]:
@@ -67,9 +76,10 @@ def judge(link: str, kind: str, use: MeshUse, mass_alone: float | None) -> UnitF
     s = use.scale[0]
     if not use.scale[0] == use.scale[1] == use.scale[2]:
         return None
-    extent, volume = mesh_size(use.source)
+    extent = mesh_extent(use.source)
     if PART_SIZE_RANGE[0] <= extent * s <= PART_SIZE_RANGE[1] or extent == 0:
         return None
+    volume = mesh_volume(use.source) if mass_alone else None
     name = os.path.basename(use.source)
     across = f"{extent * s:.3g} m" if extent * s > PART_SIZE_RANGE[1] else f"{extent * s * 1000:.3g} mm"
     what = f"link '{link}' {kind} mesh {name} is {across} across"
