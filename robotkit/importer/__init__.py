@@ -143,9 +143,8 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         tmp.unlink()
         overrides.update(more)
     os.replace(tmp, out)
-    warnings.extend(_where(source, lines, name) + f"link '{name}': the given inertial does not fit its geometry: "
-                    f"{why}; recompute it from the geometry ('inertial: {{mass: M}}' in the recipe, or import with "
-                    "--recompute-inertials)" for name, why in kept.items())
+    warnings.extend(f"{_where(source, lines, name)}link '{name}': the given inertial does not fit its geometry: {why}"
+                    for name, why in kept.items())
     result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
                           repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes),
                           left_out=list(conv.left_out))

@@ -15,6 +15,7 @@ import numpy as np
 
 from robotkit.importer.inertials import geometry_facts
 from robotkit.importer.meshes import mesh_is_closed
+from robotkit.importer.recipe_writer import fmt
 from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
 from robotkit.model import massprops
@@ -88,5 +89,6 @@ def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str
                 overrides[link.name] = ("recompute" if fit.slack == 1 else "estimate",
                                         f"repaired, {describe(fit)}")
         else:
-            kept[link.name] = describe(fit)
+            kept[link.name] = (f"{describe(fit)}; recompute it from the geometry (inertial: {{mass: {fmt(given['mass'])}}} "
+                               "on the link in the recipe, or import with --recompute-inertials)")
     return overrides, kept

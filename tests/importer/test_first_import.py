@@ -156,3 +156,30 @@ def test_the_printed_build_command_builds_a_robot_that_passes_check(tmp_path, mo
     checked = run_cli("check", "build/car", cwd=proj)
     assert checked.returncode == 0, checked.stdout + checked.stderr
     assert "error" not in checked.stdout.replace("0 errors", ""), checked.stdout
+
+
+def test_a_physical_tensor_that_does_not_fit_is_kept_with_a_warning(tmp_path, monkeypatch):
+    """A tensor some real body has is the vendor's: kept, with check's verdict and its fix."""
+    urdf = workspace(tmp_path, inertial=TYRE.replace('izz="2"', 'izz="0.9"'))
+    monkeypatch.delenv("ROBOTKIT_ROOT", raising=False)
+    monkeypatch.chdir(tmp_path / "proj")
+    result = import_file(urdf, "car.yaml")
+    assert [w for w in result.warnings if "car.urdf" in w] == [UNITS_WARNING, (
+        "../ws/tyre_pkg/urdf/car.urdf:7: link 'wheel': the given inertial does not fit its geometry: its equivalent "
+        "inertia box (5.2 x 5.2 x 1.73 m) is 96.2x larger than the geometry's at uniform density (0.0571 x 0.0571 x "
+        "0.018 m), along x, y, z; recompute it from the geometry (inertial: {mass: 0.2} on the link in the recipe, "
+        "or import with --recompute-inertials)")]
+    assert yaml.safe_load(Path("car.yaml").read_text(encoding="utf-8"))["links"]["wheel"]["inertial"] == {
+        "mass": 0.2, "inertia": {"ixx": 0.5, "iyy": 0.5, "izz": 0.9}}
+
+
+def test_an_explicit_repair_stays_the_repair(tmp_path, monkeypatch):
+    """``--inertia-policy repair`` asks for the smallest change, fit or not."""
+    urdf = workspace(tmp_path)
+    monkeypatch.delenv("ROBOTKIT_ROOT", raising=False)
+    monkeypatch.chdir(tmp_path / "proj")
+    result = import_file(urdf, "car.yaml", inertia_policy="repair")
+    assert result.repairs["wheel"].endswith(
+        "the original's principal moments 0.5, 0.5, 2 violate the triangle inequality: repaired (principal moments "
+        "0.5, 0.5, 2 moved to 0.833333, 0.833333, 1.66667 to meet the triangle inequality)")
+    assert "policy" not in yaml.safe_load(Path("car.yaml").read_text(encoding="utf-8"))["links"]["wheel"]["inertial"]
