@@ -199,18 +199,20 @@ def _add_import(subparsers) -> argparse.ArgumentParser:
                    help="folder of ROS package PKG (repeatable)")
     p.add_argument("--arg", action="append", type=_xacro_arg, default=[], metavar="NAME:=VALUE",
                    help="xacro argument (repeatable)")
-    p.add_argument("--inertia-policy", choices=("keep", "repair", "recompute", "estimate"), default="repair",
+    p.add_argument("--inertia-policy", choices=("keep", "repair", "recompute", "estimate"), default=None,
                    help="for each link whose given inertia no real body has: keep it (the import stops on it, "
-                        "as the build would), repair it with the smallest change (default), recompute it from "
+                        "as the build would), repair it with the smallest change, recompute it from "
                         "the link's geometry or estimate it from its bounding primitive, keeping the mass "
-                        "(a link without geometry is repaired)")
+                        "(a link without geometry is repaired); default: repair, and recompute (estimate "
+                        "without a closed geometry) where the repaired tensor does not fit the geometry")
     p.add_argument("--recompute-inertials", action="store_true",
                    help="compute every link's inertial from its geometry, physical or not (keeping each "
                         "link's mass, or at --density) and report the difference per link")
     p.add_argument("--density", type=float, metavar="KG_M3",
                    help="with --recompute-inertials: density in kg/m^3 instead of keeping the given masses")
     p.add_argument("--copy-meshes", action="store_true",
-                   help="copy the meshes below the recipe's folder (meshes/) instead of referencing them")
+                   help="copy every mesh below the recipe's folder (meshes/) instead of referencing them "
+                        "(those outside the project, which its build does not read, are always copied)")
     return p
 
 

@@ -23,12 +23,12 @@ from robotkit.geometry import rpy_matrix
 from robotkit.mesh.inertia import mesh_mass_properties
 from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
+from robotkit.model.inertia_policy import equivalent_box
 from robotkit.model import massprops as mi
 from robotkit.model.plausible import DENSITY_RANGE, PART_SIZE_RANGE
 
 # thresholds (documented in docs/checks.md)
 MIN_MASS = 1e-6  # kg: sdformat drops lighter links (sdformat #199)
-BOX_ERROR, BOX_WARNING = 3.0, 1.5
 FACE_BUDGET = 200_000  # visual faces per link before rendering rates suffer
 COLLISION_VOLUME_RANGE = (0.5, 2.0)  # collision / visual volume
 MASS_TOLERANCE = 0.10  # declared total mass vs computed
@@ -377,37 +377,23 @@ def _geometry_props(link: LinkFacts):
     return volume, com, I
 
 
-def equivalent_box(mass: float, moments) -> np.ndarray:
-    """Full side lengths of the uniform box with ``mass`` and principal ``moments`` (Gazebo's
-    View > Inertia): a = sqrt(6 (I2 + I3 - I1) / m), and so on; a side that comes out imaginary
-    (moments that break the triangle inequality) is 0."""
-    a, b, c = moments
-    return np.sqrt(np.maximum(0.0, 6.0 / mass * np.array([b + c - a, a + c - b, a + b - c])))
-
-
 def _box_check_geometry(link: LinkFacts, geometry, s: str) -> list[Finding]:
     """The equivalent inertia box (what Gazebo draws with View > Inertia) of the declared
-    inertia against that of the geometry at uniform density with the same mass, along the
-    geometry's principal axes (so a rotated or swapped tensor shows too)."""
+    inertia against that of the geometry at uniform density with the same mass
+    (robotkit.model.inertia_policy.box_fit_geometry: the rule ``robotkit import`` uses too)."""
     volume, _, I_geom = geometry
-    vals, vecs = np.linalg.eigh(I_geom * (link.mass / volume))
-    declared = np.diag(vecs.T @ link.inertia @ vecs)
-    want, got = equivalent_box(link.mass, vals), equivalent_box(link.mass, declared)
-    worst, axis = 1.0, 0
-    for k in range(3):
-        if want[k] < 1e-9 * max(want.max(), 1e-12):
-            continue
-        ratio = max(got[k], 1e-12) / want[k]
-        ratio = ratio if ratio >= 1 else 1 / ratio
-        if ratio > worst:
-            worst, axis = ratio, k
-    if worst <= BOX_WARNING:
+    fit = inertia_policy.box_fit_geometry(link.mass, link.inertia, volume, I_geom)
+    if fit.severity is None:
         return []
-    direction = "larger" if got[axis] > want[axis] else "smaller"
-    return [Finding("error" if worst > BOX_ERROR else "warning", "inertia-box", s,
-                    f"the equivalent inertia box ({' x '.join(f'{d:.3g}' for d in got)} m) is {worst:.3g}x {direction} "
-                    f"than the geometry's at uniform density ({' x '.join(f'{d:.3g}' for d in want)} m)",
+    return [Finding(fit.severity, "inertia-box", s,
+                    f"the equivalent inertia box ({_sides(fit.declared)} m) is {fit.ratio:.3g}x "
+                    f"{'larger' if fit.larger else 'smaller'} than the geometry's at uniform density "
+                    f"({_sides(fit.geometry)} m), along {fit.axes}",
                     "the inertia does not fit the part: hand-typed, rotated, or in the wrong units?")]
+
+
+def _sides(sides) -> str:
+    return " x ".join(f"{d:.3g}" for d in sides)
 
 
 def _com_check(link: LinkFacts, geometry, s: str) -> list[Finding]:
@@ -426,20 +412,15 @@ def _com_check(link: LinkFacts, geometry, s: str) -> list[Finding]:
 
 def _box_check(link: LinkFacts, eig, points: np.ndarray, s: str) -> list[Finding]:
     """Without a closed geometry: the equivalent inertia box against the geometry's extent
-    along the same principal axes.  A uniform body's box can exceed its extent by up to
-    sqrt(3) (mass at the ends), so only larger boxes beyond that are flagged."""
-    vals, vecs = np.linalg.eigh(0.5 * (link.inertia + link.inertia.T))
-    dims = equivalent_box(link.mass, vals)
-    local = (points - link.com) @ vecs
-    extent = local.max(axis=0) - local.min(axis=0)
-    worst = max([max(dims[k], 1e-12) / max(extent[k], 1e-12) for k in range(3)
-                 if extent[k] > 1e-9 or dims[k] > 1e-9] or [1.0])
-    if worst <= math.sqrt(3) * BOX_WARNING:
+    along the same principal axes (robotkit.model.inertia_policy.box_fit_extent).  A uniform
+    body's box can exceed its extent by up to sqrt(3) (mass at the ends), so only larger boxes
+    beyond that are flagged."""
+    fit = inertia_policy.box_fit_extent(link.mass, link.com, link.inertia, points)
+    if fit.severity is None:
         return []
-    severity = "error" if worst > math.sqrt(3) * BOX_ERROR else "warning"
-    return [Finding(severity, "inertia-box", s,
-                    f"the equivalent inertia box ({' x '.join(f'{d:.3g}' for d in dims)} m) is {worst:.3g}x "
-                    f"larger than the geometry ({' x '.join(f'{e:.3g}' for e in extent)} m) along a principal axis",
+    return [Finding(fit.severity, "inertia-box", s,
+                    f"the equivalent inertia box ({_sides(fit.declared)} m) is {fit.ratio:.3g}x "
+                    f"larger than the geometry ({_sides(fit.geometry)} m), along {fit.axes}",
                     "the inertia does not fit the part: hand-typed or in the wrong units?")]
 
 

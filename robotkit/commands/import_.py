@@ -4,6 +4,7 @@ a URDF or xacro file into a recipe (:func:`robotkit.importer.import_file`)."""
 from __future__ import annotations
 
 import os
+import shlex
 import sys
 
 from robotkit.importer import import_file
@@ -19,5 +20,12 @@ def run(args) -> int:
                          density=args.density, inertia_policy=args.inertia_policy)
     for w in result.warnings:
         print(f"warning: {w}", file=sys.stderr)
-    print(f"wrote {os.path.relpath(result.recipe_path)} (robot {result.robot})")
+    recipe = os.path.relpath(result.recipe_path)
+    if result.copied:
+        meshes = os.path.join(os.path.dirname(recipe), "meshes", "")
+        print(f"copied {len(result.copied)} file{'s' if len(result.copied) > 1 else ''} to {meshes} "
+              "(meshes outside the project, which its build does not read, with their packages' licences)"
+              if not args.copy_meshes else f"copied {len(result.copied)} files to {meshes}")
+    print(f"wrote {recipe} (robot {result.robot}); build it with:")
+    print(f"robotkit build {shlex.quote(recipe)}")
     return 0

@@ -22,8 +22,10 @@ from pydantic import ValidationError
 from robotkit import urdfxml
 from robotkit.errors import Problem, RobotkitError, display_path
 from robotkit.importer.defaults import factor_defaults
+from robotkit.importer.fit import misfits
 from robotkit.importer.inertials import POLICIES, report_recomputed
 from robotkit.importer.meshes import mark_open_meshes
+from robotkit.importer.parsing import shown
 from robotkit.importer.package_xml import package_metadata, with_own_package
 from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
 from robotkit.importer.urdf_to_recipe import Converted, urdf_to_recipe
@@ -90,7 +92,7 @@ onto the recipe; another format is another entry here."""
 
 def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_paths: dict[str, str] | None = None,
                 args: dict[str, str] | None = None, recompute_inertials: bool = False, copy_meshes: bool = False,
-                density: float | None = None, inertia_policy: str = "repair") -> ImportResult:
+                density: float | None = None, inertia_policy: str | None = None) -> ImportResult:
     """Import the URDF or xacro file ``path`` into the recipe ``out_recipe``.
 
     ``package_paths`` maps ROS package names to folders (``$(find PKG)``, ``package://PKG``);
@@ -99,10 +101,15 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     mass, or at ``density`` when given; the differences are reported per link.  Otherwise a
     physical inertial is kept as given and one that no real body has gets ``inertia_policy``
     (keep, repair, recompute, estimate; see robotkit.importer.inertials.chosen_inertial), with a
-    comment above its link saying what was wrong.
-    ``copy_meshes`` copies the meshes below the recipe's folder (``meshes/``) instead of
-    referencing them where they are.
+    comment above its link saying what was wrong; by default (None) the repair, and where the
+    repaired tensor does not fit the link's geometry by check's rule, a recompute
+    (robotkit.importer.fit).  ``copy_meshes`` copies every mesh below the recipe's folder
+    (``meshes/PKG/...``) instead of referencing it where it is; the meshes outside the recipe's
+    project, which its build may not read, are copied whatever it says, with their package's
+    licence files.
     """
+    fit = inertia_policy is None  # the default: a repair that does not fit the geometry is recomputed
+    inertia_policy = inertia_policy or "repair"
     if inertia_policy not in POLICIES:
         raise RobotkitError(Problem(f"inertia policy '{inertia_policy}' is not one of {', '.join(POLICIES)}"))
     if density is not None and not density > 0:
@@ -113,25 +120,42 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     raw = _read_input(source)
     read = next(reader for accepts, reader in READERS.values() if accepts(source, raw))
     got = read(source, raw, packages, args or {})
-    warnings, inputs = list(got.warnings), [str(source), *got.includes]
-    conv = urdf_to_recipe(got.urdf, source, out, packages, copy_meshes=copy_meshes,
-                          recompute_inertials=recompute_inertials, density=density, inertia_policy=inertia_policy)
-    warnings.extend(conv.warnings)
-    inputs.extend(sorted({m.source for m in conv.meshes.values()}))
-    recipe = _finished_recipe(conv, source, warnings, recompute_inertials)
-    copied = _copy_meshes(conv.copies, source, out)
-    header = _header(source, out, args, recompute_inertials, density, inertia_policy) + [
-        line for note in conv.left_out for line in wrap(note)]
-    text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
     lines = _element_lines(got.urdf) if got.urdf is raw else {}
-    _write_checked(text_out, out, source, lines, [] if copy_meshes else [m.source for m in conv.meshes.values()],
-                   warnings)
+    policy = recipe_policy(out)
+    copy = True if copy_meshes else (lambda p: not policy.allows(p))  # the build reads only its project
+    overrides: dict[str, tuple[str, str]] = {}
+    while True:  # twice when a repaired tensor does not fit its geometry: then recomputed
+        warnings, inputs = list(got.warnings), [str(source), *got.includes]
+        conv = urdf_to_recipe(got.urdf, source, out, packages, copy_meshes=copy, recompute_inertials=recompute_inertials,
+                              density=density, inertia_policy=inertia_policy, lines=bool(lines), overrides=overrides)
+        warnings.extend(conv.warnings)
+        inputs.extend(sorted({m.source for m in conv.meshes.values()}))
+        recipe = _finished_recipe(conv, source, warnings, recompute_inertials)
+        header = _header(source, out, args, recompute_inertials, density, inertia_policy, fit) + [
+            line for note in conv.left_out for line in wrap(note)]
+        text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
+        copied = _copy_meshes(conv.copies, source, out)
+        tmp, robot = _write_checked(text_out, out, source, lines, [m.recipe_path for m in conv.meshes.values()],
+                                    warnings)
+        more, kept = misfits(robot, conv.explicit, fit)
+        if not set(more) - set(overrides):
+            break
+        tmp.unlink()
+        overrides.update(more)
+    os.replace(tmp, out)
+    warnings.extend(f"{_where(source, lines, name)}link '{name}': the given inertial does not fit its geometry: {why}"
+                    for name, why in kept.items())
     result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
                           repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes),
                           left_out=list(conv.left_out))
     if recompute_inertials:
         report_recomputed(out, conv, result)
     return result
+
+
+def _where(source: Path, lines: dict, link: str) -> str:
+    line = lines.get(("links", link))
+    return f"{shown(source)}{f':{line}' if line else ''}: "
 
 
 def _read_input(source: Path) -> str:
@@ -179,7 +203,7 @@ def _copy_meshes(copies: dict[str, str], source: Path, out: Path) -> list[str]:
 
 
 def _header(source: Path, out: Path, args: dict[str, str] | None, recompute_inertials: bool,
-            density: float | None, inertia_policy: str) -> list[str]:
+            density: float | None, inertia_policy: str, fit: bool = False) -> list[str]:
     """The recipe's header comment: where it came from and how its inertials were decided."""
     header = [f"Imported by robotkit from {Path(os.path.relpath(source, out.parent)).as_posix()}"]
     if args:
@@ -190,12 +214,16 @@ def _header(source: Path, out: Path, args: dict[str, str] | None, recompute_iner
     else:
         header.append("inertials as given in the original (explicit); those no real body has: "
                       f"{inertia_policy} (--inertia-policy)")
+        if fit:
+            header.append("a repair that does not fit the link's geometry (check's inertia-box rule): recompute, "
+                          "or estimate without a closed geometry")
     return header
 
 
-def _write_checked(text: str, out: Path, source: Path, lines: dict, read: list[str], warnings: list[str]) -> None:
-    """Write the recipe ``out`` atomically once it loads and resolves as the build will (``read``:
-    the mesh files a build of it reads, whose folders outside its project it may read)."""
+def _write_checked(text: str, out: Path, source: Path, lines: dict, read: list[str], warnings: list[str]):
+    """Write the recipe next to ``out`` and load and resolve it as the build will (``read``:
+    the mesh files a build of it reads, whose folders outside its project it may read):
+    (the file written, which the caller moves onto ``out``, the robot)."""
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text(text, encoding="utf-8")
@@ -206,11 +234,10 @@ def _write_checked(text: str, out: Path, source: Path, lines: dict, read: list[s
                         f"build it with --root {display_path(common)}")
     try:
         with widened(outside):  # the package paths the user declared
-            _check_resolves(tmp, source, lines)
+            return tmp, _check_resolves(tmp, source, lines)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
-    os.replace(tmp, out)
 
 
 def _validate(recipe: dict, source: Path) -> None:
@@ -232,7 +259,8 @@ def _check_resolves(recipe_file: Path, source: Path, lines: dict) -> None:
     file and, for a URDF, the line of the link or joint (the recipe is not written when there
     are any)."""
     try:
-        load_robots([recipe_file])
+        (_, robot), = load_robots([recipe_file])
+        return robot
     except RobotkitError as exc:
         rest = []
         for p in exc.problems:

@@ -76,16 +76,18 @@ POLICIES = ("keep", "repair", "recompute", "estimate")
 """``robotkit import --inertia-policy``: what a link whose given tensor no real body has gets."""
 
 
-def chosen_inertial(name: str, given: dict, source: str | None, policy: str, repairs: dict[str, str]) -> dict:
+def chosen_inertial(name: str, given: dict, source: str | None, policy: str, repairs: dict[str, str],
+                    why: str = "") -> dict:
     """The recipe's inertial for link ``name`` whose original gives a positive mass: as given when
     it is physical, else by ``policy`` (``source``: the geometry a recompute or an estimate reads,
     None when the link has none, which gets the repair), with what was wrong and what was done in
-    ``repairs[name]`` (the comment above the link).  ``keep`` writes the tensor as given: the
-    import then stops on it, as the build would."""
+    ``repairs[name]`` (the comment above the link; ``why``: why not the repair, when the policy
+    replaces it).  ``keep`` writes the tensor as given: the import then stops on it, as the build
+    would."""
     wrong = inertia_policy.defects(given["mass"], _tensor(given["inertia"]))
     if not wrong or policy == "keep":
         return _explicit_dict(given)
-    what = f"the original's {'; '.join(wrong)}"
+    what = f"the original's {'; '.join(wrong)}" + (f"; {why}" if why else "")
     if policy in ("recompute", "estimate") and source is not None:
         spec = {**_explicit_dict(given), "policy": policy}  # the given values stay, for the record
         if source != "visual":
@@ -249,7 +251,7 @@ def _tensor(t: dict):
 
 
 
-def _facts(mesh) -> dict:
+def geometry_facts(mesh) -> dict:
     """Unit-density mass properties of one mesh, as robotkit's mesh task records them."""
     m = load_mesh(mesh.source, mesh.scale)
     bbox_min, bbox_max = m.bounds
@@ -268,7 +270,7 @@ def report_recomputed(recipe_file: Path, conv, result) -> None:
             continue
         for g in link.source_geoms():
             if g.shape.mesh is not None and g.shape.mesh.key not in facts:
-                facts[g.shape.mesh.key] = _facts(g.shape.mesh)
+                facts[g.shape.mesh.key] = geometry_facts(g.shape.mesh)
         new = finalize_link_inertial(link, facts)
         given = conv.explicit[link.name]
         t = given["inertia"]

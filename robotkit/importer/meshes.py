@@ -4,12 +4,15 @@ need ``open_mesh: hull`` because an inertial is computed from a mesh that is not
 
 from __future__ import annotations
 
+import glob
 import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 from robotkit.errors import MeshError, display_path
+from robotkit.importer.package_xml import find_package_xml
 from robotkit.importer.parsing import Problems
 from robotkit.mesh.io import load_mesh, volume_mesh
 
@@ -23,16 +26,34 @@ class MeshUse:
     source: str  # absolute path of the file found
     recipe_path: str  # absolute path the recipe names (source, or its copy)
     scale: tuple[float, float, float]
+    element: object = None  # the URDF's <mesh> element
+
+
+LICENCE_FILES = ("LICENSE*", "LICENCE*", "COPYING*")
+"""A package's licence files, copied with its meshes."""
 
 
 class MeshResolver:
-    def __init__(self, source: Path, recipe_dir: Path, packages: dict[str, str], copy: bool):
+    """Where the meshes a URDF names are, and where the recipe points: at them, or at copies
+    below the recipe's folder (``meshes/PKG/...``, with the package's licence) for those
+    ``copy(path)`` says (every mesh with ``--copy-meshes``; by default those outside the
+    project, which its build may not read)."""
+
+    def __init__(self, source: Path, recipe_dir: Path, packages: dict[str, str], copy: bool | Callable[[str], bool]):
         self.source = source
         self.recipe_dir = recipe_dir
         self.packages = packages
-        self.copy = copy
+        self.copy = copy if callable(copy) else (lambda path, every=bool(copy): every)
         self.copies: dict[str, str] = {}  # destination -> source
         self._dest_of: dict[str, str] = {}
+
+    def leaves_package(self, uri: str) -> str | None:
+        """The package a ``package://PKG/../..`` URI climbs out of, when its copy would land
+        outside the recipe's ``meshes/`` folder."""
+        m = re.match(r"^(package|model):///?([^/]+)/(.+)$", uri)
+        if m and os.path.normpath(os.path.join(m.group(2), m.group(3))).split(os.sep)[0] == "..":
+            return m.group(2)
+        return None
 
     def locate(self, uri: str, link: str, problems: Problems) -> str | None:
         """Absolute path of the file ``uri`` names, or None with a problem."""
@@ -66,12 +87,19 @@ class MeshResolver:
 
     def destination(self, path: str, uri: str) -> str:
         """Where the recipe points for the file at ``path`` (a copy below the recipe, or it)."""
-        if not self.copy:
+        if not self.copy(path):
             return path
         if path in self._dest_of:
             return self._dest_of[path]
         m = re.match(r"^(package|model):///?(.+)$", uri)
-        rel = m.group(2) if m else os.path.basename(path)
+        package = self.packages.get(m.group(2).split("/")[0]) if m else None
+        if m:
+            rel = m.group(2)
+        else:
+            found = find_package_xml(Path(path))
+            package = str(found.parent) if found is not None else None
+            rel = (os.path.join(os.path.basename(package), os.path.relpath(path, package)) if package
+                   else os.path.basename(path))
         dest = os.path.normpath(os.path.join(self.recipe_dir, "meshes", rel))
         stem, ext = os.path.splitext(dest)
         i = 2
@@ -79,7 +107,17 @@ class MeshResolver:
             dest, i = f"{stem}_{i}{ext}", i + 1
         self.copies[dest] = path
         self._dest_of[path] = dest
+        if package is not None:
+            self._licence(package, os.path.normpath(os.path.join(self.recipe_dir, "meshes", rel.split("/")[0])))
         return dest
+
+    def _licence(self, package: str, dest_dir: str) -> None:
+        """The package's licence files next to its copied meshes (not its package.xml, which would
+        make the copy a second package for colcon; its licence is in the recipe's metadata)."""
+        found = sorted(f for pattern in LICENCE_FILES for f in glob.glob(os.path.join(glob.escape(package), pattern))
+                       if os.path.isfile(f))
+        for f in found:
+            self.copies.setdefault(os.path.join(dest_dir, os.path.basename(f)), f)
 
     def recipe_text(self, dest: str) -> str:
         return Path(os.path.relpath(dest, self.recipe_dir)).as_posix()

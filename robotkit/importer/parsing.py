@@ -4,9 +4,19 @@ list of problems (one line each, naming the file) that an import collects before
 from __future__ import annotations
 
 import math
+import os
 
 from robotkit.errors import Problem, RobotkitError
 from robotkit.importer.recipe_writer import fmt
+
+
+def shown(path: str | os.PathLike) -> str:
+    """A path as a message names it: relative to the cwd (``../ws/pkg/robot.urdf`` too), so that
+    a line of the URDF can be opened from where the command ran."""
+    try:
+        return os.path.relpath(os.path.normpath(os.path.abspath(path)))
+    except ValueError:  # another drive (Windows)
+        return os.fspath(path)
 
 
 class Problems:
@@ -14,8 +24,9 @@ class Problems:
         self.file = file
         self.items: list[Problem] = []
 
-    def add(self, message: str):
-        self.items.append(Problem(message, file=self.file))
+    def add(self, message: str, line: int | None = None):
+        """A problem of the input file; with its ``line``, the file is named relative to the cwd."""
+        self.items.append(Problem(message, file=self.file if line is None else shown(self.file), line=line))
 
     def raise_if_any(self):
         if self.items:

@@ -35,9 +35,10 @@ from robotkit.emit.sdf import names_apart
 from robotkit.emit.urdf import MASSLESS
 from robotkit.errors import Problem, RobotkitError, short_number
 from robotkit.importer.inertials import chosen_inertial, give_moving_links_mass, no_inertial_form, read_inertial
+from robotkit.importer import units as mesh_units
 from robotkit.importer.meshes import MeshResolver, MeshUse
 from robotkit.importer.names import material_name, name_hint, valid_frame_name, valid_name
-from robotkit.importer.parsing import (Problems, fmt_list, local_name, origin_dict, read_float, read_floats,
+from robotkit.importer.parsing import (Problems, fmt_list, shown, local_name, origin_dict, read_float, read_floats,
                                        read_origin)
 from robotkit.importer.recipe_writer import fmt
 from robotkit.geometry import rpy_matrix
@@ -73,6 +74,18 @@ class _Reading:
     recompute_inertials: bool = False
     density: float | None = None
     inertia_policy: str = "repair"
+    lines: bool = False  # whether the elements' lines are the input file's (a URDF, not an expanded xacro)
+    overrides: dict[str, tuple[str, str]] = field(default_factory=dict)  # link -> (policy, why)
+    notes: dict[str, list[str]] = field(default_factory=dict)  # link -> what else the recipe changes
+    elements: dict[str, object] = field(default_factory=dict)  # link -> its <link> element
+
+    def line(self, el) -> int | None:
+        return el.sourceline if self.lines else None
+
+    def where(self, el) -> str:
+        """``file:line: `` of an element of the input, for a warning."""
+        line = self.line(el)
+        return f"{shown(self.problems.file)}{f':{line}' if line else ''}: "
 
 
 @dataclass
@@ -89,12 +102,16 @@ class _Links:
 
 
 def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.PathLike,
-                   package_paths: dict[str, str] | None = None, copy_meshes: bool = False,
+                   package_paths: dict[str, str] | None = None, copy_meshes=False,
                    recompute_inertials: bool = False, density: float | None = None,
-                   inertia_policy: str = "repair") -> Converted:
+                   inertia_policy: str = "repair", lines: bool = False,
+                   overrides: dict[str, tuple[str, str]] | None = None) -> Converted:
     """Map the URDF ``text`` (read from ``source``) to a recipe dict for ``recipe_path``.
-    ``inertia_policy``: what a link whose given tensor no real body has gets
-    (:func:`robotkit.importer.inertials.chosen_inertial`).
+    ``copy_meshes``: whether to copy every mesh below the recipe, or which (a predicate on its
+    path).  ``inertia_policy``: what a link whose given tensor no real body has gets
+    (:func:`robotkit.importer.inertials.chosen_inertial`); ``overrides``: link -> (policy, why)
+    for links whose repaired tensor would not fit their geometry.  ``lines``: whether the
+    elements' lines are ``source``'s (warnings and problems then name them).
 
     Raises RobotkitError with every problem found (one line each, naming links and URIs).
     """
@@ -103,7 +120,7 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
     root = _robot_element(text, source)
     children = [el for el in root if is_element(el)]
     r = _Reading(Problems(str(source)), [], MeshResolver(source, recipe_dir, dict(package_paths or {}), copy_meshes),
-                 Converted(recipe={}), recompute_inertials, density, inertia_policy)
+                 Converted(recipe={}), recompute_inertials, density, inertia_policy, lines, dict(overrides or {}))
     robot_name = _robot_name(root.get("name") or source.name.split(".")[0], r.warnings)
     materials = _Materials(children, r.problems, r.warnings)
     links = _links(children, materials, r)
@@ -112,7 +129,10 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
     r.problems.raise_if_any()
     give_moving_links_mass(links.links, joints, r.out)
     for link, why in r.out.repairs.items():
-        r.warnings.append(f"link '{link}': {why}")
+        where = r.where(r.elements[link]) if link in r.overrides else ""
+        r.warnings.append(f"{where}link '{link}': {why}")
+    for link, notes in r.notes.items():  # said in their own warnings
+        r.out.repairs[link] = "; ".join([*notes, *([r.out.repairs[link]] if link in r.out.repairs else [])])
     recipe: dict = {"robot": robot_name, "units": "m", "density": density if density is not None else 1000.0}
     if materials.materials:
         recipe["materials"] = materials.materials
@@ -224,7 +244,9 @@ def _links(children: list, materials: _Materials, r: _Reading) -> _Links:
         if name in found.links:
             r.problems.add(f"link '{name}' is defined twice")
             continue
+        r.elements[name] = el
         visuals, collisions, vis_materials = _link_geometry(el, name, materials, r)
+        _mesh_units(el, name, visuals, collisions, r)
         for child in el:
             if is_element(child) and local_name(child.tag) not in ("visual", "collision", "inertial"):
                 r.warnings.append(f"link '{name}': <{local_name(child.tag)}> is dropped (the recipe has no place for it)")
@@ -263,6 +285,36 @@ def _link_geometry(el, name: str, materials: _Materials, r: _Reading) -> tuple[l
                         vis_materials.append(geom["material"])
                 items.append(geom)
     return visuals, collisions, vis_materials
+
+
+def _mesh_units(el, name: str, visuals: list, collisions: list, r: _Reading) -> None:
+    """A mesh the URDF scales into an implausible part (robotkit.importer.units): the recipe's
+    ``units`` when only one unit fits, said in a warning naming the <mesh>'s line either way."""
+    mass = _number(el.find("inertial/mass"), "value")
+    judged: dict[str, mesh_units.UnitFix | None] = {}
+    for key, use in list(r.out.meshes.items()):
+        link, kind, i = key
+        if link != name:
+            continue
+        if use.source not in judged:
+            alone = len(visuals) == 1 and kind == "visual"  # the link's mass is on this mesh only
+            judged[use.source] = fix = mesh_units.judge(name, kind, use, mass if alone and mass else None)
+            if fix is not None:
+                r.warnings.append(r.where(use.element) + fix.warning)
+                if fix.note:
+                    r.notes.setdefault(name, []).append(fix.note)
+        fix = judged[use.source]
+        if fix is not None and fix.unit is not None:
+            r.out.meshes[key] = mesh_units.apply(fix, use, visuals + collisions, r.resolver.recipe_text(use.recipe_path))
+
+
+def _number(el, attr: str) -> float | None:
+    """A positive finite number in ``el``'s ``attr``, else None (what is wrong is said elsewhere)."""
+    try:
+        value = float(el.get(attr)) if el is not None else math.nan
+    except (TypeError, ValueError):
+        return None
+    return value if math.isfinite(value) and value > 0 else None
 
 
 def _link_inertial(el, name: str, visuals: list, collisions: list, no_inertial, r: _Reading):
@@ -306,7 +358,8 @@ def _given_inertial(name: str, given: dict, visuals: list, collisions: list, r: 
                           "its inertial is kept as given")
     source = ("collision" if collisions and not (visuals and _same_shapes(visuals, collisions))
               else "visual" if visuals else None)
-    return chosen_inertial(name, given, source, r.inertia_policy, r.out.repairs)
+    policy, why = r.overrides.get(name, (r.inertia_policy, ""))
+    return chosen_inertial(name, given, source, policy, r.out.repairs, why)
 
 
 def _rgba(el, what: str, problems: Problems, warnings: list[str]):
@@ -370,6 +423,10 @@ def _mesh(shape, what: str, link: str, use: tuple[str, str, int], r: _Reading) -
     if any(s == 0 for s in scale):
         r.problems.add(f"{what}: mesh '{uri}' has a zero scale ({shape.get('scale')})")
         return None
+    left = r.resolver.leaves_package(uri)
+    if left is not None and r.resolver.copy(path):  # its copy would land outside meshes/
+        r.problems.add(f"{what} mesh: {uri} leaves package '{left}'", r.line(shape))
+        return None
     dest = r.resolver.destination(path, uri)
     geom: dict = {"mesh": r.resolver.recipe_text(dest)}
     if scale[0] == scale[1] == scale[2]:
@@ -381,7 +438,7 @@ def _mesh(shape, what: str, link: str, use: tuple[str, str, int], r: _Reading) -
             geom["scale"] = s
     else:
         geom["scale"] = list(scale)
-    r.out.meshes[use] = MeshUse(path, dest, tuple(scale))
+    r.out.meshes[use] = MeshUse(path, dest, tuple(scale), shape)
     return geom
 
 

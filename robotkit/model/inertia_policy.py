@@ -130,3 +130,87 @@ def repair(mass: float, inertia: np.ndarray, min_mass: float) -> Repaired:
     out[np.abs(out) < 1e-15 * scale] = 0.0  # products of inertia that are rounding only
     return Repaired(float(mass), out + 0.0, tuple(changes))
 
+
+
+# ---------------------------------------------------------------- does the tensor fit the part?
+
+BOX_ERROR, BOX_WARNING = 3.0, 1.5
+"""How far the equivalent inertia box may stray from the geometry's (either way) before check
+warns and errs (robotkit.check.lints, inertia-box); ``robotkit import`` uses the error one to
+recompute a repaired tensor that still does not fit."""
+
+EXTENT_SLACK = float(np.sqrt(3.0))
+"""Against a geometry's extent (no closed volume) a uniform body's box may be up to sqrt(3) larger
+(mass at the ends): the thresholds are that much wider."""
+
+
+def equivalent_box(mass: float, moments) -> np.ndarray:
+    """Full side lengths of the uniform box with ``mass`` and principal ``moments`` (Gazebo's
+    View > Inertia): a = sqrt(6 (I2 + I3 - I1) / m), and so on; a side that comes out imaginary
+    (moments that break the triangle inequality) is 0."""
+    a, b, c = moments
+    return np.sqrt(np.maximum(0.0, 6.0 / mass * np.array([b + c - a, a + c - b, a + b - c])))
+
+
+@dataclass(frozen=True)
+class BoxFit:
+    """The equivalent inertia box of a declared tensor against the geometry's, along one set of axes."""
+
+    ratio: float
+    """The worst side ratio, >= 1 (1: it fits)."""
+    larger: bool
+    """Whether the declared box is the larger on that side."""
+    declared: np.ndarray
+    geometry: np.ndarray
+    axes: str
+    """What the three sides are along: "x, y, z" when the axes are the link's, else principal axes."""
+    slack: float = 1.0
+
+    @property
+    def severity(self) -> str | None:
+        """"error", "warning" or None, as check judges it."""
+        r = self.ratio / self.slack
+        return "error" if r > BOX_ERROR else "warning" if r > BOX_WARNING else None
+
+
+def _link_axes(vecs: np.ndarray, *triples):
+    """The triples reordered along x, y, z when the columns of ``vecs`` are the link's axes (a
+    part modelled square to its frame), with the label of the axes they are along."""
+    index = np.argmax(np.abs(vecs), axis=0)
+    if sorted(index.tolist()) == [0, 1, 2] and np.all(np.abs(vecs[index, range(3)]) > 1 - 1e-6):
+        order = np.argsort(index)
+        return [np.asarray(t)[order] for t in triples], "x, y, z"
+    return list(triples), None
+
+
+def box_fit_geometry(mass: float, inertia, volume: float, geometry_inertia) -> BoxFit:
+    """The declared ``inertia`` (about the centre of mass, link axes) against the closed
+    geometry's at uniform density with the same ``mass`` (``geometry_inertia``: unit density,
+    ``volume``), along the geometry's principal axes, so that a rotated or swapped tensor shows."""
+    vals, vecs = np.linalg.eigh(np.asarray(geometry_inertia, dtype=float) * (mass / volume))
+    declared = np.diag(vecs.T @ np.asarray(inertia, dtype=float) @ vecs)
+    want, got = equivalent_box(mass, vals), equivalent_box(mass, declared)
+    worst, axis = 1.0, 0
+    for k in range(3):
+        if want[k] < 1e-9 * max(want.max(), 1e-12):
+            continue
+        ratio = max(got[k], 1e-12) / want[k]
+        ratio = ratio if ratio >= 1 else 1 / ratio
+        if ratio > worst:
+            worst, axis = ratio, k
+    larger = bool(got[axis] > want[axis])
+    (got, want), axes = _link_axes(vecs, got, want)
+    return BoxFit(worst, larger, got, want, axes or "the geometry's principal axes")
+
+
+def box_fit_extent(mass: float, com, inertia, points) -> BoxFit:
+    """Without a closed geometry: the equivalent inertia box against the extent of ``points``
+    (the geometry, link frame) along the tensor's principal axes; only a larger box counts."""
+    vals, vecs = np.linalg.eigh(0.5 * (np.asarray(inertia, dtype=float) + np.asarray(inertia, dtype=float).T))
+    dims = equivalent_box(mass, vals)
+    local = (np.asarray(points, dtype=float) - np.asarray(com, dtype=float)) @ vecs
+    extent = local.max(axis=0) - local.min(axis=0)
+    worst = max([max(dims[k], 1e-12) / max(extent[k], 1e-12) for k in range(3)
+                 if extent[k] > 1e-9 or dims[k] > 1e-9] or [1.0])
+    (dims, extent), axes = _link_axes(vecs, dims, extent)
+    return BoxFit(max(worst, 1.0), worst > 1, dims, extent, axes or "its principal axes", EXTENT_SLACK)

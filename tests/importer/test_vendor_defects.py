@@ -95,8 +95,11 @@ def test_the_build_equals_the_original_and_mujoco_loads_it(built):
     urdf = robot_dir / "urdf" / "traits2.urdf"
     check_urdf(urdf)
     assert list(result.repairs) == ["mount"]
-    assert result.repairs["mount"].startswith("the original's principal moments 0.001, 0.001, 0.01 violate the "
-                                              "triangle inequality: repaired")
+    assert result.repairs["mount"] == (  # the repair leaves a 1 cm cube a 94 cm plate: recomputed instead
+        "the original's principal moments 0.001, 0.001, 0.01 violate the triangle inequality; repaired, its "
+        "equivalent inertia box (0.938 x 0.938 x 3.46e-05 m) is 289x smaller than the geometry's at uniform density "
+        "(0.01 x 0.01 x 0.01 m), along x, y, z: recomputed from its visual geometry, keeping the mass (policy: "
+        "recompute; the given com and inertia are unused)")
     stated = robot_dir.parent / "stated.urdf"  # the original with the stated repair
     stated.write_text(_with_stated_repairs(source, urdf, result.repairs), encoding="utf-8")
     assert compare(read_urdf(stated), read_urdf(urdf), 1e-9, configs=5) == []
@@ -131,7 +134,7 @@ def test_check_on_the_original_reads_the_meshes_and_names_the_refusals(built):
     found = check(str(source), package_paths=packages)
     assert [(f.subject, f.message) for f in found if f.check == "inertia-box"] == [
         ("link 'base_link'", "the equivalent inertia box (0.245 x 0.245 x 0.245 m) is 2.45x larger than the "
-                             "geometry's at uniform density (0.3 x 0.2 x 0.1 m)")]
+                             "geometry's at uniform density (0.3 x 0.2 x 0.1 m), along x, y, z")]
     assert [(f.check, f.subject, f.message) for f in found if f.severity == "error"] == [
         ("mesh-uri", "link 'base_link'", "visual mesh 'package:///tpkg/meshes/body.stl' names no package "
                                          "('package:///' leaves the package name empty): ROS's resource retriever, "

@@ -321,7 +321,7 @@ def test_a_material_defined_in_a_link_colours_the_links_that_name_it_after(tmp_p
     data = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
     assert data["materials"] == {"black": {"rgba": [0.2, 0.2, 0.2, 1]}}
     assert [v["material"] for v in data["links"]["finger"]["visual"]] == ["black", "black"]
-    assert not [w for w in result.warnings if "material" in w], result.warnings
+    assert not [w for w in result.warnings if "material '" in w], result.warnings
 
 
 # ---------------------------------------------------------------- xacro's generated elements and attributes

@@ -1,0 +1,94 @@
+"""Whether an imported link's explicit tensor fits its geometry, by ``robotkit check``'s rule
+(robotkit.model.inertia_policy.box_fit_geometry, box_fit_extent: the equivalent inertia box
+against the geometry's), read on the recipe as the build resolves it.
+
+A tensor the import repaired (no real body has the original) that still does not fit gets
+``recompute`` (``estimate`` without a closed geometry) instead: a repair keeps the wrong size of
+a hand-typed tensor.  A physical one that does not fit is kept, with a warning.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from robotkit.importer.inertials import geometry_facts
+from robotkit.importer.meshes import mesh_is_closed
+from robotkit.importer.recipe_writer import fmt
+from robotkit.mesh.io import load_mesh
+from robotkit.model import inertia_policy
+from robotkit.model import massprops
+from robotkit.model.resolve import geom_mass_props
+
+
+_FACTS: dict[tuple, dict] = {}
+
+
+def _facts(mesh) -> dict:
+    """robotkit.importer.inertials.geometry_facts, once per file version (an import loads the
+    recipe twice when it recomputes a tensor)."""
+    st = os.stat(mesh.source)
+    key = (mesh.key, st.st_mtime_ns, st.st_size)
+    if key not in _FACTS:
+        _FACTS[key] = geometry_facts(mesh)
+    return _FACTS[key]
+
+
+def _points(geom) -> np.ndarray:
+    """The geometry's vertices (a primitive's bounding box corners), in its link frame."""
+    s = geom.shape
+    if s.kind == "mesh":
+        P = np.asarray(load_mesh(s.mesh.source, s.mesh.scale).vertices, dtype=float)
+    else:
+        half = {"box": lambda: np.asarray(s.size, dtype=float) / 2,
+                "cylinder": lambda: np.array([s.radius, s.radius, s.length / 2]),
+                "sphere": lambda: np.full(3, s.radius)}[s.kind]()
+        P = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
+    T = geom.pose.matrix()
+    return P @ T[:3, :3].T + T[:3, 3]
+
+
+def link_fit(link) -> inertia_policy.BoxFit | None:
+    """The fit of a resolved link's explicit inertial to its visual (else collision) geometry,
+    as check judges it; None when it has no explicit inertial or no geometry."""
+    geoms = list(link.visuals or link.collisions)
+    if link.inertial_spec.mode != "explicit" or not geoms:
+        return None
+    given = link.inertial_spec.explicit
+    closed = all(g.shape.kind != "mesh" or mesh_is_closed(g.shape.mesh.source, g.shape.mesh.scale) for g in geoms)
+    if closed:
+        facts = {g.shape.mesh.key: _facts(g.shape.mesh) for g in geoms if g.shape.kind == "mesh"}
+        volume, _, I = massprops.combine([geom_mass_props(g, facts) for g in geoms])
+        return inertia_policy.box_fit_geometry(given.mass, given.tensor(), volume, I)
+    points = np.vstack([_points(g) for g in geoms])
+    return inertia_policy.box_fit_extent(given.mass, given.com, given.tensor(), points)
+
+
+def describe(fit: inertia_policy.BoxFit) -> str:
+    sides = [" x ".join(f"{d:.3g}" for d in t) for t in (fit.declared, fit.geometry)]
+    than = "the geometry's at uniform density" if fit.slack == 1 else "the geometry"
+    return (f"its equivalent inertia box ({sides[0]} m) is {fit.ratio:.3g}x {'larger' if fit.larger else 'smaller'} "
+            f"than {than} ({sides[1]} m), along {fit.axes}")
+
+
+def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
+    """(link -> (policy, why) for the repaired tensors that do not fit, when ``recompute``; link ->
+    why for the given physical ones that do not fit), judged as check's errors."""
+    overrides, kept = {}, {}
+    for link in robot.links:
+        given = explicit.get(link.name)
+        fit = link_fit(link) if given is not None else None
+        if fit is None or fit.severity != "error":
+            continue
+        t = given["inertia"]
+        tensor = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]],
+                           [t["ixz"], t["iyz"], t["izz"]]])
+        if inertia_policy.defects(given["mass"], tensor):
+            if recompute:
+                overrides[link.name] = ("recompute" if fit.slack == 1 else "estimate",
+                                        f"repaired, {describe(fit)}")
+        else:
+            kept[link.name] = (f"{describe(fit)}; recompute it from the geometry (inertial: {{mass: {fmt(given['mass'])}}} "
+                               "on the link in the recipe, or import with --recompute-inertials)")
+    return overrides, kept
