@@ -149,6 +149,12 @@ def test_shared_cache_on_s3(s3, tmp_path):
     assert local_b == sorted(p.rsplit("/", 1)[1] for p in objects)
     third = _build(recipe, tmp_path / "c", {"ROBOTKIT_CACHE": str(tmp_path / "local_b")}, forbid_compute=True)
     assert third.returncode == 0, third.stderr
+    # a warm local copy publishes its entries into a new, empty shared cache (one HEAD per key)
+    later = _build(recipe, tmp_path / "d", {"ROBOTKIT_CACHE": "s3://robotkit-cache/later",
+                                            "ROBOTKIT_CACHE_LOCAL": str(tmp_path / "local_b")}, forbid_compute=True)
+    assert later.returncode == 0, later.stderr
+    assert {p.split("/", 2)[2]: b for p, b in _objects(fs, "later").items()} == \
+        {p.split("/", 2)[2]: b for p, b in objects.items()}
 
 
 @pytest.mark.slow
