@@ -160,6 +160,7 @@ def _lumped(urdf: Path) -> dict[str, str]:
     return {link.get("name"): up(link.get("name")) for link in root.findall("link")}
 
 
+@pytest.mark.slow
 def test_turtlebot3_model_sdf_has_its_imu_and_lidar(turtlebot3):
     ign_sdf_check(turtlebot3 / "model.sdf")
     model = ET.parse(turtlebot3 / "model.sdf").getroot().find("model")
@@ -183,6 +184,8 @@ def test_turtlebot3_model_sdf_has_its_imu_and_lidar(turtlebot3):
     assert plugins == ["turtlebot3_burger_controller", "imu_plugin"]
 
 
+@pytest.mark.slow
+@pytest.mark.consumers
 def test_turtlebot3_sensors_are_those_gazebo_sees_in_its_urdf(turtlebot3):
     """libsdformat's conversion of the URDF (`ign sdf -p`) and model.sdf: the same sensors, of
     the same types, in the same links (up to libsdformat's lumping of fixed joints) at the same
