@@ -34,9 +34,16 @@ SURFACE = {"mu1": "mu", "mu2": "mu2", "fdir1": "fdir1", "kp": "kp", "kd": "kd", 
            "minDepth": "min_depth"}
 """URDF <gazebo reference="link"> surface tags -> SDF collision <surface> element names."""
 LINK_TAGS = {"gravity": "gravity", "selfCollide": "self_collide", "self_collide": "self_collide",
-             "maxContacts": None, "laserRetro": None}
-"""Link tags with an SDF element of another name (None: a collision element, see COLLISION)."""
+             "kinematic": "kinematic"}
+"""URDF link tags -> SDF link elements (turnGravityOff and dampingFactor: see :func:`_link_tag`)."""
 COLLISION = {"maxContacts": "max_contacts", "laserRetro": "laser_retro"}
+"""URDF link tags -> elements of each of the link's SDF collisions."""
+JOINT_PHYSICS = {"provideFeedback": ("provide_feedback",), "implicitSpringDamper": ("ode", "implicit_spring_damper"),
+                 "cfmDamping": ("ode", "implicit_spring_damper"), "stopCfm": ("ode", "limit", "cfm"),
+                 "stopErp": ("ode", "limit", "erp")}
+"""URDF joint tags -> paths below the SDF joint's <physics>."""
+JOINT_LOST = {"springStiffness", "springReference", "fudgeFactor"}
+"""URDF joint tags model.sdf does not carry (the recipe's joint dynamics are its own)."""
 MODEL_OWN = {"self_collide"}
 """Model elements robotkit writes itself when the recipe sets them: a block's copy would be a duplicate."""
 
@@ -76,12 +83,12 @@ def carry(robot: Robot, markup: bool = False) -> Carried:
 
 
 def _carry(robot: Robot, ET) -> Carried:
-
+    """:func:`carry`, block by block and element by element."""
     out = Carried()
     links = {link.name for link in robot.links}
     joints = {j.name for j in robot.joints}
     frames = robot.frame_links()
-    other = []
+    other, physics = [], {}
     for text in robot.urdf_extras:
         try:
             block = ET.fromstring(text)
@@ -98,10 +105,13 @@ def _carry(robot: Robot, ET) -> Carried:
             elif ref in links:
                 _to_link(out, ref, elem, robot, frames)
             elif ref in joints:
-                out.joints.setdefault(ref, []).append(_text(_rebodied(elem, robot, frames)))
+                _to_joint(out, ref, elem, robot, frames, physics.setdefault(ref, ET.Element("physics")))
             else:
                 out.losses.append(f'<gazebo reference="{ref}">: <{elem.tag}> not in model.sdf: '
                                   f"'{ref}' names no link or joint of the robot")
+    for ref, elem in physics.items():
+        if len(elem):
+            out.joints.setdefault(ref, []).insert(0, _text(elem))
     if other:
         heads = [_head(x) for x in other]
         out.losses.append(f"{len(other)} urdf_extras element{'s' * (len(other) != 1)} that "
@@ -130,13 +140,12 @@ def _to_link(out: Carried, ref: str, elem, robot: Robot, frames: set[str]) -> No
         out.collision.setdefault(ref, []).append(_leaf(COLLISION[elem.tag], value))
     elif elem.tag == "material" and len(elem) == 0:
         out.materials[ref] = value
-    elif elem.tag in LINK_TAGS:
-        tag = LINK_TAGS[elem.tag]
+    elif elem.tag in LINK_TAGS or elem.tag in ("turnGravityOff", "dampingFactor"):
         if ref in frames:
             out.losses.append(f'<gazebo reference="{ref}">: <{elem.tag}> not in model.sdf: '
                               f"'{ref}' is a frame there (massless, fixed), carried by '{host_of(robot, ref)[0]}'")
         else:
-            out.links.setdefault(ref, []).append(_leaf(tag, value))
+            out.links.setdefault(ref, []).append(_link_tag(elem.tag, value))
     else:
         elem = _rebodied(elem, robot, frames)
         host = ref
@@ -145,6 +154,26 @@ def _to_link(out: Carried, ref: str, elem, robot: Robot, frames: set[str]) -> No
             if elem.tag == "sensor":
                 _pose_relative_to(elem, ref)
         out.links.setdefault(host, []).append(_text(elem))
+
+
+def _to_joint(out: Carried, ref: str, elem, robot: Robot, frames: set[str], physics) -> None:
+    """One element of a <gazebo reference="joint"> block into the SDF joint (``physics``: its
+    <physics> element, filled here)."""
+    import xml.etree.ElementTree as ET
+
+    child = next(j.child for j in robot.joints if j.name == ref)
+    unwritten = child in frames or child == robot.anchor()
+    if unwritten or elem.tag in JOINT_LOST:
+        why = (f"the joint is not there (it fixes a frame to '{child}' or '{child}' to a link)" if unwritten else
+               "model.sdf writes the recipe's joint dynamics")
+        out.losses.append(f'<gazebo reference="{ref}">: <{elem.tag}> not in model.sdf: {why}')
+    elif elem.tag in JOINT_PHYSICS:
+        node = physics
+        for tag in JOINT_PHYSICS[elem.tag]:
+            node = node.find(tag) if node.find(tag) is not None else ET.SubElement(node, tag)
+        node.text = (elem.text or "").strip()
+    else:
+        out.joints.setdefault(ref, []).append(_text(_rebodied(elem, robot, frames)))
 
 
 def _pose_relative_to(sensor, frame: str) -> None:
@@ -181,6 +210,20 @@ def _rebodied(elem, robot: Robot, frames: set[str]):
             for tag, v in (("xyzOffset", pose.xyz), ("rpyOffset", pose.rpy)):
                 ET.SubElement(plugin, tag).text = vec(v)
     return elem
+
+
+def _link_tag(tag: str, value: str) -> str:
+    """A URDF link tag as its SDF link element (libsdformat's translation)."""
+    import xml.etree.ElementTree as ET
+
+    if tag == "turnGravityOff":
+        return _leaf("gravity", "false" if value.lower() in ("true", "1") else "true")
+    if tag == "dampingFactor":
+        decay = ET.Element("velocity_decay")
+        ET.SubElement(decay, "linear").text = value
+        ET.SubElement(decay, "angular").text = value
+        return _text(decay)
+    return _leaf(LINK_TAGS[tag], value)
 
 
 def _leaf(tag: str, value: str) -> str:

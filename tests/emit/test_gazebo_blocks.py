@@ -37,12 +37,17 @@ joints:
     origin: {xyz: [0, 0.1, 0]}
     axis: [0, 1, 0]
 urdf_extras:
-  - <gazebo reference="imu_link"><sensor name="imu" type="imu"><always_on>true</always_on></sensor></gazebo>
+  - >-
+    <gazebo reference="imu_link"><sensor name="imu" type="imu"><always_on>true</always_on></sensor>
+    <gravity>false</gravity></gazebo>
   - >-
     <gazebo reference="wheel"><mu1>0.8</mu1><mu2>0.7</mu2><fdir1>1 0 0</fdir1><maxVel>0.1</maxVel>
-    <maxContacts>4</maxContacts><material>Gazebo/Black</material>
+    <maxContacts>4</maxContacts><material>Gazebo/Black</material><turnGravityOff>true</turnGravityOff>
+    <dampingFactor>0.01</dampingFactor>
     <sensor name="wheel_imu" type="imu"><pose>0 0 0.01 0 0 0</pose></sensor></gazebo>
-  - <gazebo reference="wheel_joint"><provideFeedback>true</provideFeedback></gazebo>
+  - >-
+    <gazebo reference="wheel_joint"><provideFeedback>true</provideFeedback><stopErp>0.2</stopErp>
+    <springStiffness>5</springStiffness></gazebo>
   - >-
     <gazebo><plugin filename="p.so" name="imu_plugin"><bodyName>imu_link</bodyName></plugin>
     <static>false</static></gazebo>
@@ -83,8 +88,11 @@ def test_gazebo_blocks_go_where_libsdformat_puts_them(blocks, tmp_path):
     assert collision.findtext("max_contacts") == "4"
     assert link["wheel"].findtext("visual/material/script/name") == "Gazebo/Black"
     assert link["base"].find("visual/material") is None
+    assert link["wheel"].findtext("gravity") == "false" and link["base"].find("gravity") is None
+    assert [(e.tag, e.text) for e in link["wheel"].find("velocity_decay")] == [("linear", "0.01"), ("angular", "0.01")]
     # a joint's tags into the joint; the model's into the model, a plugin's body moved to the carrier
-    assert model.findtext("joint[@name='wheel_joint']/provideFeedback") == "true"
+    physics = model.find("joint[@name='wheel_joint']/physics")
+    assert (physics.findtext("provide_feedback"), physics.findtext("ode/limit/erp")) == ("true", "0.2")
     assert model.findtext("static") == "false"
     plugin = model.find("plugin[@name='imu_plugin']")
     assert [(e.tag, e.text) for e in plugin] == [("bodyName", "base"), ("xyzOffset", "0.1 0 0.05"),
@@ -96,6 +104,10 @@ def test_only_what_cannot_be_carried_is_a_loss(blocks):
     from robotkit.emit.sdf import losses
 
     assert [x for x in losses(blocks) if "gazebo" in x or "urdf_extras" in x] == [
+        "<gazebo reference=\"imu_link\">: <gravity> not in model.sdf: 'imu_link' is a frame there (massless, "
+        "fixed), carried by 'base'",
+        "<gazebo reference=\"wheel_joint\">: <springStiffness> not in model.sdf: model.sdf writes the recipe's "
+        "joint dynamics",
         "<gazebo reference=\"nowhere\">: <sensor> not in model.sdf: 'nowhere' names no link or joint of the robot",
         "1 urdf_extras element that is not a <gazebo> block is in the URDF only, not in model.sdf: "
         "<transmission name=\"t\">",
