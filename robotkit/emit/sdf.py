@@ -188,7 +188,6 @@ def context(robot: Robot) -> dict:
             # URDF emitter's explicit massless inertial, else Gazebo and Drake give it 1 kg
             "inertial": link.inertial if link.inertial is not None else Inertial(MASSLESS, (0.0, 0.0, 0.0),
                                                                                    (0.0,) * 6),
-            "contact": link.contact,
         })
     joints = [{"j": j, "name": names[j.name], "type": JOINT_TYPES.get(j.type), "extras": gz.joints.get(j.name, [])}
               for j in robot.joints if j.child not in frames and j.type in JOINT_TYPES and j.child != anchor]
