@@ -7,7 +7,9 @@ link without an inertial weighs 1 kg in Gazebo and Drake): a massless link fixed
 a frame attached to it and its geometry and sensors move into the link that carries it; a
 massless root with a fixed child is a frame on that child.  A massless link that must stay a
 link (welded to the world, or moved by a joint) gets the URDF's explicit massless inertial.  Joints named like a link are
-renamed (:func:`joint_names`).  What SDF 1.9 cannot express is listed by :func:`losses`.
+renamed (:func:`joint_names`).  The recipe's verbatim ``<gazebo>`` blocks (``urdf_extras``) are
+carried as libsdformat's URDF conversion carries them (:func:`robotkit.emit.gazebo.carry`).
+What SDF 1.9 cannot express is listed by :func:`losses`.
 """
 
 from __future__ import annotations
@@ -15,7 +17,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 from robotkit.emit import layout
-from robotkit.emit.env import render
+from robotkit.emit.env import fmt, render
+from robotkit.emit.gazebo import carry
 from robotkit.emit.formats import Format
 from robotkit.emit.meshfiles import collision_file
 from robotkit.emit.urdf import MASSLESS, geom_context
@@ -52,7 +55,7 @@ def losses(robot: Robot) -> list[str]:
                        f"it moves independently of '{j.mimic.joint}' in Gazebo")
     out += armature_losses(robot, "SDF")
     out += self_collide(robot)[2]
-    out += extras_losses(robot, "model.sdf")
+    out += carry(robot).losses
     out += gravcomp_losses(robot, "model.sdf's joint controllers (Gazebo Sim)")
     return out + sensor_losses(robot)["sdf"]
 
@@ -151,6 +154,7 @@ def context(robot: Robot) -> dict:
         host, pose = host_of(robot, name)
         carried.setdefault(host, []).append((robot.link(name), pose))
     collide, masks, _ = self_collide(robot)
+    gz = carry(robot, markup=True)
     links = []
     for link in robot.links:
         if link.name in frames or link.name == "world":
@@ -164,7 +168,8 @@ def context(robot: Robot) -> dict:
                 ctx_pose = (names[j.name], None)
             else:  # no SDF joint: a free body placed at the joint's pose
                 ctx_pose = ("__model__" if j.parent == "world" else j.parent, j.origin)
-        visuals = list(link.visuals) + [_moved(g, pose) for f, pose in carried.get(link.name, []) for g in f.visuals]
+        visuals = [(g, link.name) for g in link.visuals] + [
+            (_moved(g, pose), f.name) for f, pose in carried.get(link.name, []) for g in f.visuals]
         collisions = [(g, link.name) for g in link.collisions_for("sdf")] + [
             (_moved(g, pose), f.name) for f, pose in carried.get(link.name, []) for g in f.collisions_for("sdf")]
         links.append({
@@ -172,23 +177,53 @@ def context(robot: Robot) -> dict:
             "pose": ctx_pose,
             "sensors": [s for s in sensors if s["host"] == link.name],
             "visuals": [dict(geom_context(robot, g), uri=_uri(robot, g),
-                             material=materials.get(g.material)) for g in visuals],
+                             material=_material(materials.get(g.material), gz.materials.get(owner)))
+                        for g, owner in visuals],
             "collisions": [dict(geom_context(robot, g, "collision"), uri=_uri(robot, g, "collision"),
-                                bitmask=masks.get(owner)) for g, owner in collisions],
+                                surface=_surface(robot.link(owner).contact, gz.surfaces.get(owner, {}),
+                                                 masks.get(owner)),
+                                extras=gz.collision.get(owner, [])) for g, owner in collisions],
+            "extras": gz.links.get(link.name, []),
             # a massless link SDF must keep a link (welded to the world, or moved by a joint): the
             # URDF emitter's explicit massless inertial, else Gazebo and Drake give it 1 kg
             "inertial": link.inertial if link.inertial is not None else Inertial(MASSLESS, (0.0, 0.0, 0.0),
                                                                                    (0.0,) * 6),
-            "contact": link.contact,
         })
-    joints = [{"j": j, "name": names[j.name], "type": JOINT_TYPES.get(j.type)} for j in robot.joints
-              if j.child not in frames and j.type in JOINT_TYPES and j.child != anchor]
+    joints = [{"j": j, "name": names[j.name], "type": JOINT_TYPES.get(j.type), "extras": gz.joints.get(j.name, [])}
+              for j in robot.joints if j.child not in frames and j.type in JOINT_TYPES and j.child != anchor]
     frame_list = [{"name": j.child, "attached_to": j.parent, "origin": j.origin}
                   for j in robot.joints if j.child in frames]
     if anchor is not None:
         frame_list.insert(0, {"name": robot.root, "attached_to": anchor, "origin": None})
     return {"robot": robot, "self_collide": collide, "version": SDF_VERSION, "links": links, "joints": joints, "frames": frame_list,
-            "specular": SPECULAR, "controllers": controller_contexts(robot, names)}
+            "specular": SPECULAR, "controllers": controller_contexts(robot, names), "extras": gz.model}
+
+
+def _material(material, script: str | None) -> dict | None:
+    """A visual's material: the recipe's, its Gazebo script replaced by a <gazebo> block's
+    <material> for the visual's link (libsdformat does the same; a script alone when the
+    recipe gives no colour)."""
+    if material is None and script is None:
+        return None
+    return {"rgba": material.rgba if material is not None else None,
+            "gazebo": script or (material.gazebo if material is not None else None)}
+
+
+def _surface(contact, carried: dict[str, str], bitmask: int | None) -> dict | None:
+    """A collision's <surface>: friction (SDF's ODE names) and contact values, the recipe's
+    ``contact`` then the <gazebo> blocks' (text as written, later ones win), and the collide
+    bit mask."""
+    own = {}
+    if contact is not None:
+        if contact.mu1 is not None:
+            own |= {"mu": fmt(contact.mu1), "mu2": fmt(contact.mu2)}
+        own |= {k: fmt(v) for k, v in (("kp", contact.kp), ("kd", contact.kd)) if v is not None}
+    values = own | carried
+    friction = [(k, values[k]) for k in ("mu", "mu2", "fdir1") if k in values]
+    ode = [(k, values[k]) for k in ("kp", "kd", "max_vel", "min_depth") if k in values]
+    if not friction and not ode and bitmask is None and contact is None:
+        return None
+    return {"friction": friction, "ode": ode, "bitmask": bitmask}
 
 
 CONTROLLER_SYSTEMS = {

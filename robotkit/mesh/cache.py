@@ -12,8 +12,10 @@ bytes, or :func:`mesh_digest` of a mesh).  Changing any of them is a miss.
 *shared* cache (:mod:`robotkit.mesh.remote`) and the local default folder is its
 read-through copy: a lookup tries the local copy, then the shared one (verified, then
 copied locally); a computed entry is stored locally and published to the shared copy
-unless ``ROBOTKIT_CACHE_READONLY`` is set.  Entries live in ``<root>/v1/<key[:2]>/``
-(the same names locally and remotely):
+unless ``ROBOTKIT_CACHE_READONLY`` is set, and so is an entry found in the local copy that
+the shared one lacks (made before the team shared its cache: checked once per key and
+process, by one existence check, never by listing the shared copy).  Entries live in
+``<root>/v1/<key[:2]>/`` (the same names locally and remotely):
 
 - ``<key>.<payload sha256[:16]>.bin``: the meshes, as little-endian float64
   vertices and int32/int64 faces back to back (exact: binary STL would round
@@ -125,6 +127,10 @@ def plain(value):
     raise TypeError(f"cannot put a {type(value).__name__} into a cache key or manifest")
 
 
+_SHARED: set = set()
+"""(shared cache URL, key) of the entries this process knows the shared copy holds."""
+
+
 class CacheCorrupt(Exception):
     """An entry failed verification (internal: the entry is removed and recomputed)."""
 
@@ -198,7 +204,30 @@ class Cache:
             self._remove(key)
             return self._get_remote(key) if self.remote is not None else None
         self.stats["hits"] += 1
+        if self.remote is not None and self.remote_writable:
+            self._share(key, path)
         return value
+
+    def _share(self, key: str, path: Path) -> None:
+        """Publish a local entry the shared copy lacks (one made before the team shared its
+        cache, or while the shared copy was unreachable).  One existence check per key and
+        process; a key found there, or published, is not checked again."""
+        name = self.entry_name(key, f"{key}.json")
+        if (self.remote.url, key) in _SHARED:
+            return
+        try:
+            if not self.remote.exists(name):
+                manifest_bytes = path.read_bytes()
+                payload_file = json.loads(manifest_bytes)["payload"]["file"]
+                payload = (self.folder(key) / payload_file).read_bytes()
+                if not self._publish(key, payload_file, payload, manifest_bytes):
+                    return
+        except RemoteError as exc:
+            self._remote_problem(exc)
+            return
+        except (OSError, ValueError, KeyError, TypeError):
+            return  # the local entry changed under us: it was just read and verified
+        _SHARED.add((self.remote.url, key))
 
     def _get_remote(self, key: str):
         """The shared copy's entry, verified and copied into the local folder; None on a miss,
@@ -233,6 +262,7 @@ class Cache:
         except OSError:
             pass
         self.stats["remote_hits"] += 1
+        _SHARED.add((self.remote.url, key))
         return value
 
     def _remote_problem(self, exc) -> None:
@@ -286,14 +316,18 @@ class Cache:
             self._publish(key, manifest["payload"]["file"], payload, manifest_bytes)
         return rebuilt
 
-    def _publish(self, key: str, payload_file: str, payload: bytes, manifest_bytes: bytes) -> None:
-        """Payload first, manifest last: a reader never finds a manifest without its payload."""
+    def _publish(self, key: str, payload_file: str, payload: bytes, manifest_bytes: bytes) -> bool:
+        """Payload first, manifest last: a reader never finds a manifest without its payload.
+        Whether the entry was published."""
         try:
             self.remote.put(self.entry_name(key, payload_file), payload)
             self.remote.put(self.entry_name(key, f"{key}.json"), manifest_bytes)
-            self.stats["published"] += 1
         except RemoteError as exc:
             self._remote_problem(exc)
+            return False
+        self.stats["published"] += 1
+        _SHARED.add((self.remote.url, key))
+        return True
 
     def clear(self) -> None:
         """Remove every entry of this cache format."""

@@ -75,6 +75,16 @@ class RemoteStore:
         except Exception as exc:  # network, permissions, backend errors
             raise RemoteError(f"cannot read {name} from {self.url}: {exc}") from exc
 
+    def exists(self, name: str) -> bool:
+        """Whether an object is stored under ``name`` (one HEAD or stat, no listing)."""
+        try:
+            self.fs.info(self._path(name))
+        except FileNotFoundError:
+            return False
+        except Exception as exc:  # network, permissions, backend errors
+            raise RemoteError(f"cannot read {name} from {self.url}: {exc}") from exc
+        return True
+
     def put(self, name: str, data: bytes) -> None:
         """Publish ``data`` under ``name`` so that readers see all of it or nothing."""
         path = self._path(name)

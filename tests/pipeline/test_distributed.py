@@ -90,14 +90,23 @@ def s3(tmp_path_factory):
     proc.wait(timeout=20)
 
 
-def _build(recipe: Path, out: Path, env: dict, *extra: str, forbid_compute: bool = False):
+def _build(recipe: Path, out: Path, env: dict, *extra: str, forbid_compute: bool = False,
+           tally: Path | None = None):
     """``robotkit build`` in its own process; with ``forbid_compute`` the hull and CoACD
-    functions raise, so the build can only succeed from the cache."""
+    functions raise, so the build can only succeed from the cache; with ``tally`` every cache
+    lookup appends its statistics (hits, misses = computations, ...) to that file, a JSON line each."""
     code = ["import sys"]
     if forbid_compute:
         code += ["import robotkit.mesh.hull as h, robotkit.mesh.decompose as d",
                  "def boom(*a, **k): raise AssertionError('computed instead of read from the cache')",
                  "h.convex_hull = boom; d.decompose = boom"]
+    if tally is not None:
+        code += ["import json, robotkit.mesh.cache as c",
+                 "lookup = c.Cache.get_or_compute",
+                 "def counted(self, *a, **k):",
+                 "    try: return lookup(self, *a, **k)",
+                 f"    finally: open({str(tally)!r}, 'a').write(json.dumps(self.stats) + '\\n')",
+                 "c.Cache.get_or_compute = counted"]
     code += ["from robotkit.cli import main", "sys.exit(main(sys.argv[1:]))"]
     return subprocess.run([sys.executable, "-c", "\n".join(code), "build", str(recipe), "--out", str(out),
                            "--no-report", "-j", "1", *extra], capture_output=True, text=True,
@@ -140,6 +149,12 @@ def test_shared_cache_on_s3(s3, tmp_path):
     assert local_b == sorted(p.rsplit("/", 1)[1] for p in objects)
     third = _build(recipe, tmp_path / "c", {"ROBOTKIT_CACHE": str(tmp_path / "local_b")}, forbid_compute=True)
     assert third.returncode == 0, third.stderr
+    # a warm local copy publishes its entries into a new, empty shared cache (one HEAD per key)
+    later = _build(recipe, tmp_path / "d", {"ROBOTKIT_CACHE": "s3://robotkit-cache/later",
+                                            "ROBOTKIT_CACHE_LOCAL": str(tmp_path / "local_b")}, forbid_compute=True)
+    assert later.returncode == 0, later.stderr
+    assert {p.split("/", 2)[2]: b for p, b in _objects(fs, "later").items()} == \
+        {p.split("/", 2)[2]: b for p, b in objects.items()}
 
 
 @pytest.mark.slow
@@ -194,6 +209,83 @@ def test_unreachable_shared_cache_costs_time_not_the_build(tmp_path):
     assert len(warnings) == 1
     assert warnings[0].startswith("robotkit: warning: shared cache: cannot read v1/")
     assert warnings[0].endswith("(building without it)")
+
+
+def _tally(path: Path) -> dict:
+    """The statistics of every cache lookup of a build, summed."""
+    total: dict = {}
+    for line in path.read_text().splitlines():
+        for k, v in json.loads(line).items():
+            total[k] = total.get(k, 0) + v
+    return total
+
+
+def _entries(root: Path) -> dict[str, bytes]:
+    """The entries' files below a cache folder (no locks), by name relative to it."""
+    return {p.relative_to(root).as_posix(): p.read_bytes() for p in sorted(root.rglob("*"))
+            if p.suffix in (".json", ".bin")}
+
+
+def test_local_entries_are_published_to_a_new_shared_cache(tmp_path, monkeypatch):
+    """Entries made before the team shared its cache are published on their first use, by one
+    existence check per key and process; a read-only shared cache is never written."""
+    from robotkit.mesh.cache import Cache
+
+    meshes = [trimesh.creation.icosphere(2), trimesh.creation.box((0.1, 0.2, 0.3))]
+    alone = Cache(tmp_path / "local", versions={"v": "1"})
+    keys = [alone.key("op", {}, m) for m in meshes]
+    for key, m in zip(keys, meshes):
+        alone.put(key, [m], op="op")
+    assert alone.stats["published"] == 0
+
+    monkeypatch.setenv("ROBOTKIT_CACHE_READONLY", "1")
+    readonly = Cache(f"file://{tmp_path}/ro", local=tmp_path / "local", versions={"v": "1"})
+    monkeypatch.delenv("ROBOTKIT_CACHE_READONLY")
+    assert readonly.get(keys[0]) is not None and not (tmp_path / "ro").exists()
+
+    team = Cache(f"file://{tmp_path}/shared", local=tmp_path / "local", versions={"v": "1"})
+    checks = []
+    exists = team.remote.exists
+    team.remote.exists = lambda name: checks.append(name) or exists(name)
+    for key, m in zip(keys, meshes):
+        got = team.get_or_compute("op", {}, m, lambda: pytest.fail("computed a local entry"))
+        assert got is not None
+        assert team.get(key) is not None  # again: known published, not checked again
+    assert team.stats["published"] == 2 and team.stats["misses"] == 0
+    assert checks == [Cache.entry_name(k, f"{k}.json") for k in keys]
+    assert _entries(tmp_path / "shared") == _entries(tmp_path / "local")
+
+    fresh = Cache(f"file://{tmp_path}/shared", local=tmp_path / "fresh", versions={"v": "1"})
+    for m in meshes:
+        fresh.get_or_compute("op", {}, m, lambda: pytest.fail("computed an entry of the shared cache"))
+    assert fresh.stats["remote_hits"] == 2 and fresh.stats["misses"] == 0
+
+
+@pytest.mark.slow
+def test_build_publishes_a_warm_local_cache(tmp_path):
+    """A build with a warm local copy into a new, empty shared cache (file://) leaves every
+    entry it used there; a fresh machine then rebuilds the same bytes computing nothing."""
+    recipe = write_recipe(tmp_path / "src", RECIPE, meshes=_meshes())
+    local = tmp_path / "local"
+    cold = _build(recipe, tmp_path / "a", {"ROBOTKIT_CACHE": str(local)}, tally=tmp_path / "cold.log")
+    assert cold.returncode == 0, cold.stderr
+    used = _entries(local)
+    assert sum(n.endswith(".json") for n in used) == 3 == _tally(tmp_path / "cold.log")["misses"]
+
+    shared = {"ROBOTKIT_CACHE": f"file://{tmp_path}/shared"}
+    warm = _build(recipe, tmp_path / "b", {**shared, "ROBOTKIT_CACHE_LOCAL": str(local)}, tally=tmp_path / "warm.log")
+    assert warm.returncode == 0, warm.stderr
+    assert "shared cache" not in warm.stderr
+    stats = _tally(tmp_path / "warm.log")
+    assert (stats["hits"], stats["misses"], stats["published"]) == (3, 0, 3)
+    assert _entries(tmp_path / "shared") == used
+
+    fresh = _build(recipe, tmp_path / "c", {**shared, "ROBOTKIT_CACHE_LOCAL": str(tmp_path / "fresh")},
+                   tally=tmp_path / "fresh.log")
+    assert fresh.returncode == 0, fresh.stderr
+    stats = _tally(tmp_path / "fresh.log")
+    assert (stats["remote_hits"], stats["misses"], stats["published"]) == (3, 0, 0)
+    assert tree_bytes(tmp_path / "a" / "cached_bot") == tree_bytes(tmp_path / "c" / "cached_bot")
 
 
 def test_two_writers_of_one_entry(tmp_path):
