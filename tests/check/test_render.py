@@ -215,10 +215,9 @@ def test_recipe_build_warnings_are_annotated_on_their_line(tmp_path):
         ("warning", "careless.yaml", "14", "links.payload.inertial: link 'payload': mass 2000 kg in 0.001 m^3 of "
          "visual geometry implies 2e+06 kg/m^3, outside 10..25000 (grams written as kilograms, or a mesh in "
          "millimetres declared as metres?)"),
-        ("warning", "careless.yaml", "6", "materials.blue: material 'blue' is used by no geometry"),
-        ("warning", "careless.yaml", "23", "actuators.wheel_joint: the velocity actuator of continuous joint "
-         "'wheel_joint' has no force range in MuJoCo (unbounded torque): the joint has no effort limit (give it "
-         "limit: {effort: ...})")]
+        ("warning", "careless.yaml", "6", "materials.blue: material 'blue': used by no geometry"),
+        ("warning", "careless.yaml", "23", "actuators.wheel_joint: joint 'wheel_joint': the velocity actuator has no "
+         "force range in MuJoCo (unbounded torque) without an effort limit (give the joint limit: {effort: ...})")]
     assert not (tmp_path / "build").exists()  # --temp-out
 
 
