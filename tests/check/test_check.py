@@ -4,6 +4,7 @@ clean one; real cases from the assets; exit codes; report formats that parse."""
 from __future__ import annotations
 
 import json
+import re
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -64,7 +65,8 @@ def test_plausible_arm_exits_0(tmp_path):
     (tmp_path / "arm.urdf").write_text(arm_urdf())
     proc = run_cli("check", tmp_path / "arm.urdf")
     assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert proc.stdout.endswith("arm.urdf: ok, no problems found\n")
+    assert proc.stdout.splitlines()[:3] == ["  ok  check_urdf", "  ok  lints (3 links and joints)", "  ok  consumers"]
+    assert re.search(r"arm\.urdf: 3 stages passed, 0 errors, 0 warnings \(\d+\.\d s\)\n\Z", proc.stdout), proc.stdout
 
 
 @pytest.mark.parametrize("case, arm, expected", [

@@ -134,9 +134,16 @@ def test_github_annotations_name_the_urdf_line(urdfs):
 @pytest.mark.slow
 def test_text_and_json_reflect_fail_on(urdfs):
     proc = run_cli("check", "warn.urdf", "--fail-on", "warning", cwd=urdfs)
-    assert proc.stdout.splitlines()[-1] == "warn.urdf: 0 errors, 1 warning (they fail the check: --fail-on warning)"
+    # each stage with its verdict (the lint's warning is the lints stage's), then the problem
+    assert proc.stdout.splitlines()[:4] == ["  ok         check_urdf", "  1 warning  lints (3 links and joints)",
+                                            "  ok         consumers", f"link 'arm' (warn.urdf:{link_line(urdfs / 'warn.urdf', 'arm')})"]
+    assert re.fullmatch(r"warn\.urdf: 2 stages passed, 0 errors, 1 warning \(they fail the check: --fail-on "
+                        r"warning\) \(\d+\.\d s\)", proc.stdout.splitlines()[-1])
     data = json.loads(run_cli("check", urdfs / "warn.urdf", "--format", "json", "--fail-on", "warning").stdout)
     assert (data["fail_on"], data["failed"], data["warnings"]) == ("warning", 1, 1)
+    assert data["stages"] == [{"stage": "check_urdf", "verdict": "ok", "subjects": 1},
+                              {"stage": "lints", "verdict": "1 warning", "subjects": 3},
+                              {"stage": "consumers", "verdict": "ok", "subjects": 1}]
 
 
 BAD_RECIPE = "robot: x\nlinks:\n  a:\n    visual: {box: {size: [0.1, 0.1]}}\n    inertial: {denisty: 3}\n"
@@ -255,4 +262,5 @@ def test_several_paths_one_missing(urdfs):
     proc = run_cli("check", "warn.urdf", "nothing.urdf", cwd=urdfs)
     assert proc.returncode == 2
     assert proc.stderr == "nothing.urdf: no such file or folder\n"
-    assert proc.stdout.splitlines()[-1] == "warn.urdf nothing.urdf: 0 errors, 1 warning"
+    assert re.fullmatch(r"warn\.urdf nothing\.urdf: 2 stages passed, 0 errors, 1 warning \(\d+\.\d s\)",
+                        proc.stdout.splitlines()[-1])

@@ -4,6 +4,8 @@ an SDF frame-graph reader)."""
 
 from __future__ import annotations
 
+import re
+
 import json
 import math
 import shutil
@@ -113,16 +115,24 @@ def test_equivalence_finds_a_moved_joint_axis(examples, tmp_path):
     assert diffs and "pose differs" in diffs[0]
 
 
+TIME = r" \(\d+\.\d s\)"  # the check's wall time
+
+
 @pytest.mark.consumers
 @pytest.mark.slow
 def test_check_command_on_a_build_folder(examples, tmp_path):
     proc = run_cli("check", examples / "turret_bot")
     assert proc.returncode == 0, proc.stdout + proc.stderr
     lines = proc.stdout.splitlines()
-    assert lines[-1] == f"{examples / 'turret_bot'}: ok, no problems found"
+    # each stage with its verdict, as test runners list them
+    assert lines[:9] == ["  ok  check_urdf", "  ok  ign sdf -k", "  ok  mujoco (2 files)",
+                         "  ok  lints (5 links and joints)", "  ok  equivalence", "  ok  consumers", "  ok  simulation",
+                         "  ok  self-collision", "  ok  motion"]
+    assert re.fullmatch(re.escape(f"{examples / 'turret_bot'}: 9 stages passed, 0 errors, 0 warnings") + TIME,
+                        lines[-1]), lines[-1]
     # the drives' step responses: a line per joint (its slowest simulator)
-    assert lines[0].startswith("motion of robot 'turret_bot' (implicitfast, dt 0.002 s; stage ")
-    assert lines[1].split() == ["joint", "pose", "sim", "rise", "overshoot", "final", "error"]
+    assert lines[9].startswith("motion of robot 'turret_bot' (implicitfast, dt 0.002 s; stage ")
+    assert lines[10].split() == ["joint", "pose", "sim", "rise", "overshoot", "final", "error"]
     assert [line.split()[:2] for line in lines[2:4]] == [["j1", "zero"], ["j2", "zero"]]
     robot = _copy(examples, tmp_path)
     sdf = robot / "model.sdf"
