@@ -144,10 +144,14 @@ def losses(robot: Robot) -> dict[str, list[str]]:
         if s.type in ("camera", "depth"):
             mjcf.append(Limit(f"sensor '{s.name}': a MuJoCo camera has no clip distances or image format; "
                               "fovy and resolution are written"))
-    for a in robot.actuators:
-        if a.i:  # with gravity compensated in the MJCF, the integral term has no sag to remove there
-            text = f"actuator '{a.joint}': MuJoCo servos have no integral term (i = {a.i:g} dropped)"
-            mjcf.append(Limit(text + "; the MJCF compensates gravity instead") if a.gravcomp else text)
+    for compensated in (False, True):  # with gravity compensated in the MJCF, i has no sag to remove there
+        drives = [a for a in robot.actuators if a.i and a.gravcomp == compensated]
+        if drives:
+            names = [a.joint for a in drives]
+            more = f" and {len(names) - 1} more ({', '.join(repr(n) for n in names[1:])})" if names[1:] else ""
+            gains = ", ".join(sorted({f"{a.i:g}" for a in drives}, key=float))
+            text = f"actuator '{names[0]}'{more}: MuJoCo servos have no integral term (i = {gains} dropped)"
+            mjcf.append(Limit(text + "; the MJCF compensates gravity instead") if compensated else text)
     return {"sdf": sdf, "mjcf": mjcf}
 
 
