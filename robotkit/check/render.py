@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import xml.etree.ElementTree as ET
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 from robotkit.check.findings import STAGES, Finding
 from robotkit.errors import display_path
@@ -44,7 +44,7 @@ def _text(findings: list[Finding], source: str, fail_on: str, cases: list[tuple[
     ran = stages(findings, cases)
     width = max((len(s.verdict) for s in ran), default=0)
     out = [f"  {s.verdict:<{width}}  {s.label}" + (f"  ({s.why})" if s.why else "") for s in ran]
-    for subject, items in _by_subject(findings).items():
+    for subject, items in _by_subject(_one_per_kind(findings)).items():
         where = ""
         if items[0].file:
             where = f" ({display_path(items[0].file)}" + (f":{items[0].line}" if items[0].line else "") + ")"
@@ -66,6 +66,20 @@ def _text(findings: list[Finding], source: str, fail_on: str, cases: list[tuple[
 
 def _count(n: int, what: str) -> str:
     return f"{n} {what}{'s' * (n != 1)}"
+
+
+def _one_per_kind(findings: list[Finding]) -> list[Finding]:
+    """The findings that say the same (severity, check, message, hint) of several subjects as
+    one, naming the count and the subjects (``link 'a' and 2 more ('b', 'c')``), where the first is."""
+    kinds: dict[tuple, list[Finding]] = {}
+    for f in findings:
+        kinds.setdefault((f.severity, f.check, f.message, f.hint), []).append(f)
+    out = []
+    for items in kinds.values():
+        subjects = list(dict.fromkeys(f.subject for f in items))
+        more = f" and {len(subjects) - 1} more ({', '.join(subjects[1:])})" if subjects[1:] else ""
+        out.append(replace(items[0], subject=subjects[0] + more))
+    return out
 
 
 def _by_subject(findings: list[Finding]) -> dict[str, list[Finding]]:

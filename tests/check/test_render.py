@@ -264,3 +264,30 @@ def test_several_paths_one_missing(urdfs):
     assert proc.stderr == "nothing.urdf: no such file or folder\n"
     assert re.fullmatch(r"warn\.urdf nothing\.urdf: 2 stages passed, 0 errors, 1 warning \(\d+\.\d s\)",
                         proc.stdout.splitlines()[-1])
+
+
+def test_text_lists_each_stage_then_the_problems_once_per_kind():
+    """A stage per line with its verdict; a finding said of several subjects is one, with the
+    count and the subjects; a validator whose program is missing is skipped, and says why."""
+    from robotkit.check.findings import Finding
+    from robotkit.check.render import render
+
+    findings = [Finding("warning", "com-offset", "link 'a'", "centre of mass outside", file="r.urdf", line=3),
+                Finding("warning", "com-offset", "link 'b'", "centre of mass outside", file="r.urdf", line=7),
+                Finding("error", "tree", "joint 'j'", "its joints form a cycle"),
+                Finding("warning", "ign sdf -k", "r.sdf", "ign is not installed", "apt install ignition-tools")]
+    cases = [("check_urdf", "r.urdf"), ("ign sdf -k", "r.sdf"), ("lints", "link 'a'"), ("lints", "link 'b'"),
+             ("lints", "joint 'j'"), ("consumer", "robot 'r'")]
+    assert render(findings, "text", "r.urdf", cases=cases, elapsed=1.23).splitlines() == [
+        "  ok                   check_urdf",
+        "  skipped              ign sdf -k  (ign is not installed)",
+        "  1 error, 2 warnings  lints (3 links and joints)",
+        "  ok                   consumers",
+        "link 'a' and 1 more (link 'b') (r.urdf:3)",
+        "  warning: centre of mass outside [com-offset]",
+        "joint 'j'",
+        "  error: its joints form a cycle [tree]",
+        "r.sdf",
+        "  warning: ign is not installed [ign sdf -k]",
+        "    hint: apt install ignition-tools",
+        "r.urdf: 2 stages passed, 1 error, 3 warnings (1.2 s)"]
