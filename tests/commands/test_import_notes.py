@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import shutil
 
-from conftest import run_cli
-from tests.importer.test_import import ASSETS
+from conftest import ASSETS, run_cli
 
 
 def test_package_metadata_is_a_note(tmp_path):
