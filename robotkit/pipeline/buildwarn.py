@@ -81,7 +81,7 @@ def collapse(pairs: list[tuple[str, str]], form: re.Pattern) -> list[tuple[str, 
     for text, line in pairs:
         m = form.match(text)
         place = parse(line)[:3]
-        key = (m["head"], m.groupdict().get("kind"), m["tail"], place if form is ROBOTS else None) if m else (text,)
+        key = (m["head"], m.groupdict().get("kind"), m["tail"], place if form is ROBOTS else None) if m else (line,)
         groups.setdefault(key, []).append((text, line, m))
     out = []
     for items in groups.values():

@@ -120,13 +120,16 @@ def test_collapse_names_the_count_and_the_items():
               "noise is not written"),
              ("r: MJCF: joint 'x' and 1 more ('y'): slow", "f.yaml:6: joints.x: warning: r: MJCF: joint 'x' and 1 "
               "more ('y'): slow"),
-             ("r: MJCF: joint 'z': slow", "f.yaml:7: joints.z: warning: r: MJCF: joint 'z': slow")]
+             ("r: MJCF: joint 'z': slow", "f.yaml:7: joints.z: warning: r: MJCF: joint 'z': slow"),
+             ("mesh 'm.stl' is open", "f.yaml:8: links.a.visual.mesh: warning: mesh 'm.stl' is open"),
+             ("mesh 'm.stl' is open", "f.yaml:9: links.b.visual.mesh: warning: mesh 'm.stl' is open")]
     assert collapse(lines, SUBJECT) == [
         ("r: MJCF: sensor 'a' and 1 more ('b'): noise is not written",
          "f.yaml:3: sensors.a: warning: r: MJCF: sensor 'a' and 1 more ('b'): noise is not written"),
         ("r: SDF: joint 'j': mimic", "f.yaml:4: joints.j: warning: r: SDF: joint 'j': mimic"),
         ("r: MJCF: joint 'x' and 2 more ('y', 'z'): slow",
-         "f.yaml:6: joints.x: warning: r: MJCF: joint 'x' and 2 more ('y', 'z'): slow")]
+         "f.yaml:6: joints.x: warning: r: MJCF: joint 'x' and 2 more ('y', 'z'): slow"),
+        lines[5], lines[6]]  # no item named as the form wants: each where it is
     # the robots of a recipe's variants: one line when the place is the same, else apart
     twins = [("a_1: SDF: lost", "f.yaml:1: robot: warning: a_1: SDF: lost"),
              ("a_2: SDF: lost", "f.yaml:1: robot: warning: a_2: SDF: lost"),
