@@ -179,7 +179,8 @@ def test_exit_codes_and_formats(tmp_path):
     proc = run_cli("check", bad.name, cwd=tmp_path)
     assert proc.returncode == 1
     line = next(i for i, text in enumerate(bad.read_text().splitlines(), 1) if '<link name="arm">' in text)
-    assert proc.stdout.splitlines()[:2] == [
+    assert proc.stdout.splitlines()[:5] == [
+        "  ok         check_urdf", "  1 error    lints (3 links and joints)", "  1 warning  consumers",
         f"link 'arm' (bad.urdf:{line})",
         "  error: principal moments 0.01, 0.01, 0.05 violate the triangle inequality (I1 + I2 >= I3): "
         "no real body has them [triangle-inequality]"]
