@@ -203,7 +203,9 @@ def _junit(findings: list[Finding], source: str, fail_on: str, ran: list[tuple[s
     for f in findings:
         cases.setdefault((f.check, f.subject), []).append(f)
     linted = {f.subject for f in findings if f.check not in STAGES}
-    passed = list(dict.fromkeys(c for c in ran if c not in cases and not (c[0] == "lints" and c[1] in linted)))
+    warned = any(f.check == "build" for f in findings)  # the build's warnings are placed on the recipe's keys
+    passed = list(dict.fromkeys(c for c in ran if c not in cases and not (c[0] == "lints" and c[1] in linted)
+                                and not (c[0] == "build" and warned)))
     failing = [any(x.fails(fail_on) for x in v) for v in cases.values()]
     total = len(cases) + len(passed)
     suite = ET.Element("testsuite", name=f"robotkit check {source}", tests=str(max(total, 1)),
