@@ -291,3 +291,15 @@ def test_text_lists_each_stage_then_the_problems_once_per_kind():
         "  warning: ign is not installed [ign sdf -k]",
         "    hint: apt install ignition-tools",
         "r.urdf: 2 stages passed, 1 error, 3 warnings (1.2 s)"]
+
+
+def test_junit_has_no_passing_build_case_beside_the_build_s_warnings():
+    from robotkit.check.findings import Finding
+    from robotkit.check.render import render
+
+    cases = [("build", "robot 'r'"), ("check_urdf", "r.urdf")]
+    warned = [Finding("warning", "build", "links.a", "r: MJCF: lost", file="r.yaml", line=3)]
+    for findings, expected in ((warned, [("robotkit.build", "links.a"), ("robotkit.check_urdf", "r.urdf")]),
+                               ([], [("robotkit.build", "robot 'r'"), ("robotkit.check_urdf", "r.urdf")])):
+        suite = ET.fromstring(render(findings, "junit", "r.yaml", cases=cases)).find("testsuite")
+        assert [(c.get("classname"), c.get("name")) for c in suite] == expected
