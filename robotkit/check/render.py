@@ -5,23 +5,28 @@ from __future__ import annotations
 
 import json
 import xml.etree.ElementTree as ET
-from dataclasses import asdict
+from dataclasses import asdict, dataclass, replace
 
 from robotkit.check.findings import STAGES, Finding
 from robotkit.errors import display_path
 
 
 def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error",
-           cases: list[tuple[str, str]] | None = None, motion: dict | None = None) -> str:
+           cases: list[tuple[str, str]] | None = None, motion: dict | None = None,
+           elapsed: float | None = None) -> str:
     """``fail_on`` (``--fail-on``): the lowest severity that fails the check; every format says
     which findings fail it (JUnit failures, GitHub ``::error``, JSON ``failed``, the text's last line).
     ``cases``: every (check, subject) that ran (:func:`robotkit.commands.check.cases`): JUnit lists the
-    ones without findings as passing test cases.  ``motion``: the motion stage's results by robot
-    (JSON: under ``motion``; text: one line per joint)."""
+    ones without findings as passing test cases, the text and JSON each stage with its verdict.
+    ``motion``: the motion stage's results by robot (JSON: under ``motion``; text: one line per
+    joint).  ``elapsed``: the check's wall time in seconds (the text's last line)."""
     if fmt == "json":
         out = {"source": source, "errors": sum(f.severity == "error" for f in findings),
                "warnings": sum(f.severity == "warning" for f in findings), "fail_on": fail_on,
-               "failed": sum(f.fails(fail_on) for f in findings), "findings": [asdict(f) for f in findings]}
+               "failed": sum(f.fails(fail_on) for f in findings),
+               "stages": [{"stage": s.name, "verdict": s.verdict, "subjects": s.subjects}
+                          for s in stages(findings, cases or [])],
+               "findings": [asdict(f) for f in findings]}
         if motion:
             out["motion"] = motion
         return json.dumps(out, indent=1) + "\n"
@@ -29,14 +34,17 @@ def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error
         return _junit(findings, source, fail_on, cases or [])
     if fmt == "github":
         return "".join(annotation(f, fail_on) + "\n" for f in findings)
-    table = motion_table(motion or {})
-    if not findings:
-        return "".join(line + "\n" for line in table) + f"{source}: ok, no problems found\n"
-    groups: dict[str, list[Finding]] = {}
-    for f in findings:
-        groups.setdefault(f.subject, []).append(f)
-    out = []
-    for subject, items in groups.items():
+    return _text(findings, source, fail_on, cases or [], motion or {}, elapsed)
+
+
+def _text(findings: list[Finding], source: str, fail_on: str, cases: list[tuple[str, str]], motion: dict,
+          elapsed: float | None) -> str:
+    """Each stage with its verdict (as test runners list them), the problems by subject, the
+    motion table, then one line: the stages passed, the counts, the time."""
+    ran = stages(findings, cases)
+    width = max((len(s.verdict) for s in ran), default=0)
+    out = [f"  {s.verdict:<{width}}  {s.label}" + (f"  ({s.why})" if s.why else "") for s in ran]
+    for subject, items in _by_subject(_one_per_kind(findings)).items():
         where = ""
         if items[0].file:
             where = f" ({display_path(items[0].file)}" + (f":{items[0].line}" if items[0].line else "") + ")"
@@ -48,9 +56,88 @@ def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error
     errors = sum(f.severity == "error" for f in findings)
     warnings = len(findings) - errors
     tail = " (they fail the check: --fail-on warning)" if fail_on == "warning" and warnings else ""
-    out += table
-    out.append(f"{source}: {errors} error{'s' * (errors != 1)}, {warnings} warning{'s' * (warnings != 1)}{tail}")
+    passed = sum(s.verdict == "ok" for s in ran)
+    took = f" ({elapsed:.1f} s)" if elapsed is not None else ""
+    out += motion_table(motion)
+    out.append(f"{source}: {passed} stage{'s' * (passed != 1)} passed, {_count(errors, 'error')}, "
+               f"{_count(warnings, 'warning')}{tail}{took}")
     return "\n".join(out) + "\n"
+
+
+def _count(n: int, what: str) -> str:
+    return f"{n} {what}{'s' * (n != 1)}"
+
+
+def _one_per_kind(findings: list[Finding]) -> list[Finding]:
+    """The findings that say the same (severity, check, message, hint) of several subjects as
+    one, naming the count and the subjects (``link 'a' and 2 more ('b', 'c')``), where the first is."""
+    kinds: dict[tuple, list[Finding]] = {}
+    for f in findings:
+        kinds.setdefault((f.severity, f.check, f.message, f.hint), []).append(f)
+    out = []
+    for items in kinds.values():
+        subjects = list(dict.fromkeys(f.subject for f in items))
+        more = f" and {len(subjects) - 1} more ({', '.join(subjects[1:])})" if subjects[1:] else ""
+        out.append(replace(items[0], subject=subjects[0] + more))
+    return out
+
+
+def _by_subject(findings: list[Finding]) -> dict[str, list[Finding]]:
+    groups: dict[str, list[Finding]] = {}
+    for f in findings:
+        groups.setdefault(f.subject, []).append(f)
+    return groups
+
+
+ORDER = ("build", "check_urdf", "ign sdf -k", "mujoco", "lints", "equivalence", "consumers", "simulation",
+         "self-collision", "motion")
+"""The stages in the order a check runs them (``lints``: every physics lint, :mod:`robotkit.check.lints`)."""
+
+
+@dataclass(frozen=True)
+class Stage:
+    name: str
+    subjects: int  # the files or subjects it ran on
+    verdict: str  # ok | skipped | 1 error | 2 warnings | 1 error, 2 warnings
+    why: str = ""  # why it was skipped
+
+    @property
+    def label(self) -> str:
+        if self.name == "lints" and self.subjects:
+            return f"lints ({self.subjects} links and joints)"
+        if self.name in ("check_urdf", "ign sdf -k", "mujoco") and self.subjects > 1:
+            return f"{self.name} ({self.subjects} files)"
+        return self.name
+
+
+def stages(findings: list[Finding], cases: list[tuple[str, str]]) -> list[Stage]:
+    """Each stage that ran (a case of ``cases``, or a finding of its) with its verdict: ``ok``,
+    the count of its findings, or ``skipped`` when all it says is that its program is not installed."""
+    subjects: dict[str, set[str]] = {}
+    found: dict[str, list[Finding]] = {}
+    for check, subject in cases:
+        subjects.setdefault(_stage_of(check), set()).add(subject)
+    for f in findings:
+        if f.check != "input":
+            found.setdefault(_stage_of(f.check), []).append(f)
+    out = []
+    for name in sorted(subjects.keys() | found.keys(), key=lambda s: (ORDER + (s,)).index(s)):
+        items = found.get(name, [])
+        errors = sum(f.severity == "error" for f in items)
+        verdict = ", ".join(([_count(errors, "error")] if errors else [])
+                            + ([_count(len(items) - errors, "warning")] if len(items) > errors else [])) or "ok"
+        # a validator whose program is missing did not run; a consumer missing is one of several
+        missing = name != "consumers" and items and all("not installed" in f.message for f in items)
+        out.append(Stage(name, len(subjects.get(name, ())), "skipped" if missing else verdict,
+                         "; ".join(dict.fromkeys(f.message for f in items)) if missing else ""))
+    return out
+
+
+def _stage_of(check: str) -> str:
+    """The stage a case or finding belongs to (``consumer``: the consumers stage; a lint: ``lints``)."""
+    if check in ("consumer", "consumers"):
+        return "consumers"
+    return check if check in STAGES else "lints"
 
 
 def motion_table(motion: dict) -> list[str]:
@@ -116,7 +203,9 @@ def _junit(findings: list[Finding], source: str, fail_on: str, ran: list[tuple[s
     for f in findings:
         cases.setdefault((f.check, f.subject), []).append(f)
     linted = {f.subject for f in findings if f.check not in STAGES}
-    passed = list(dict.fromkeys(c for c in ran if c not in cases and not (c[0] == "lints" and c[1] in linted)))
+    warned = any(f.check == "build" for f in findings)  # the build's warnings are placed on the recipe's keys
+    passed = list(dict.fromkeys(c for c in ran if c not in cases and not (c[0] == "lints" and c[1] in linted)
+                                and not (c[0] == "build" and warned)))
     failing = [any(x.fails(fail_on) for x in v) for v in cases.values()]
     total = len(cases) + len(passed)
     suite = ET.Element("testsuite", name=f"robotkit check {source}", tests=str(max(total, 1)),

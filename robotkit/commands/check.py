@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -41,6 +42,7 @@ def _check_paths(args, packages: dict[str, str]) -> int:
     """Every PATH in turn; bad input (exit 2) is reported in the chosen format too, so a CI
     report never comes out empty, and its lines go to stderr as always."""
     findings, status, ran, motion = [], 0, [], {}
+    start = time.perf_counter()
     for path in args.paths:
         try:  # a recipe is built as `robotkit build` builds it; its picture report for GitHub's summary,
             # or kept when an earlier build wrote one (None), never drawn anew only for a check
@@ -53,18 +55,19 @@ def _check_paths(args, packages: dict[str, str]) -> int:
                 print(line, file=sys.stderr)
             findings += input_findings(exc.problems, path)
             status = max(status, exc.exit_status)
-    _write_findings(args, findings, status, ran, motion)
+    ran += [("motion", f"robot '{name}'") for name in motion]  # the robots whose drives were stepped
+    _write_findings(args, findings, status, ran, motion, time.perf_counter() - start)
     return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)
 
 
 def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[str, str]],
-                    motion: dict | None = None) -> None:
+                    motion: dict | None = None, elapsed: float | None = None) -> None:
     source = " ".join(args.paths)
     if args.format != "text" or not status:
-        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran, motion=motion))
+        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran, motion=motion, elapsed=elapsed))
     elif any(f.check != "input" for f in findings):  # the paths that could be checked
-        sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on,
-                                motion=motion))
+        sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on, ran,
+                                motion=motion, elapsed=elapsed))
     if args.junit:
         Path(args.junit).parent.mkdir(parents=True, exist_ok=True)
         Path(args.junit).write_text(render(findings, "junit", source, args.fail_on, ran), encoding="utf-8")
@@ -152,9 +155,10 @@ def cases(path: str, out_dir: str = "build", args: dict[str, str] | None = None,
     p = what.path
     if what.kind == "build":
         return [c for d in what.robots for c in _folder_cases(d)]
-    if what.kind == "recipe":
+    if what.kind == "recipe":  # the build, then its folder
         return [c for loaded in load_recipes(p, args, variant)
-                for c in _folder_cases(robot_layout(Path(out_dir) / loaded.recipe.robot))]
+                for c in [("build", f"robot '{loaded.recipe.robot}'")]
+                + _folder_cases(robot_layout(Path(out_dir) / loaded.recipe.robot))]
     if what.kind == "urdf":
         return [("check_urdf", str(p)), ("consumer", f"robot '{p.stem}'")] + _described(p)
     if what.kind == "xacro":
@@ -172,7 +176,8 @@ def _described(file: Path) -> list[tuple[str, str]]:
 def _folder_cases(d: RobotLayout) -> list[tuple[str, str]]:
     robot = f"robot '{d.name}'"
     files = [("check_urdf", d.urdf), ("ign sdf -k", d.sdf), ("mujoco", d.mjcf), ("mujoco", d.scene)]
-    return ([(c, str(f)) for c, f in files] + [(c, robot) for c in ("equivalence", "consumer", "simulation")]
+    return ([(c, str(f)) for c, f in files]
+            + [(c, robot) for c in ("equivalence", "consumer", "simulation", "self-collision")]
             + _described(d.urdf))
 
 

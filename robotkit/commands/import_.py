@@ -9,6 +9,9 @@ import sys
 
 from robotkit.importer import import_file
 
+NOTES = ("metadata from ",)
+"""What the import says that is information, not a warning (the importer lists it among its warnings)."""
+
 
 def run(args) -> int:
     if args.density is not None and not args.recompute_inertials:
@@ -18,8 +21,8 @@ def run(args) -> int:
     result = import_file(args.file, args.output, packages, dict(args.arg),
                          recompute_inertials=args.recompute_inertials, copy_meshes=args.copy_meshes,
                          density=args.density, inertia_policy=args.inertia_policy)
-    for w in result.warnings:
-        print(f"warning: {w}", file=sys.stderr)
+    for w in result.warnings:  # where the metadata came from is information, not a warning
+        print(f"{'note' if w.startswith(NOTES) else 'warning'}: {w}", file=sys.stderr)
     recipe = os.path.relpath(result.recipe_path)
     if result.copied:
         meshes = os.path.join(os.path.dirname(recipe), "meshes", "")

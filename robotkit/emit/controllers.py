@@ -11,7 +11,7 @@ from __future__ import annotations
 import yaml
 
 from robotkit.emit import layout
-from robotkit.emit.formats import Format
+from robotkit.emit.formats import Format, Limit
 from robotkit.model.robot import Robot
 
 ROS2_GROUP = {"position": "position_controllers/JointGroupPositionController",
@@ -85,13 +85,14 @@ def armature_losses(robot: Robot, fmt: str) -> list[str]:
     joints = [j.name for j in robot.joints if j.dynamics is not None and j.dynamics.armature]
     if not joints:
         return []
-    return [f"{joints_phrase(joints)}: armature is not written ({fmt} has no such joint property; the MJCF "
-            "carries it)"]
+    return [Limit(f"{joints_phrase(joints)}: armature is not written ({fmt} has no such joint property; the MJCF "
+                  "carries it)")]
 
 
 def gravcomp_losses(robot: Robot, where: str) -> list[str]:
-    """The drives the MJCF compensates for gravity, which ``where`` cannot."""
-    joints = [a.joint for a in robot.actuators if a.gravcomp and a.interface == "position"]
+    """The drives the MJCF compensates for gravity, which ``where`` cannot (an integral gain holds
+    the pose there: a drive with one does not sag)."""
+    joints = [a.joint for a in robot.actuators if a.gravcomp and a.interface == "position" and not a.i]
     if not joints:
         return []
     return [f"{joints_phrase(joints)}: the MJCF compensates gravity (gravcomp); {where} cannot, so they sag "

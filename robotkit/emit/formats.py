@@ -24,6 +24,14 @@ READS = {
 """What part of the robot an output depends on: what its task hashes and which records it waits for."""
 
 
+class Limit(str):
+    """A loss that is the format's nature, not the recipe's doing (MJCF has no velocity limit,
+    URDF no armature): ``report.json`` lists it once per build under ``limits``, never as a
+    warning, since no recipe could avoid it.  Every other loss is a warning."""
+
+    __slots__ = ()
+
+
 @dataclass(frozen=True)
 class Format:
     """One output file of a robot's build folder."""

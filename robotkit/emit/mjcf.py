@@ -18,7 +18,7 @@ from robotkit.emit import layout
 from robotkit.emit.controllers import joints_phrase
 from robotkit.emit.env import render
 from robotkit.geometry import rpy_quat
-from robotkit.emit.formats import Format
+from robotkit.emit.formats import Format, Limit
 from robotkit.emit.meshfiles import collision_file, conversions, visual_file
 from robotkit.emit.sdf import extras_losses
 from robotkit.emit.sensors import losses as sensor_losses
@@ -39,27 +39,29 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     for rel, (src, _) in conversions(robot).items():
         if not rel.startswith("mjcf/"):
             continue
-        out.append(f"mesh '{os.path.basename(src)}': MuJoCo reads no {os.path.splitext(src)[1].upper()[1:]}; "
+        out.append(Limit(f"mesh '{os.path.basename(src)}': MuJoCo reads no {os.path.splitext(src)[1].upper()[1:]}; "
                    f"converted to {layout.MESHES}/{rel} (the file's own colours and textures are dropped, "
-                   "the recipe's material is used)")
+                   "the recipe's material is used)"))
     for j in robot.joints:
         if j.type == "planar":
-            out.append(f"joint '{j.name}': MJCF has no planar joint; written as slides "
-                       f"'{j.name}_x', '{j.name}_y' and hinge '{j.name}_rz'")
+            out.append(Limit(f"joint '{j.name}': MJCF has no planar joint; written as slides "
+                             f"'{j.name}_x', '{j.name}_y' and hinge '{j.name}_rz'"))
         if j.type == "floating" and j.parent != WORLD:
             out.append(f"joint '{j.name}': MuJoCo allows free joints only on bodies of the world; "
                        f"link '{j.child}' is welded to '{j.parent}'")
     fast = [j for j in robot.joints if j.limit is not None and j.limit.velocity is not None and j.type != "fixed"]
     if fast:
         speeds = ", ".join(sorted({f"{j.limit.velocity:g}" for j in fast}, key=float))
-        out.append(f"{joints_phrase([j.name for j in fast])}: MJCF has no velocity limit ({speeds} not enforced)")
+        out.append(Limit(f"{joints_phrase([j.name for j in fast])}: MJCF has no velocity limit ({speeds} not enforced)"))
     for link in robot.links:
         c = link.contact
         if c is not None and (c.kp is not None or c.kd is not None):
-            out.append(f"link '{link.name}': contact kp/kd are Gazebo (ODE) stiffness and damping; MuJoCo keeps "
-                       "its own contact softness (solref is per unit mass there: copied, they bounce the robot)")
+            out.append(Limit(f"link '{link.name}': contact kp/kd are Gazebo (ODE) stiffness and damping; MuJoCo "
+                             "keeps its own contact softness (solref is per unit mass there: copied, they bounce the "
+                             "robot)"))
         if c is not None and c.mu2 is not None and c.mu1 is not None and c.mu2 != c.mu1:
-            out.append(f"link '{link.name}': MuJoCo friction is isotropic; mu2 {c.mu2:g} dropped, mu1 {c.mu1:g} used")
+            out.append(Limit(f"link '{link.name}': MuJoCo friction is isotropic; mu2 {c.mu2:g} dropped, mu1 "
+                             f"{c.mu1:g} used"))
         for g in link.collisions_for("mjcf"):
             if g.shape.mesh is not None and facts is not None:
                 f = facts.get(g.shape.mesh.key)

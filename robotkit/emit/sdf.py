@@ -18,8 +18,8 @@ from dataclasses import replace
 
 from robotkit.emit import layout
 from robotkit.emit.env import fmt, render
+from robotkit.emit.formats import Format, Limit
 from robotkit.emit.gazebo import carry
-from robotkit.emit.formats import Format
 from robotkit.emit.meshfiles import collision_file
 from robotkit.emit.urdf import MASSLESS, geom_context
 from robotkit.emit.sensors import contexts, host_of
@@ -41,9 +41,9 @@ def losses(robot: Robot) -> list[str]:
         if names[j.name] != j.name:
             out.append(f"joint '{j.name}' is named '{names[j.name]}' in model.sdf: SDF needs link, joint "
                        "and frame names unique within a model")
-        if j.type == "floating" and j.parent == "world":
-            out.append(f"joint '{j.name}': SDF has no floating joint; link '{j.child}' is a free body "
-                       "placed at the joint's pose")
+        if j.type == "floating" and j.parent == "world":  # the same free body
+            out.append(Limit(f"joint '{j.name}': SDF has no floating joint; link '{j.child}' is a free body "
+                             "placed at the joint's pose"))
         elif j.type == "floating":
             out.append(f"joint '{j.name}': SDF has no floating joint; link '{j.child}' is a free body "
                        "placed at the joint's pose")

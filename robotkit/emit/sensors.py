@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from robotkit.geometry import matrix_rpy
+from robotkit.emit.formats import Limit
 from robotkit.model.robot import Pose, Robot, Sensor
 
 MJCF_MAX_RAYS = 64
@@ -129,23 +130,28 @@ def losses(robot: Robot) -> dict[str, list[str]]:
     sdf, mjcf = [], []
     for s in robot.sensors:
         if s.type == "sonar":
-            sdf.append(f"sensor '{s.name}': Gazebo Sim has no sonar; written as a 5 x 5 gpu_lidar cone")
-            mjcf.append(f"sensor '{s.name}': MuJoCo has no cone sensor; written as one rangefinder on the axis")
+            sdf.append(Limit(f"sensor '{s.name}': Gazebo Sim has no sonar; written as a 5 x 5 gpu_lidar cone"))
+            mjcf.append(Limit(f"sensor '{s.name}': MuJoCo has no cone sensor; written as one rangefinder on the axis"))
         if s.type == "lidar":
             n = s.params["samples"] * s.params["vertical_samples"]
             rays = len(mjcf_rays(s))
             if rays < n:
-                mjcf.append(f"sensor '{s.name}': {n} lidar rays written as {rays} MuJoCo rangefinders")
+                mjcf.append(Limit(f"sensor '{s.name}': {n} lidar rays written as {rays} MuJoCo rangefinders"))
             if s.params["noise"]:
-                mjcf.append(f"sensor '{s.name}': range noise is not written (MuJoCo sensors have none)")
+                mjcf.append(Limit(f"sensor '{s.name}': range noise is not written (MuJoCo sensors have none)"))
         if s.type == "imu" and (s.params["gyro_noise"] or s.params["accel_noise"]):
-            mjcf.append(f"sensor '{s.name}': IMU noise is not written (MuJoCo sensors have none)")
+            mjcf.append(Limit(f"sensor '{s.name}': IMU noise is not written (MuJoCo sensors have none)"))
         if s.type in ("camera", "depth"):
-            mjcf.append(f"sensor '{s.name}': a MuJoCo camera has no clip distances or image format; "
-                        "fovy and resolution are written")
-    for a in robot.actuators:
-        if a.i:
-            mjcf.append(f"actuator '{a.joint}': MuJoCo servos have no integral term (i = {a.i:g} dropped)")
+            mjcf.append(Limit(f"sensor '{s.name}': a MuJoCo camera has no clip distances or image format; "
+                              "fovy and resolution are written"))
+    for compensated in (False, True):  # with gravity compensated in the MJCF, i has no sag to remove there
+        drives = [a for a in robot.actuators if a.i and a.gravcomp == compensated]
+        if drives:
+            names = [a.joint for a in drives]
+            more = f" and {len(names) - 1} more ({', '.join(repr(n) for n in names[1:])})" if names[1:] else ""
+            gains = ", ".join(sorted({f"{a.i:g}" for a in drives}, key=float))
+            text = f"actuator '{names[0]}'{more}: MuJoCo servos have no integral term (i = {gains} dropped)"
+            mjcf.append(Limit(text + "; the MJCF compensates gravity instead") if compensated else text)
     return {"sdf": sdf, "mjcf": mjcf}
 
 

@@ -1,8 +1,10 @@
 """The build's summary (``report.json``): what each format could not express, what each program
 that loads the outputs will see, and the mesh facts.
 
-Nothing is lost silently: every loss is listed here per format and printed as a warning
-on every build.
+Nothing is lost silently: every loss is listed here per format.  The losses the recipe could
+avoid (``losses``) are printed as warnings on every build; those that are the format's nature
+(``limits``: MJCF has no velocity limit, URDF no armature; :class:`robotkit.emit.formats.Limit`)
+are listed here once per build and printed by no build.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ import json
 
 from robotkit.emit import layout, mjcf, moveit, ros, sdf
 from robotkit.emit.controllers import armature_losses, gravcomp_losses, joints_phrase
-from robotkit.emit.formats import Format
+from robotkit.emit.formats import Format, Limit
 from robotkit.emit.sensors import host_of
 from robotkit.emit.urdf import massless_mass, typed_transmissions
 from robotkit.model.robot import Robot
@@ -27,6 +29,7 @@ def urdf_losses(robot: Robot) -> list[str]:
 
 
 def losses(robot: Robot, facts: dict) -> dict[str, list[str]]:
+    """Every loss per format, the format's limits (:class:`Limit`) among them."""
     return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts),
             "package": ros.losses(robot) + gravcomp_losses(robot, "the ros_control controllers (controllers.yaml)")
             + matrix_losses(robot),
@@ -88,8 +91,12 @@ def summary(robot: Robot, facts: dict) -> dict:
             collision[key] = {"source": f["source"], "strategy": f["strategy"]["kind"], "pieces": f["pieces"],
                               "fidelity": f["fidelity"], "repair": f.get("repair")}
     meshes = {k: v for k, v in meshes.items() if k not in collision}
-    out = {"robot": robot.name, "losses": losses(robot, facts), "consumers": consumers(robot), "meshes": meshes,
-           "inertials": links, "collision": collision}
+    every = losses(robot, facts)
+    out = {"robot": robot.name, "losses": {fmt: [x for x in items if not isinstance(x, Limit)]
+                                           for fmt, items in every.items()},
+           "limits": {fmt: limits for fmt, items in every.items()
+                      if (limits := [str(x) for x in items if isinstance(x, Limit)])},
+           "consumers": consumers(robot), "meshes": meshes, "inertials": links, "collision": collision}
     if robot.drive_report:  # the tuner's gains, their reasons and checks (robotkit.model.gains)
         out["actuators"] = json.loads(robot.drive_report)
     if robot.poses:

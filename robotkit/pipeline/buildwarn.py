@@ -62,7 +62,50 @@ def build_warnings(robots, out: Path) -> list[tuple[str, str]]:
     seen: dict[str, str] = {}
     for text, line in pairs:
         seen.setdefault(line, text)
-    return [(text, line) for line, text in seen.items()]
+    return collapse(collapse([(text, line) for line, text in seen.items()], SUBJECT), ROBOTS)
+
+
+SUBJECT = re.compile(r"^(?P<head>(?:[^':]+: )*)(?P<kind>link|joint|sensor|mesh|actuator|material) '(?P<item>[^']+)'"
+                      r"(?: and \d+ more \((?P<more>[^)]*)\))?: (?P<tail>.+)$", re.S)
+"""``robot: FORMAT: kind 'name' [and N more (...)]: what``: one warning of a kind on one item."""
+ROBOTS = re.compile(r"^(?P<head>)(?P<item>[A-Za-z_][\w-]*(?:, [A-Za-z_][\w-]*)*): (?P<tail>.+)$", re.S)
+"""``robot: FORMAT: what``: one warning of a variant's robot (the same on every variant)."""
+
+
+def collapse(pairs: list[tuple[str, str]], form: re.Pattern) -> list[tuple[str, str]]:
+    """The warnings of one kind (the same text but for the item ``form`` finds: a link, joint,
+    sensor... with ``SUBJECT``; the robot with ``ROBOTS``) as one, naming the count and the
+    items, placed where the first was, in the first's place in the order.  With ``ROBOTS``
+    only warnings placed on the same line are one (the variants of one recipe line)."""
+    groups: dict[tuple, list[tuple[str, str, re.Match]]] = {}
+    for text, line in pairs:
+        m = form.match(text)
+        place = parse(line)[:3]
+        key = (m["head"], m.groupdict().get("kind"), m["tail"], place if form is ROBOTS else None) if m else (line,)
+        groups.setdefault(key, []).append((text, line, m))
+    out = []
+    for items in groups.values():
+        text, line, m = items[0]
+        if len(items) > 1:
+            text = _merged(m, [i for _, _, x in items for i in _named(x)])
+            file, number, key = parse(line)[:3]
+            line = warning_line(text, {"file": file, "line": number, "key": key} if file else None)
+        out.append((text, line))
+    return out
+
+
+def _named(m: re.Match) -> list[str]:
+    """The items one warning names (``joint 'a' and 2 more ('b', 'c')``: a, b, c)."""
+    more = m.groupdict().get("more")
+    return [m["item"]] + ([x.strip().strip("'") for x in more.split(", ")] if more else [])
+
+
+def _merged(m: re.Match, items: list[str]) -> str:
+    items = list(dict.fromkeys(i for x in items for i in x.split(", ")))
+    if m.groupdict().get("kind") is None:  # robots
+        return f"{', '.join(items)}: {m['tail']}"
+    rest = f" and {len(items) - 1} more ({', '.join(repr(i) for i in items[1:])})" if items[1:] else ""
+    return f"{m['head']}{m['kind']} '{items[0]}'{rest}: {m['tail']}"
 
 
 def _mesh_facts(state: Path, robot) -> dict[str, dict]:
@@ -194,13 +237,11 @@ def lints(loaded, robot, facts: dict[str, dict], where: dict) -> list[tuple[str,
     used = {g.material for link in robot.links for g in robot.all_geoms(link)}
     for material in robot.materials:
         if material.name not in used:
-            warn(f"material '{material.name}' is used by no geometry", _at(loaded, ("materials", material.name)))
+            warn(f"material '{material.name}': used by no geometry", _at(loaded, ("materials", material.name)))
     joints = {j.name: j for j in robot.joints}
     for a in robot.actuators:
         j = joints.get(a.joint)
         if a.interface in ("position", "velocity") and j is not None and not (j.limit and j.limit.effort):
-            warn(
-                f"the {a.interface} actuator of {j.type} joint '{j.name}' has no force range in MuJoCo (unbounded "
-                f"torque): the joint has no effort limit (give it limit: {{effort: ...}})",
-                _at(loaded, ("actuators", a.joint)))
+            warn(f"joint '{j.name}': the {a.interface} actuator has no force range in MuJoCo (unbounded torque) "
+                 "without an effort limit (give the joint limit: {effort: ...})", _at(loaded, ("actuators", a.joint)))
     return out

@@ -4,6 +4,7 @@ clean one; real cases from the assets; exit codes; report formats that parse."""
 from __future__ import annotations
 
 import json
+import re
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -64,7 +65,8 @@ def test_plausible_arm_exits_0(tmp_path):
     (tmp_path / "arm.urdf").write_text(arm_urdf())
     proc = run_cli("check", tmp_path / "arm.urdf")
     assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert proc.stdout.endswith("arm.urdf: ok, no problems found\n")
+    assert proc.stdout.splitlines()[:3] == ["  ok  check_urdf", "  ok  lints (3 links and joints)", "  ok  consumers"]
+    assert re.search(r"arm\.urdf: 3 stages passed, 0 errors, 0 warnings \(\d+\.\d s\)\n\Z", proc.stdout), proc.stdout
 
 
 @pytest.mark.parametrize("case, arm, expected", [
@@ -177,7 +179,8 @@ def test_exit_codes_and_formats(tmp_path):
     proc = run_cli("check", bad.name, cwd=tmp_path)
     assert proc.returncode == 1
     line = next(i for i, text in enumerate(bad.read_text().splitlines(), 1) if '<link name="arm">' in text)
-    assert proc.stdout.splitlines()[:2] == [
+    assert proc.stdout.splitlines()[:5] == [
+        "  ok         check_urdf", "  1 error    lints (3 links and joints)", "  1 warning  consumers",
         f"link 'arm' (bad.urdf:{line})",
         "  error: principal moments 0.01, 0.01, 0.05 violate the triangle inequality (I1 + I2 >= I3): "
         "no real body has them [triangle-inequality]"]

@@ -134,9 +134,16 @@ def test_github_annotations_name_the_urdf_line(urdfs):
 @pytest.mark.slow
 def test_text_and_json_reflect_fail_on(urdfs):
     proc = run_cli("check", "warn.urdf", "--fail-on", "warning", cwd=urdfs)
-    assert proc.stdout.splitlines()[-1] == "warn.urdf: 0 errors, 1 warning (they fail the check: --fail-on warning)"
+    # each stage with its verdict (the lint's warning is the lints stage's), then the problem
+    assert proc.stdout.splitlines()[:4] == ["  ok         check_urdf", "  1 warning  lints (3 links and joints)",
+                                            "  ok         consumers", f"link 'arm' (warn.urdf:{link_line(urdfs / 'warn.urdf', 'arm')})"]
+    assert re.fullmatch(r"warn\.urdf: 2 stages passed, 0 errors, 1 warning \(they fail the check: --fail-on "
+                        r"warning\) \(\d+\.\d s\)", proc.stdout.splitlines()[-1])
     data = json.loads(run_cli("check", urdfs / "warn.urdf", "--format", "json", "--fail-on", "warning").stdout)
     assert (data["fail_on"], data["failed"], data["warnings"]) == ("warning", 1, 1)
+    assert data["stages"] == [{"stage": "check_urdf", "verdict": "ok", "subjects": 1},
+                              {"stage": "lints", "verdict": "1 warning", "subjects": 3},
+                              {"stage": "consumers", "verdict": "ok", "subjects": 1}]
 
 
 BAD_RECIPE = "robot: x\nlinks:\n  a:\n    visual: {box: {size: [0.1, 0.1]}}\n    inertial: {denisty: 3}\n"
@@ -215,10 +222,9 @@ def test_recipe_build_warnings_are_annotated_on_their_line(tmp_path):
         ("warning", "careless.yaml", "14", "links.payload.inertial: link 'payload': mass 2000 kg in 0.001 m^3 of "
          "visual geometry implies 2e+06 kg/m^3, outside 10..25000 (grams written as kilograms, or a mesh in "
          "millimetres declared as metres?)"),
-        ("warning", "careless.yaml", "6", "materials.blue: material 'blue' is used by no geometry"),
-        ("warning", "careless.yaml", "23", "actuators.wheel_joint: the velocity actuator of continuous joint "
-         "'wheel_joint' has no force range in MuJoCo (unbounded torque): the joint has no effort limit (give it "
-         "limit: {effort: ...})")]
+        ("warning", "careless.yaml", "6", "materials.blue: material 'blue': used by no geometry"),
+        ("warning", "careless.yaml", "23", "actuators.wheel_joint: joint 'wheel_joint': the velocity actuator has no "
+         "force range in MuJoCo (unbounded torque) without an effort limit (give the joint limit: {effort: ...})")]
     assert not (tmp_path / "build").exists()  # --temp-out
 
 
@@ -256,4 +262,44 @@ def test_several_paths_one_missing(urdfs):
     proc = run_cli("check", "warn.urdf", "nothing.urdf", cwd=urdfs)
     assert proc.returncode == 2
     assert proc.stderr == "nothing.urdf: no such file or folder\n"
-    assert proc.stdout.splitlines()[-1] == "warn.urdf nothing.urdf: 0 errors, 1 warning"
+    assert re.fullmatch(r"warn\.urdf nothing\.urdf: 2 stages passed, 0 errors, 1 warning \(\d+\.\d s\)",
+                        proc.stdout.splitlines()[-1])
+
+
+def test_text_lists_each_stage_then_the_problems_once_per_kind():
+    """A stage per line with its verdict; a finding said of several subjects is one, with the
+    count and the subjects; a validator whose program is missing is skipped, and says why."""
+    from robotkit.check.findings import Finding
+    from robotkit.check.render import render
+
+    findings = [Finding("warning", "com-offset", "link 'a'", "centre of mass outside", file="r.urdf", line=3),
+                Finding("warning", "com-offset", "link 'b'", "centre of mass outside", file="r.urdf", line=7),
+                Finding("error", "tree", "joint 'j'", "its joints form a cycle"),
+                Finding("warning", "ign sdf -k", "r.sdf", "ign is not installed", "apt install ignition-tools")]
+    cases = [("check_urdf", "r.urdf"), ("ign sdf -k", "r.sdf"), ("lints", "link 'a'"), ("lints", "link 'b'"),
+             ("lints", "joint 'j'"), ("consumer", "robot 'r'")]
+    assert render(findings, "text", "r.urdf", cases=cases, elapsed=1.23).splitlines() == [
+        "  ok                   check_urdf",
+        "  skipped              ign sdf -k  (ign is not installed)",
+        "  1 error, 2 warnings  lints (3 links and joints)",
+        "  ok                   consumers",
+        "link 'a' and 1 more (link 'b') (r.urdf:3)",
+        "  warning: centre of mass outside [com-offset]",
+        "joint 'j'",
+        "  error: its joints form a cycle [tree]",
+        "r.sdf",
+        "  warning: ign is not installed [ign sdf -k]",
+        "    hint: apt install ignition-tools",
+        "r.urdf: 2 stages passed, 1 error, 3 warnings (1.2 s)"]
+
+
+def test_junit_has_no_passing_build_case_beside_the_build_s_warnings():
+    from robotkit.check.findings import Finding
+    from robotkit.check.render import render
+
+    cases = [("build", "robot 'r'"), ("check_urdf", "r.urdf")]
+    warned = [Finding("warning", "build", "links.a", "r: MJCF: lost", file="r.yaml", line=3)]
+    for findings, expected in ((warned, [("robotkit.build", "links.a"), ("robotkit.check_urdf", "r.urdf")]),
+                               ([], [("robotkit.build", "robot 'r'"), ("robotkit.check_urdf", "r.urdf")])):
+        suite = ET.fromstring(render(findings, "junit", "r.yaml", cases=cases)).find("testsuite")
+        assert [(c.get("classname"), c.get("name")) for c in suite] == expected

@@ -4,6 +4,8 @@ an SDF frame-graph reader)."""
 
 from __future__ import annotations
 
+import re
+
 import json
 import math
 import shutil
@@ -113,17 +115,25 @@ def test_equivalence_finds_a_moved_joint_axis(examples, tmp_path):
     assert diffs and "pose differs" in diffs[0]
 
 
+TIME = r" \(\d+\.\d s\)"  # the check's wall time
+
+
 @pytest.mark.consumers
 @pytest.mark.slow
 def test_check_command_on_a_build_folder(examples, tmp_path):
     proc = run_cli("check", examples / "turret_bot")
     assert proc.returncode == 0, proc.stdout + proc.stderr
     lines = proc.stdout.splitlines()
-    assert lines[-1] == f"{examples / 'turret_bot'}: ok, no problems found"
+    # each stage with its verdict, as test runners list them
+    assert lines[:9] == ["  ok  check_urdf", "  ok  ign sdf -k", "  ok  mujoco (2 files)",
+                         "  ok  lints (5 links and joints)", "  ok  equivalence", "  ok  consumers", "  ok  simulation",
+                         "  ok  self-collision", "  ok  motion"]
+    assert re.fullmatch(re.escape(f"{examples / 'turret_bot'}: 9 stages passed, 0 errors, 0 warnings") + TIME,
+                        lines[-1]), lines[-1]
     # the drives' step responses: a line per joint (its slowest simulator)
-    assert lines[0].startswith("motion of robot 'turret_bot' (implicitfast, dt 0.002 s; stage ")
-    assert lines[1].split() == ["joint", "pose", "sim", "rise", "overshoot", "final", "error"]
-    assert [line.split()[:2] for line in lines[2:4]] == [["j1", "zero"], ["j2", "zero"]]
+    assert lines[9].startswith("motion of robot 'turret_bot' (implicitfast, dt 0.002 s; stage ")
+    assert lines[10].split() == ["joint", "pose", "sim", "rise", "overshoot", "final", "error"]
+    assert [line.split()[:2] for line in lines[11:13]] == [["j1", "zero"], ["j2", "zero"]]
     robot = _copy(examples, tmp_path)
     sdf = robot / "model.sdf"
     sdf.write_text(sdf.read_text().replace("<xyz>0 0 1</xyz>", "<xyz>0 1 0</xyz>"))
@@ -169,15 +179,16 @@ def test_mimic_floating_base_contact_and_losses(tmp_path):
     robot = tmp_path / "out" / "gripper"
     assert "gripper: SDF: joint 'right_finger': SDF 1.9 cannot express mimic joints (SDF 1.11 can); " \
            "it moves independently of 'left_finger' in Gazebo" in result.warnings
-    assert "gripper: SDF: joint 'base': SDF has no floating joint; link 'palm' is a free body placed at " \
-           "the joint's pose" in result.warnings
-    assert "gripper: URDF: joint 'left_finger': armature is not written (URDF has no such joint property; the " \
-           "MJCF carries it)" \
-        in result.warnings
-    assert "gripper: MJCF: link 'palm': MuJoCo friction is isotropic; mu2 0.7 dropped, mu1 0.9 used" \
-        in result.warnings
     report = json.loads((robot / "report.json").read_text())
-    assert len(report["losses"]["sdf"]) == 3  # floating, armature, mimic
+    # what a format cannot hold by its nature: report.json's limits, never a warning
+    limits = report["limits"]
+    assert "joint 'base': SDF has no floating joint; link 'palm' is a free body placed at the joint's pose" \
+        in limits["sdf"]
+    assert limits["urdf"] == ["joint 'left_finger': armature is not written (URDF has no such joint property; the "
+                              "MJCF carries it)"]
+    assert "link 'palm': MuJoCo friction is isotropic; mu2 0.7 dropped, mu1 0.9 used" in limits["mjcf"]
+    assert not any(x in w for w in result.warnings for x in ("floating", "armature", "isotropic", "kp/kd"))
+    assert len(report["losses"]["sdf"]) == 1 and len(limits["sdf"]) == 2  # mimic; floating, armature
     check_urdf(robot / "urdf" / "gripper.urdf")
     ign_sdf_check(robot / "model.sdf")
     mj = mujoco()
@@ -190,8 +201,8 @@ def test_mimic_floating_base_contact_and_losses(tmp_path):
     assert model.geom_friction[palm_geom][0] == 0.9
     # Gazebo's kp/kd are not MuJoCo's solref (per unit mass there): MuJoCo keeps its default softness
     np.testing.assert_allclose(model.geom_solref[palm_geom], [0.02, 1.0])
-    assert ("gripper: MJCF: link 'palm': contact kp/kd are Gazebo (ODE) stiffness and damping; MuJoCo keeps its "
-            "own contact softness (solref is per unit mass there: copied, they bounce the robot)") in result.warnings
+    assert ("link 'palm': contact kp/kd are Gazebo (ODE) stiffness and damping; MuJoCo keeps its own contact "
+            "softness (solref is per unit mass there: copied, they bounce the robot)") in limits["mjcf"]
     sdf = ET.parse(robot / "model.sdf").getroot()
     assert sdf.find("model/link[@name='palm']/collision/surface/friction/ode/mu2").text == "0.7"
     urdf = ET.parse(robot / "urdf" / "gripper.urdf").getroot()
@@ -213,8 +224,10 @@ def test_dae_visuals_are_converted_for_mujoco(tmp_path, assets):
     robot = tmp_path / "out" / "dae"
     assert (robot / "meshes" / "visual" / "wrist3.dae").read_bytes() == (tmp_path / "wrist3.dae").read_bytes()
     assert (robot / "meshes" / "mjcf" / "wrist3.obj").is_file()
-    assert ("dae: MJCF: mesh 'wrist3.dae': MuJoCo reads no DAE; converted to meshes/mjcf/wrist3.obj (the file's "
-            "own colours and textures are dropped, the recipe's material is used)") in result.warnings
+    limits = json.loads((robot / "report.json").read_text())["limits"]
+    assert ("mesh 'wrist3.dae': MuJoCo reads no DAE; converted to meshes/mjcf/wrist3.obj (the file's own colours "
+            "and textures are dropped, the recipe's material is used)") in limits["mjcf"]
+    assert not any("DAE" in w for w in result.warnings)
     mujoco().MjModel.from_xml_path(str(robot / "mjcf" / "scene.xml"))
     assert_equivalent(robot, configs=5)
 
