@@ -68,7 +68,9 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
                 if f is not None and not f.get("convex", True):
                     out.append(f"link '{link.name}': collision mesh '{g.shape.mesh.file_name}' is not convex; "
                                "MuJoCo collides with its convex hull")
-    return out + extras_losses(robot, "the MJCF") + sensor_losses(robot)["mjcf"]
+    # urdf_extras are the URDF's and Gazebo's own vocabulary (<gazebo>, <transmission>), which
+    # MuJoCo does not read: a limit of the format (report.json), not a warning
+    return out + [Limit(x) for x in extras_losses(robot, "the MJCF")] + sensor_losses(robot)["mjcf"]
 
 
 def _geom(robot: Robot, geom: Geom, name: str, assets: dict, role: str = "visual") -> dict:

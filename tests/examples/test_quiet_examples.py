@@ -17,8 +17,6 @@ PENDING = {  # what is left, and why (strict: the test says when it is fixed)
     "lidar_mast": "its lidar mesh (lds.stl) is not convex, so MuJoCo collides with its hull; but it is a thin "
                   "shell: its hull is 2.9x its volume, a fitted cylinder 5.8x (check's collision-volume), and "
                   "CoACD cuts it into 266 pieces in 3.5 min",
-    "turtlebot3_burger": "its Gazebo blocks (an IMU and a lidar among them) are urdf_extras, carried into neither "
-                         "model.sdf nor the MJCF yet; its base mesh is open (open_mesh: hull warns)",
 }
 
 

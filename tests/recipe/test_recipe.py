@@ -3,6 +3,8 @@ includes, the open-mesh policy, and the second example."""
 
 from __future__ import annotations
 
+import json
+
 import math
 import shutil
 import xml.etree.ElementTree as ET
@@ -184,7 +186,9 @@ def mesh_warnings(result) -> list[str]:
     return [w for w in result.warnings if ": ROS package: " not in w]
 
 
-def test_open_mesh_with_hull_policy_warns_and_uses_the_hull(tmp_path, monkeypatch):
+def test_open_mesh_with_hull_policy_uses_the_hull_and_says_so_in_report_json(tmp_path, monkeypatch):
+    """open_mesh: hull is the recipe's choice (the error without it offers it): no warning, the
+    fact and its cost in report.json's meshes."""
     monkeypatch.chdir(tmp_path)
     tube = trimesh.creation.cylinder(radius=0.05, height=0.1, sections=32)
     box = trimesh.Trimesh(tube.vertices, tube.faces[tube.face_normals[:, 2] < 0.99])  # a 32-edge hole
@@ -195,9 +199,11 @@ def test_open_mesh_with_hull_policy_warns_and_uses_the_hull(tmp_path, monkeypatc
           a: {visual: {mesh: open.stl}}
         """, meshes={"open.stl": box})
     result = build([recipe], tmp_path / "out")
-    assert mesh_warnings(result) == [
-        "robot.yaml:4: links.a.visual.mesh: mesh 'open.stl' is not a closed volume (32 open edges); "
-        "its mass properties use its convex hull, which overestimates the volume"]
+    assert mesh_warnings(result) == []
+    meshes = json.loads((tmp_path / "out" / "op" / "report.json").read_text())["meshes"]
+    assert [(m["used"], m["repairs"]) for m in meshes.values()] == [("hull", [
+        "not a closed volume (32 open edges): mass properties from its convex hull (open_mesh: hull), "
+        "which overestimates the volume"])]
     mass, _, _ = urdf_inertials(tmp_path / "out" / "op" / "urdf" / "op.urdf")["a"]
     assert mass == pytest.approx(1000 * stored(box).convex_hull.volume, rel=1e-9)
 
