@@ -462,14 +462,15 @@ def read_recipes(file: str | os.PathLike, args: dict[str, str] | None = None,
             marks = Marks(where=flat_where, origins=origins)
         else:
             marks = Marks(where=dict(where) if len(expanded) > 1 else where)
-        loaded = _validate(file, exp.data, marks, shared, exp.variant)
+        loaded = _validate(file, exp.data, marks, shared, exp.variant, exp.quiet)
         loaded.arg_names = exp.arg_names
         loaded.files = sorted(set(loaded.files) | set(exp.files))
         out.append(loaded)
     return out
 
 
-def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], variant) -> LoadedRecipe:
+def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], variant,
+              quiet: frozenset = frozenset()) -> LoadedRecipe:
     from pydantic import ValidationError
 
     _apply_defaults(data, marks)
@@ -480,7 +481,7 @@ def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], var
     try:
         recipe = Recipe.model_validate(data)
     except ValidationError as exc:
-        taken = {(p.file, p.line, p.key) for p in problems}
+        taken = {(p.file, p.line, p.key) for p in problems} | quiet
         problems.extend(p for p in schema_problems(exc, marks, Recipe) if (p.file, p.line, p.key) not in taken)
         recipe, partial = _salvage(data, exc)
     unique = []

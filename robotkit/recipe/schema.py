@@ -16,7 +16,8 @@ any value may be an expression ``${...}`` of ``args``, ``values``, ``pi``, ``e``
 ``tau``, arithmetic (``+ - * / // % **``), comparisons, ``and``/``or``/``not``,
 ``a if c else b`` and the functions sqrt, sin, cos, tan, asin, acos, atan, atan2,
 sinh, cosh, tanh, exp, log, log10, log2, hypot, radians, degrees, floor, ceil,
-fabs, abs, round, min, max, int, float; text may embed them (``${side}_wheel``).
+fabs, abs, round, min, max, int, float, and quantities (``${width + 1 cm}``: SI numbers);
+text may embed them (``${side}_wheel``).
 ``parts`` are instantiated by ``instances``, ``if`` keeps or drops an entry, and
 ``variants`` build several robots from one recipe.  ``robotkit expand RECIPE``
 prints the flat recipe all of this expands to.

@@ -72,13 +72,54 @@ def test_expressions_against_known_answers(text, scope, expected):
     ("sqrt(-1)", "sqrt(): math domain error"),
     ("sqrt(1, 2)", "sqrt() takes 1 argument (got 2)"),
     ("sin", "'sin' is a function: call it as sin(...)"),
-    ("1 +", "invalid syntax (invalid syntax)"),
+    ("1 +", "invalid syntax"),
     ("1" + " + 1" * 300, "longer than 500 characters"),
 ])
 def test_bad_expressions(text, message):
     with pytest.raises(ExprError) as exc:
         evaluate(text, {"width": 1.0})
     assert str(exc.value) == message
+
+
+UNIT_FUNCTIONS = {unit: to_si for unit, (_, to_si) in units.UNITS.items()}
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("width + 1 cm", 0.21),
+    ("width + 1cm", 0.21),
+    ("2 * 3 mm", 0.006),
+    ("-5 mm", -0.005),
+    ("90 deg", math.pi / 2),
+    ("300 g + 1 kg", 1.3),
+    ("1 in", 0.0254),
+    ("1.5e2 mm", 0.15),
+    ("width if width > 10 cm else 0", 0.2),
+    ("1 if width else 2", 1),          # a keyword after a number is no unit
+    ("'5 cm'", "5 cm"),                # nor is anything inside text
+])
+def test_quantities_inside_expressions_are_their_si_numbers(text, expected):
+    got = evaluate(text, {"width": 0.2}, UNIT_FUNCTIONS, units.KNOWN)
+    assert got == pytest.approx(expected, rel=1e-15) if isinstance(expected, float) else got == expected
+
+
+def test_an_unknown_unit_inside_an_expression_says_so():
+    with pytest.raises(ExprError) as exc:
+        evaluate("width + 2 furlong", {"width": 0.2}, UNIT_FUNCTIONS, units.KNOWN)
+    assert str(exc.value) == ("unknown unit 'furlong' in '2 furlong' (lengths: m, cm, mm, um, km, in, ft; "
+                              "angles: rad, deg; masses: kg, g, mg, lb)")
+
+
+def test_a_recipe_with_units_inside_expressions(tmp_path):
+    write_recipe(tmp_path, """
+        robot: r
+        values: {body_width: 20 cm}
+        links:
+          base: {visual: {box: {size: ["${body_width + 1 cm}", 0.1, "${2 * 5 mm}"]}}}
+        """)
+    proc = run_cli("expand", "robot.yaml", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    size = yaml.safe_load(proc.stdout)["links"]["base"]["visual"]["box"]["size"]
+    assert size == [pytest.approx(0.21, rel=1e-15), 0.1, 0.01]
 
 
 def test_float_overflow_is_an_error_not_inf():
@@ -137,7 +178,7 @@ BAD = {
           b: ${1 / 0}
         links:
           base: {}
-        """, ["robot.yaml:3: values.a: in ${1 +}: invalid syntax (invalid syntax)",
+        """, ["robot.yaml:3: values.a: in ${1 +}: invalid syntax",
               "robot.yaml:4: values.b: in ${1 / 0}: division by zero"]),
     "wrong_dimension": ("""
         robot: r
@@ -204,6 +245,26 @@ BAD = {
               "robot.yaml:13: instances.b.mirror: must be one of xz, yz, xy (got 'yx')",
               "robot.yaml:14: instances.c.orgin: unknown key (did you mean 'origin'?)"]),
 }
+
+
+BAD["expression_errors_without_knock_on"] = ("""
+    robot: r
+    values:
+      width: 20 cm
+      wide: ${widht + 1 cm}
+      wider: ${wide * 2}
+      odd: ${width + 2 furlong}
+    args:
+      half: {default: "${1 +}"}
+    links:
+      base: {visual: {box: {size: ["${wide}", "${wider}", "${half}"]}}}
+      arm: {visual: {box: {size: ["${odd}", 1, "${wider} m"]}}}
+    joints:
+      j: {type: fixed, parent: base, child: arm}
+    """, ["robot.yaml:4: values.wide: in ${widht + 1 cm}: unknown name 'widht' (did you mean 'width'?)",
+          "robot.yaml:6: values.odd: in ${width + 2 furlong}: unknown unit 'furlong' in '2 furlong' "
+          "(lengths: m, cm, mm, um, km, in, ft; angles: rad, deg; masses: kg, g, mg, lb)",
+          "robot.yaml:8: args.half.default: in ${1 +}: invalid syntax"])
 
 
 @pytest.mark.parametrize("case", sorted(BAD))

@@ -41,6 +41,9 @@ class Expanded:
     items: dict = field(default_factory=dict)
     arg_names: tuple = ()
     files: tuple = ()  # part files read (dependencies even when no item of theirs is kept)
+    # (file, line, key) of values a failed expression left unevaluated, its problem reported
+    # where it failed: validation adds none of its own there
+    quiet: frozenset = frozenset()
 
 
 # ---------------------------------------------------------------- the stage
@@ -102,6 +105,7 @@ def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_y
         out.append(result)
     for result in out:
         result.files = tuple(sorted(p for p, (d, _) in ctx.part_files.items() if d is not None))
+        result.quiet = frozenset(ctx.quiet)
     return out
 
 
