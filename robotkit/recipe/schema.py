@@ -6,7 +6,9 @@ description in the JSON Schema that editors use.
 
 Conventions: lengths written in the recipe are metres, angles radians, masses
 kilograms, densities kg/m^3.  Mesh files carry their own units (``units`` or
-``scale``), converted exactly when the recipe is resolved.
+``scale``), converted exactly when the recipe is resolved.  The generated files write every
+number rounded to 15 significant digits (5e-15 relative at most), then in its shortest form:
+``0.1 + 0.0175`` is written ``0.1175``, as a person would write it.
 
 The recipe language (robotkit.recipe.expand; a guide with examples is
 docs/recipe-language.md): any length, angle or mass may carry a unit (``5 cm``,
