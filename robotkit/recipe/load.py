@@ -48,19 +48,24 @@ class Marks:
                 break
         via = ""
         if self.origins and len(path) >= 2 and path[:2] in self.origins and key_path is path:
-            source, via = self.origins[path[:2]]
+            source, via, redirects = self.origins[path[:2]]
+            for n in range(len(path), 1, -1):
+                if path[2:n] in redirects:  # the value came whole from the instance: its line
+                    file, line, key, note = redirects[path[2:n]]
+                    return Problem(message + note, file=file, line=line, key=key + dotted(path[n:], nested=True))
             key_path = source + path[2:]
         file, line = self.locate(path)
         return Problem(message + via, file=file, line=line, key=dotted(key_path))
 
 
-def dotted(path: Path_) -> str:
+def dotted(path: Path_, nested: bool = False) -> str:
+    """``links.base.visual[0]``; ``nested``: the path continues a key (``.visual[0]``)."""
     out = ""
     for part in path:
         if isinstance(part, int):
             out += f"[{part}]"
         else:
-            out += ("." if out else "") + str(part)
+            out += ("." if out or nested else "") + str(part)
     return out
 
 

@@ -239,11 +239,11 @@ BAD = {
           b: {part: wheel, parent: base, args: {radios: 1}, mirror: yx}
           c: {part: wheel, parent: base, args: {radius: -1}, orgin: {}}
           d: {part: wheel, parent: base, args: {radius: -1}}
-        """, ["robot.yaml:6: parts.wheel.links.tyre.visual.cylinder.radius: must be > 0 "
-              "(in instance d at robot.yaml:15)",
-              "robot.yaml:12: instances.a.part: no part named 'wheeel' (did you mean 'wheel'?)",
+        """, ["robot.yaml:12: instances.a.part: no part named 'wheeel' (did you mean 'wheel'?)",
               "robot.yaml:13: instances.b.mirror: must be one of xz, yz, xy (got 'yx')",
-              "robot.yaml:14: instances.c.orgin: unknown key (did you mean 'origin'?)"]),
+              "robot.yaml:14: instances.c.orgin: unknown key (did you mean 'origin'?)",
+              "robot.yaml:15: instances.d.args.radius: must be > 0 (via part 'wheel': robot.yaml:6: "
+              "parts.wheel.links.tyre.visual.cylinder.radius)"]),
 }
 
 
@@ -275,6 +275,35 @@ def test_bad_recipes(tmp_path, case):
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.splitlines() == expected
     assert not (tmp_path / "out").exists()
+
+
+def test_a_typo_in_an_instance_names_the_instance_line(tmp_path):
+    """The part file writes ``parent: ${parent}``; the typo is the instance's, so is the line."""
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "wheel.yaml").write_text(textwrap.dedent("""\
+        args: {radius: 5 cm}
+        links:
+          wheel: {visual: {cylinder: {radius: "${radius}", length: 2 cm}}}
+        joints:
+          axle: {type: continuous, parent: "${parent}", child: wheel, axis: [0, 1, 0]}
+        """))
+    write_recipe(tmp_path, """
+        robot: r
+        links:
+          base_link: {visual: {box: {size: [0.1, 0.1, 0.1]}}}
+        parts:
+          wheel: parts/wheel.yaml
+        instances:
+          left: {part: wheel, parent: bsae_link}
+          right: {part: wheel, parent: base_link, args: {radius: 0 cm}}
+        """)
+    proc = run_cli("build", "robot.yaml", "--out", "out", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        "robot.yaml:7: instances.left.parent: no link named 'bsae_link' (did you mean 'base_link'?) "
+        "(via part 'wheel': parts/wheel.yaml:5: joints.axle.parent)",
+        "robot.yaml:8: instances.right.args.radius: must be > 0 (via part 'wheel': parts/wheel.yaml:3: "
+        "links.wheel.visual.cylinder.radius)"]
 
 
 @pytest.mark.slow
@@ -330,8 +359,8 @@ def test_an_error_in_a_part_file_names_the_file_and_the_instances(tmp_path):
     proc = run_cli("build", "robot.yaml", "--out", "out", cwd=tmp_path)
     assert proc.returncode == 2
     assert proc.stderr.splitlines() == [
-        "parts/segment.yaml:3: links.body.visual.box.size[2]: must be > 0 "
-        "(in instance left at robot.yaml:11 > lower at robot.yaml:7)",
+        "robot.yaml:7: parts.arm.instances.lower.args.length: must be > 0 (via part 'segment': "
+        "parts/segment.yaml:3: links.body.visual.box.size[2]) (in instance left at robot.yaml:11)",
         "parts/segment.yaml:6: joints.hinge.limit.velocity: in ${speed}: unknown name 'speed' "
         "(in instance left at robot.yaml:11 > upper at robot.yaml:6)",
         "parts/segment.yaml:6: joints.hinge.limit.velocity: in ${speed}: unknown name 'speed' "

@@ -130,11 +130,12 @@ def convert_units(data: dict, problem) -> dict:
 def copy_marks(expanded: Expanded, where: dict) -> tuple[dict, dict]:
     """Line marks of the flat recipe: the recipe's own, plus every instance item's, copied from
     where it was written.  Returns (where, origins): origins maps a flat item's key path to
-    (its key path in its source, the instance text) for messages."""
+    (its key path in its source, the instance text, its redirects: robotkit.recipe.expand.parts
+    ._part_items) for messages."""
     out = dict(where)
     origins = {}
     index: dict = {}
-    for (section, name), (src, path) in expanded.items.items():
+    for (section, name), (src, path, redirects) in expanded.items.items():
         depth = len(path)
         key = (id(src.where), depth)
         if key not in index:
@@ -146,7 +147,7 @@ def copy_marks(expanded: Expanded, where: dict) -> tuple[dict, dict]:
         dst = (section, name)
         for rest, m in index[key].get(path, []):
             out[dst + rest] = m
-        origins[dst] = (path, src.via)
+        origins[dst] = (path, src.via, redirects)
     return out, origins
 
 
