@@ -111,8 +111,8 @@ def _instance(name, spec, isrc: Source, scope, parts_env, ctx, flat, items, defa
         if key not in PART_KEYS:
             ctx.report(bsrc, (key,), f"unknown key (expected one of: {', '.join(PART_KEYS)})")
     pscope = _part_scope(spec, body, bsrc, def_scope, prefix, isrc, ctx)
-    given = {"parent": ("parent",)} | {a: ("args", a) for a in (spec.get("args") or {})
-                                       if isinstance(spec.get("args"), dict)}
+    args = spec.get("args") if isinstance(spec.get("args"), dict) else {}
+    given = {"parent": ("parent",)} | {a: ("args", a) for a in args}
     given = {n: (*isrc.locate(rel), dotted(isrc.prefix + rel), isrc.via) for n, rel in given.items()}
     local, local_items = _part_items(body, bsrc, pscope, ctx, given, spec["part"])
     expand_instances(body.get("instances"), bsrc.sub("instances"), pscope, env, ctx, local, local_items,
