@@ -247,6 +247,17 @@ BAD = {
 }
 
 
+BAD["instance_args_not_a_mapping"] = ("""
+    robot: r
+    parts:
+      wheel:
+        links: {tyre: {visual: {cylinder: {radius: 0.1, length: 0.05}}}}
+        joints: {axle: {type: continuous, parent: "${parent}", child: tyre}}
+    links: {base: {}}
+    instances:
+      a: {part: wheel, parent: base, args: .nan}
+    """, ["robot.yaml:8: instances.a.args: must be a mapping of argument values (got nan)"])
+
 BAD["expression_errors_without_knock_on"] = ("""
     robot: r
     values:
