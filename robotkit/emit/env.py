@@ -24,11 +24,20 @@ def template_dirs(extra: tuple[str, ...] = ()) -> list[str]:
     return dirs
 
 
+SIGNIFICANT_DIGITS = 15
+"""Resolution of every number the emitters write: 15 significant digits (at most 5e-15
+relative, far below any physical tolerance; 15 is the decimal precision every float64 holds,
+C's DBL_DIG), so sums of the decimals a recipe gives print as those decimals (0.1 + 0.0175 is
+written 0.1175, not 0.11750000000000001) while computed values keep all but the noise digit."""
+
+
 def fmt(x: float) -> str:
-    """Shortest text that reads back as the same float64 (no -0, no exponent surprises)."""
+    """``x`` rounded to :data:`SIGNIFICANT_DIGITS`, then the shortest text that reads back as that
+    float64 (no -0, no exponent surprises)."""
     x = float(x)
     if not math.isfinite(x):
         raise ValueError(f"cannot write non-finite number {x!r}")
+    x = float(f"{x:.{SIGNIFICANT_DIGITS}g}")
     if x == 0.0:
         return "0"
     text = repr(x)

@@ -48,19 +48,24 @@ class Marks:
                 break
         via = ""
         if self.origins and len(path) >= 2 and path[:2] in self.origins and key_path is path:
-            source, via = self.origins[path[:2]]
+            source, via, redirects = self.origins[path[:2]]
+            for n in range(len(path), 1, -1):
+                if path[2:n] in redirects:  # the value came whole from the instance: its line
+                    file, line, key, note = redirects[path[2:n]]
+                    return Problem(message + note, file=file, line=line, key=key + dotted(path[n:], nested=True))
             key_path = source + path[2:]
         file, line = self.locate(path)
         return Problem(message + via, file=file, line=line, key=dotted(key_path))
 
 
-def dotted(path: Path_) -> str:
+def dotted(path: Path_, nested: bool = False) -> str:
+    """``links.base.visual[0]``; ``nested``: the path continues a key (``.visual[0]``)."""
     out = ""
     for part in path:
         if isinstance(part, int):
             out += f"[{part}]"
         else:
-            out += ("." if out else "") + str(part)
+            out += ("." if out or nested else "") + str(part)
     return out
 
 
@@ -463,7 +468,7 @@ def read_recipes(file: str | os.PathLike, args: dict[str, str] | None = None,
             marks = Marks(where=flat_where, origins=origins)
         else:
             marks = Marks(where=dict(where) if len(expanded) > 1 else where)
-        loaded = _validate(file, exp.data, marks, shared, exp.variant)
+        loaded = _validate(file, exp.data, marks, shared, exp.variant, exp.quiet)
         loaded.arg_names = exp.arg_names
         loaded.files = sorted(set(loaded.files) | set(exp.files))
         out.append(loaded)
@@ -487,7 +492,8 @@ def _one_variant(loaded: list[LoadedRecipe], variant: str, file: Path) -> list[L
     return [LoadedRecipe(file=file, recipe=None, marks=loaded[0].marks, files=files, partial=True, problems=problems)]
 
 
-def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], variant) -> LoadedRecipe:
+def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], variant,
+              quiet: frozenset = frozenset()) -> LoadedRecipe:
     from pydantic import ValidationError
 
     _apply_defaults(data, marks)
@@ -498,7 +504,7 @@ def _validate(file: Path, data: dict, marks: Marks, problems: list[Problem], var
     try:
         recipe = Recipe.model_validate(data)
     except ValidationError as exc:
-        taken = {(p.file, p.line, p.key) for p in problems}
+        taken = {(p.file, p.line, p.key) for p in problems} | quiet
         problems.extend(p for p in schema_problems(exc, marks, Recipe) if (p.file, p.line, p.key) not in taken)
         recipe, partial = _salvage(data, exc)
     unique = []

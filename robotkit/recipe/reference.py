@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import inspect
 import json
 import typing
 
@@ -15,14 +16,31 @@ from robotkit.recipe import schema as s
 from robotkit.recipe.expand.units import UNITS
 
 SECTIONS = [
-    (s.Recipe, "recipe (top level)"), (s.Metadata, "metadata"), (s.Author, "metadata.authors[]"),
-    (s.Material, "materials.<name>"), (s.Defaults, "defaults"), (s.Link, "links.<name>"),
-    (s.Geometry, "links.<name>.visual / collision"), (s.Origin, "origin"), (s.Box, "box"),
-    (s.Cylinder, "cylinder"), (s.Sphere, "sphere"), (s.Inertial, "links.<name>.inertial"),
-    (s.Inertia, "inertial.inertia"), (s.Joint, "joints.<name>"), (s.Limit, "joints.<name>.limit"),
-    (s.Dynamics, "joints.<name>.dynamics"), (s.Mimic, "joints.<name>.mimic"),
-    (s.Arg, "args.<name>"), (s.Part, "parts.<name> (or a part file)"), (s.Instance, "instances.<name>"),
+    (s.Recipe, "the top level of a recipe"), (s.Metadata, "`metadata`"), (s.Author, "`metadata.authors[]`"),
+    (s.Maintainer, "`metadata.maintainers[]`"), (s.Urls, "`metadata.urls`"),
+    (s.Material, "`materials.<name>`"), (s.Defaults, "`defaults`"), (s.Link, "`links.<name>`"),
+    (s.Geometry, "`links.<name>.visual` / `collision`"), (s.Origin, "`origin`"), (s.Box, "`box`"),
+    (s.Cylinder, "`cylinder`"), (s.Sphere, "`sphere`"), (s.Decimate, "`decimate`"),
+    (s.Collision, "`links.<name>.collision` (a strategy) / `meshes.collision`"),
+    (s.Proxy, "a collision strategy's `urdf` / `sdf` / `mjcf`"), (s.Coacd, "a collision strategy's `coacd`"),
+    (s.Inertial, "`links.<name>.inertial`"), (s.Inertia, "`inertial.inertia`"), (s.Contact, "`links.<name>.contact`"),
+    (s.Joint, "`joints.<name>`"), (s.Limit, "`joints.<name>.limit`"), (s.Dynamics, "`joints.<name>.dynamics`"),
+    (s.Mimic, "`joints.<name>.mimic`"), (s.MeshDefaults, "`meshes`"), (s.SelfCollision, "`self_collision`"),
+    (s.Sensor, "`sensors.<name>`"), (s.CameraParams, "`sensors.<name>.camera`"),
+    (s.LidarParams, "`sensors.<name>.lidar`"), (s.SonarParams, "`sensors.<name>.sonar`"),
+    (s.ImuParams, "`sensors.<name>.imu`"), (s.SensorBody, "`sensors.<name>.body`"),
+    (s.Actuator, "`actuators.<joint>`"), (s.Motor, "`actuators.<joint>.motor`"), (s.World, "`worlds.<name>`"),
+    (s.Arg, "`args.<name>`"), (s.Part, "`parts.<name>` (or a part file)"), (s.Instance, "`instances.<name>`"),
 ]
+"""Every model of the schema, in the reference's order, with the key path it is written at
+(:func:`markdown` refuses a model reachable from the recipe that is not listed)."""
+
+DIMENSIONS = {"length": "length", "angle": "angle", "mass": "mass", "position": "joint position"}
+
+TYPES = """Types: a *length* is a number in metres or a quantity with a length unit (``5 cm``), an
+*angle* a number in radians or a quantity (``90 deg``), a *mass* a number in kilograms or a
+quantity (``300 g``), a *joint position* an angle for revolute and continuous joints and a
+length for prismatic ones; any value may be an expression ``${...}``."""
 
 EXPRESSION = r"\$\{[^{}]*\}"
 
@@ -59,12 +77,19 @@ def json_schema(part: bool = False) -> str:
     return json.dumps(data, indent=2, sort_keys=True) + "\n"
 
 
+def _anchor(model) -> str:
+    return model.__name__.lower()
+
+
 def _type(tp) -> str:
     import types
 
+    from pydantic import BaseModel
+
     origin, args = typing.get_origin(tp), typing.get_args(tp)
     if origin is typing.Annotated:
-        return _type(args[0])
+        dims = [m.kind for m in args[1:] if isinstance(m, s.Dim)]
+        return DIMENSIONS[dims[0]] if dims else _type(args[0])
     if origin in (typing.Union, types.UnionType):
         return " or ".join(_type(a) for a in args if a is not type(None))
     if origin is list:
@@ -73,26 +98,66 @@ def _type(tp) -> str:
         return f"mapping of name to {_type(args[1])}"
     if origin is typing.Literal:
         return " / ".join(f"`{a}`" for a in args)
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        return f"[{tp.__name__}](#{_anchor(tp)})"
     return {float: "number", str: "text", int: "integer", bool: "true/false", dict: "mapping"}.get(
         tp, getattr(tp, "__name__", str(tp)))
 
 
+def _annotation(field):
+    """A field's type with its own metadata (a Dim) put back (pydantic keeps them apart)."""
+    return typing.Annotated[(field.annotation, *field.metadata)] if field.metadata else field.annotation
+
+
+def _models(tp, found: set):
+    """Every schema model reachable from type ``tp`` into ``found``."""
+    from pydantic import BaseModel
+
+    if isinstance(tp, str):  # a forward reference pydantic resolved: the field's annotation has it
+        return
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        if tp in found:
+            return
+        found.add(tp)
+        for field in tp.model_fields.values():
+            _models(field.annotation, found)
+        return
+    for a in typing.get_args(tp):
+        _models(a, found)
+
+
+def _default(field) -> str:
+    if field.default is PydanticUndefined and field.default_factory is None:
+        return "required"
+    if field.default is None:
+        return ""
+    return json.dumps(field.default.model_dump() if hasattr(field.default, "model_dump") else field.default)
+
+
+def _section(model, title: str) -> list[str]:
+    lines = [f'<a id="{_anchor(model)}"></a>', "", f"## {model.__name__}: {title}", ""]
+    doc = inspect.cleandoc(model.__doc__ or "")
+    if doc and not doc.startswith(("!!!", "Usage docs")):
+        lines += [doc, ""]
+    lines += ["| key | type | default | meaning |", "|---|---|---|---|"]
+    for name, field in model.model_fields.items():
+        desc = (field.description or "").replace("\n", " ").replace("|", "\\|")
+        tp = _type(_annotation(field)).replace("|", "\\|")
+        lines.append(f"| `{field.alias or name}` | {tp} | {_default(field)} | {desc} |")
+    return lines + [""]
+
+
 def markdown() -> str:
+    """The reference: one section per schema model (every key of the JSON Schema)."""
+    reachable: set = set()
+    _models(s.Recipe, reachable)
+    missing = sorted(m.__name__ for m in reachable - {m for m, _ in SECTIONS})
+    if missing:
+        raise AssertionError(f"robotkit.recipe.reference.SECTIONS lacks {', '.join(missing)}")
     lines = ["# Recipe reference", "",
              "Generated from `robotkit/recipe/schema.py` by `robotkit schema --markdown`; do not edit.",
-             "", (s.__doc__ or "").split("\n\n", 1)[1].strip(), ""]
+             "", (s.__doc__ or "").split("\n\n", 1)[1].strip(), "", TYPES, "",
+             "Sections: " + ", ".join(f"[{m.__name__}](#{_anchor(m)})" for m, _ in SECTIONS) + ".", ""]
     for model, title in SECTIONS:
-        lines += [f"## {title}", ""]
-        doc = (model.__doc__ or "").strip()
-        if doc and not doc.startswith(("!!!", "Usage docs")):
-            lines += [doc, ""]
-        lines += ["| key | type | default | meaning |", "|---|---|---|---|"]
-        for name, field in model.model_fields.items():
-            default = "required" if field.default is PydanticUndefined and field.default_factory is None else (
-                "" if field.default is None else json.dumps(
-                    field.default.model_dump() if hasattr(field.default, "model_dump") else field.default))
-            desc = (field.description or "").replace("\n", " ").replace("|", "\\|")
-            tp = _type(field.annotation).replace("|", "\\|")
-            lines.append(f"| `{field.alias or name}` | {tp} | {default} | {desc} |")
-        lines.append("")
+        lines += _section(model, title)
     return "\n".join(lines)

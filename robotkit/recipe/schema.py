@@ -6,7 +6,9 @@ description in the JSON Schema that editors use.
 
 Conventions: lengths written in the recipe are metres, angles radians, masses
 kilograms, densities kg/m^3.  Mesh files carry their own units (``units`` or
-``scale``), converted exactly when the recipe is resolved.
+``scale``), converted exactly when the recipe is resolved.  The generated files write every
+number rounded to 15 significant digits (5e-15 relative at most), then in its shortest form:
+``0.1 + 0.0175`` is written ``0.1175``, as a person would write it.
 
 The recipe language (robotkit.recipe.expand; a guide with examples is
 docs/recipe-language.md): any length, angle or mass may carry a unit (``5 cm``,
@@ -16,7 +18,8 @@ any value may be an expression ``${...}`` of ``args``, ``values``, ``pi``, ``e``
 ``tau``, arithmetic (``+ - * / // % **``), comparisons, ``and``/``or``/``not``,
 ``a if c else b`` and the functions sqrt, sin, cos, tan, asin, acos, atan, atan2,
 sinh, cosh, tanh, exp, log, log10, log2, hypot, radians, degrees, floor, ceil,
-fabs, abs, round, min, max, int, float; text may embed them (``${side}_wheel``).
+fabs, abs, round, min, max, int, float, and quantities (``${width + 1 cm}``: SI numbers);
+text may embed them (``${side}_wheel``).
 ``parts`` are instantiated by ``instances``, ``if`` keeps or drops an entry, and
 ``variants`` build several robots from one recipe.  ``robotkit expand RECIPE``
 prints the flat recipe all of this expands to.
@@ -811,7 +814,7 @@ class Recipe(Strict):
     self_collision: SelfCollision = SelfCollision()
     """The self-collision matrix (``srdf/<robot>.srdf``, the MJCF's excludes, the SDF's bit masks): how many configurations to sample and which pairs to force out of or into checking."""
     urdf_extras: list[XmlElement] = []
-    """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
+    """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF; ``<gazebo>`` blocks are also carried into model.sdf as libsdformat's URDF conversion places them (sensors and plugins into the link named, surface tags into its collisions, joint tags into the joint), and what cannot be carried is listed. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
     metadata: Metadata = Metadata()
     materials: dict[Name, Material] = {}
     defaults: Defaults = Defaults()

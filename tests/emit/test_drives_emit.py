@@ -12,6 +12,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from robotkit.emit.env import fmt
 from robotkit.pipeline.runner import build
 from tests.model.test_gains import ARM, ARMATURE, ROTOR, GEAR
 from tests.conftest import write_recipe
@@ -68,10 +69,10 @@ def test_ros2_control_starts_at_home_and_gazebo_sim_gets_the_same_gains(arm):
     assert plugin.get("name") == "gz::sim::systems::JointPositionController"
     assert {k: float(plugin.find(k).text) for k in ("p_gain", "i_gain", "d_gain", "initial_position",
                                                    "cmd_max")} == {
-        "p_gain": drive["p"], "i_gain": 0.0, "d_gain": drive["d"],
+        "p_gain": pytest.approx(drive["p"], rel=1e-14), "i_gain": 0.0, "d_gain": pytest.approx(drive["d"], rel=1e-14),
         "initial_position": pytest.approx(math.radians(30)), "cmd_max": 20.0}
     launch = (arm / "launch" / "display.launch.py").read_text()
-    assert f"ZEROS = {{'zeros.hinge': {math.radians(30)!r}}}" in launch
+    assert f"ZEROS = {{'zeros.hinge': {fmt(math.radians(30))}}}" in launch  # 15 significant digits, as every number
 
 
 def test_what_a_format_cannot_carry_is_a_loss(arm):

@@ -72,13 +72,54 @@ def test_expressions_against_known_answers(text, scope, expected):
     ("sqrt(-1)", "sqrt(): math domain error"),
     ("sqrt(1, 2)", "sqrt() takes 1 argument (got 2)"),
     ("sin", "'sin' is a function: call it as sin(...)"),
-    ("1 +", "invalid syntax (invalid syntax)"),
+    ("1 +", "invalid syntax"),
     ("1" + " + 1" * 300, "longer than 500 characters"),
 ])
 def test_bad_expressions(text, message):
     with pytest.raises(ExprError) as exc:
         evaluate(text, {"width": 1.0})
     assert str(exc.value) == message
+
+
+UNIT_FUNCTIONS = {unit: to_si for unit, (_, to_si) in units.UNITS.items()}
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("width + 1 cm", 0.21),
+    ("width + 1cm", 0.21),
+    ("2 * 3 mm", 0.006),
+    ("-5 mm", -0.005),
+    ("90 deg", math.pi / 2),
+    ("300 g + 1 kg", 1.3),
+    ("1 in", 0.0254),
+    ("1.5e2 mm", 0.15),
+    ("width if width > 10 cm else 0", 0.2),
+    ("1 if width else 2", 1),          # a keyword after a number is no unit
+    ("'5 cm'", "5 cm"),                # nor is anything inside text
+])
+def test_quantities_inside_expressions_are_their_si_numbers(text, expected):
+    got = evaluate(text, {"width": 0.2}, UNIT_FUNCTIONS, units.KNOWN)
+    assert got == pytest.approx(expected, rel=1e-15) if isinstance(expected, float) else got == expected
+
+
+def test_an_unknown_unit_inside_an_expression_says_so():
+    with pytest.raises(ExprError) as exc:
+        evaluate("width + 2 furlong", {"width": 0.2}, UNIT_FUNCTIONS, units.KNOWN)
+    assert str(exc.value) == ("unknown unit 'furlong' in '2 furlong' (lengths: m, cm, mm, um, km, in, ft; "
+                              "angles: rad, deg; masses: kg, g, mg, lb)")
+
+
+def test_a_recipe_with_units_inside_expressions(tmp_path):
+    write_recipe(tmp_path, """
+        robot: r
+        values: {body_width: 20 cm}
+        links:
+          base: {visual: {box: {size: ["${body_width + 1 cm}", 0.1, "${2 * 5 mm}"]}}}
+        """)
+    proc = run_cli("expand", "robot.yaml", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    size = yaml.safe_load(proc.stdout)["links"]["base"]["visual"]["box"]["size"]
+    assert size == [pytest.approx(0.21, rel=1e-15), 0.1, 0.01]
 
 
 def test_float_overflow_is_an_error_not_inf():
@@ -137,7 +178,7 @@ BAD = {
           b: ${1 / 0}
         links:
           base: {}
-        """, ["robot.yaml:3: values.a: in ${1 +}: invalid syntax (invalid syntax)",
+        """, ["robot.yaml:3: values.a: in ${1 +}: invalid syntax",
               "robot.yaml:4: values.b: in ${1 / 0}: division by zero"]),
     "wrong_dimension": ("""
         robot: r
@@ -198,12 +239,43 @@ BAD = {
           b: {part: wheel, parent: base, args: {radios: 1}, mirror: yx}
           c: {part: wheel, parent: base, args: {radius: -1}, orgin: {}}
           d: {part: wheel, parent: base, args: {radius: -1}}
-        """, ["robot.yaml:6: parts.wheel.links.tyre.visual.cylinder.radius: must be > 0 "
-              "(in instance d at robot.yaml:15)",
-              "robot.yaml:12: instances.a.part: no part named 'wheeel' (did you mean 'wheel'?)",
+        """, ["robot.yaml:12: instances.a.part: no part named 'wheeel' (did you mean 'wheel'?)",
               "robot.yaml:13: instances.b.mirror: must be one of xz, yz, xy (got 'yx')",
-              "robot.yaml:14: instances.c.orgin: unknown key (did you mean 'origin'?)"]),
+              "robot.yaml:14: instances.c.orgin: unknown key (did you mean 'origin'?)",
+              "robot.yaml:15: instances.d.args.radius: must be > 0 (via part 'wheel': robot.yaml:6: "
+              "parts.wheel.links.tyre.visual.cylinder.radius)"]),
 }
+
+
+BAD["instance_args_not_a_mapping"] = ("""
+    robot: r
+    parts:
+      wheel:
+        links: {tyre: {visual: {cylinder: {radius: 0.1, length: 0.05}}}}
+        joints: {axle: {type: continuous, parent: "${parent}", child: tyre}}
+    links: {base: {}}
+    instances:
+      a: {part: wheel, parent: base, args: .nan}
+    """, ["robot.yaml:8: instances.a.args: must be a mapping of argument values (got nan)"])
+
+BAD["expression_errors_without_knock_on"] = ("""
+    robot: r
+    values:
+      width: 20 cm
+      wide: ${widht + 1 cm}
+      wider: ${wide * 2}
+      odd: ${width + 2 furlong}
+    args:
+      half: {default: "${1 +}"}
+    links:
+      base: {visual: {box: {size: ["${wide}", "${wider}", "${half}"]}}}
+      arm: {visual: {box: {size: ["${odd}", 1, "${wider} m"]}}}
+    joints:
+      j: {type: fixed, parent: base, child: arm}
+    """, ["robot.yaml:4: values.wide: in ${widht + 1 cm}: unknown name 'widht' (did you mean 'width'?)",
+          "robot.yaml:6: values.odd: in ${width + 2 furlong}: unknown unit 'furlong' in '2 furlong' "
+          "(lengths: m, cm, mm, um, km, in, ft; angles: rad, deg; masses: kg, g, mg, lb)",
+          "robot.yaml:8: args.half.default: in ${1 +}: invalid syntax"])
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
@@ -214,6 +286,35 @@ def test_bad_recipes(tmp_path, case):
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.splitlines() == expected
     assert not (tmp_path / "out").exists()
+
+
+def test_a_typo_in_an_instance_names_the_instance_line(tmp_path):
+    """The part file writes ``parent: ${parent}``; the typo is the instance's, so is the line."""
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "wheel.yaml").write_text(textwrap.dedent("""\
+        args: {radius: 5 cm}
+        links:
+          wheel: {visual: {cylinder: {radius: "${radius}", length: 2 cm}}}
+        joints:
+          axle: {type: continuous, parent: "${parent}", child: wheel, axis: [0, 1, 0]}
+        """))
+    write_recipe(tmp_path, """
+        robot: r
+        links:
+          base_link: {visual: {box: {size: [0.1, 0.1, 0.1]}}}
+        parts:
+          wheel: parts/wheel.yaml
+        instances:
+          left: {part: wheel, parent: bsae_link}
+          right: {part: wheel, parent: base_link, args: {radius: 0 cm}}
+        """)
+    proc = run_cli("build", "robot.yaml", "--out", "out", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        "robot.yaml:7: instances.left.parent: no link named 'bsae_link' (did you mean 'base_link'?) "
+        "(via part 'wheel': parts/wheel.yaml:5: joints.axle.parent)",
+        "robot.yaml:8: instances.right.args.radius: must be > 0 (via part 'wheel': parts/wheel.yaml:3: "
+        "links.wheel.visual.cylinder.radius)"]
 
 
 @pytest.mark.slow
@@ -269,8 +370,8 @@ def test_an_error_in_a_part_file_names_the_file_and_the_instances(tmp_path):
     proc = run_cli("build", "robot.yaml", "--out", "out", cwd=tmp_path)
     assert proc.returncode == 2
     assert proc.stderr.splitlines() == [
-        "parts/segment.yaml:3: links.body.visual.box.size[2]: must be > 0 "
-        "(in instance left at robot.yaml:11 > lower at robot.yaml:7)",
+        "robot.yaml:7: parts.arm.instances.lower.args.length: must be > 0 (via part 'segment': "
+        "parts/segment.yaml:3: links.body.visual.box.size[2]) (in instance left at robot.yaml:11)",
         "parts/segment.yaml:6: joints.hinge.limit.velocity: in ${speed}: unknown name 'speed' "
         "(in instance left at robot.yaml:11 > upper at robot.yaml:6)",
         "parts/segment.yaml:6: joints.hinge.limit.velocity: in ${speed}: unknown name 'speed' "

@@ -41,6 +41,9 @@ class Expanded:
     items: dict = field(default_factory=dict)
     arg_names: tuple = ()
     files: tuple = ()  # part files read (dependencies even when no item of theirs is kept)
+    # (file, line, key) of values a failed expression left unevaluated, its problem reported
+    # where it failed: validation adds none of its own there
+    quiet: frozenset = frozenset()
 
 
 # ---------------------------------------------------------------- the stage
@@ -102,6 +105,7 @@ def expand(data: dict, where: dict, file: str, overrides: dict[str, str], read_y
         out.append(result)
     for result in out:
         result.files = tuple(sorted(p for p, (d, _) in ctx.part_files.items() if d is not None))
+        result.quiet = frozenset(ctx.quiet)
     return out
 
 
@@ -126,11 +130,12 @@ def convert_units(data: dict, problem) -> dict:
 def copy_marks(expanded: Expanded, where: dict) -> tuple[dict, dict]:
     """Line marks of the flat recipe: the recipe's own, plus every instance item's, copied from
     where it was written.  Returns (where, origins): origins maps a flat item's key path to
-    (its key path in its source, the instance text) for messages."""
+    (its key path in its source, the instance text, its redirects: robotkit.recipe.expand.parts
+    ._part_items) for messages."""
     out = dict(where)
     origins = {}
     index: dict = {}
-    for (section, name), (src, path) in expanded.items.items():
+    for (section, name), (src, path, redirects) in expanded.items.items():
         depth = len(path)
         key = (id(src.where), depth)
         if key not in index:
@@ -142,7 +147,7 @@ def copy_marks(expanded: Expanded, where: dict) -> tuple[dict, dict]:
         dst = (section, name)
         for rest, m in index[key].get(path, []):
             out[dst + rest] = m
-        origins[dst] = (path, src.via)
+        origins[dst] = (path, src.via, redirects)
     return out, origins
 
 

@@ -5,15 +5,19 @@ numbers, strings, true/false, names from the scope, arithmetic, comparisons,
 ``and``/``or``/``not``, ``a if c else b`` and calls of the functions in
 :data:`FUNCTIONS` are evaluated.  Sizes are capped (expression length, node
 count, exponents, integer size, string length) so no expression can exhaust
-the machine.
+the machine.  A number followed by a unit (``1 cm``, ``90deg``) is a quantity: it is
+replaced by its SI number before parsing (``${body_width + 1 cm}`` is ``body_width + 0.01``).
 """
 
 from __future__ import annotations
 
 import ast
 import difflib
+import io
+import keyword
 import math
 import operator
+import tokenize
 
 MAX_LENGTH = 500  # characters of one expression
 MAX_NODES = 200  # AST nodes of one expression
@@ -54,6 +58,21 @@ class ExprError(ValueError):
     """An expression that cannot be evaluated; the message says why."""
 
 
+class Quiet(ExprError):
+    """An expression that uses a value whose own expression failed: its problem is reported
+    already, so this one is not (no knock-on errors)."""
+
+
+class Failed:
+    """The value of a name whose expression could not be evaluated (see :class:`Quiet`)."""
+
+    def __repr__(self):
+        return "<failed>"
+
+
+FAILED = Failed()
+
+
 _BIN = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
         ast.FloorDiv: operator.floordiv, ast.Mod: operator.mod, ast.Pow: operator.pow}
 _CMP = {ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt, ast.LtE: operator.le,
@@ -62,17 +81,52 @@ _SYMBOL = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.FloorDiv
            ast.Pow: "**"}
 
 
-def evaluate(text: str, scope: dict):
-    """The value of expression ``text`` with the names in ``scope`` (and the constants)."""
+def evaluate(text: str, scope: dict, units: dict | None = None, known_units: str = ""):
+    """The value of expression ``text`` with the names in ``scope`` (and the constants).
+
+    ``units``: unit name -> function converting a number to SI; a number followed by one of
+    them (``1 cm``) is that SI number; ``known_units`` lists them for the message of an unknown one."""
     if len(text) > MAX_LENGTH:
         raise ExprError(f"longer than {MAX_LENGTH} characters")
+    text = quantities(text.strip(), units or {}, known_units)
     try:
-        tree = ast.parse(text.strip(), mode="eval")
+        tree = ast.parse(text, mode="eval")
     except SyntaxError as exc:
-        raise ExprError(f"invalid syntax ({exc.msg})") from None
+        raise ExprError("invalid syntax" if exc.msg == "invalid syntax" else f"invalid syntax ({exc.msg})") from None
     if sum(1 for _ in ast.walk(tree)) > MAX_NODES:
         raise ExprError(f"more than {MAX_NODES} terms")
     return _Eval(scope).visit(tree.body)
+
+
+def quantities(text: str, units: dict, known: str = "") -> str:
+    """``text`` with every number followed by a unit of ``units`` (``1 cm``, ``90deg``) replaced by
+    its SI number in parentheses; a number followed by another name that is not a keyword is an
+    unknown unit."""
+    try:
+        tokens = list(tokenize.generate_tokens(io.StringIO(text).readline))
+    except (tokenize.TokenError, SyntaxError, IndentationError):
+        return text  # the parser says what is wrong
+    starts = [0]
+    for line in text.splitlines(keepends=True):
+        starts.append(starts[-1] + len(line))
+    out, pos = [], 0
+    for number, unit in zip(tokens, tokens[1:]):
+        if number.type != tokenize.NUMBER or unit.type != tokenize.NAME:
+            continue
+        if unit.string not in units:
+            if keyword.iskeyword(unit.string):
+                continue
+            raise ExprError(f"unknown unit '{unit.string}' in '{number.string} {unit.string}'"
+                            + (f" ({known})" if known else ""))
+        try:
+            value = units[unit.string](float(number.string) if any(c in number.string for c in ".eE")
+                                       else int(number.string, 0))
+        except ValueError:
+            raise ExprError(f"'{number.string} {unit.string}' is not a quantity") from None
+        begin = starts[number.start[0] - 1] + number.start[1]
+        out += [text[pos:begin], f"({value!r})"]
+        pos = starts[unit.end[0] - 1] + unit.end[1]
+    return "".join(out) + text[pos:]
 
 
 class _Eval:
@@ -103,6 +157,8 @@ class _Eval:
     def v_Name(self, node):
         if node.id in self.scope:
             value = self.scope[node.id]
+            if value is FAILED:
+                raise Quiet(f"'{node.id}' could not be evaluated")
             if not isinstance(value, (bool, int, float, str)):  # a value the schema will reject too
                 raise ExprError(f"'{node.id}' is not a number, true/false or text (got {show(value)})")
             return value

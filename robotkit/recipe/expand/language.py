@@ -60,6 +60,8 @@ class Context:
         self.problems = problems
         self.reads = reads  # where part files may be read (robotkit.paths.ReadPolicy)
         self.part_files: dict = {}  # resolved path -> (data, marks)
+        self.failures = 0  # expressions that could not be evaluated (reported or quiet)
+        self.quiet: set = set()  # (file, line, key) of values left unevaluated by a failure reported elsewhere
 
     def report(self, src: Source, rel, message: str):
         self.problems.append(src.problem(rel, message))
@@ -79,11 +81,14 @@ def evaluate_tree(node, scope: dict, ctx: Context, src: Source, rel=()):
     return node
 
 
+UNITS = {unit: to_si for unit, (_, to_si) in _units.UNITS.items()}
+
+
 def evaluate_string(text: str, scope: dict, ctx: Context, src: Source, rel):
     m = WHOLE_RE.match(text.strip())
     try:
         if m and text.strip() == text:
-            return _expr.evaluate(m.group(1), scope)
+            return _expr.evaluate(m.group(1), scope, UNITS, _units.KNOWN)
         out, pos = [], 0
         for part in PART_RE.finditer(text):
             out.append(text[pos:part.start()])
@@ -91,16 +96,37 @@ def evaluate_string(text: str, scope: dict, ctx: Context, src: Source, rel):
                 out.append("${")
             else:
                 current = part.group(1)
-                out.append(_expr.show(_expr.evaluate(current, scope)))
+                out.append(_expr.show(_expr.evaluate(current, scope, UNITS, _units.KNOWN)))
             pos = part.end()
         out.append(text[pos:])
         result = "".join(out)
         if "${" in result.replace("$${", "") and "${" in text[pos:]:
             raise _expr.ExprError("'${' without its closing '}'")
         return result
+    except _expr.Quiet:
+        ctx.failures += 1
+        p = src.problem(rel, "")
+        ctx.quiet.add((p.file, p.line, p.key))
+        return text
     except _expr.ExprError as exc:
+        ctx.failures += 1
         ctx.report(src, rel, f"in {text.strip()}: {exc}")
         return text
+
+
+def failed_here(ctx: Context, src: Source, rel) -> bool:
+    """Whether an expression written at ``rel`` of ``src`` failed (reported or quiet)."""
+    p = src.problem(rel, "")
+    where = (p.file, p.line, p.key)
+    return where in ctx.quiet or any((q.file, q.line, q.key) == where for q in ctx.problems)
+
+
+def evaluated(node, scope: dict, ctx: Context, src: Source, rel=()):
+    """:func:`evaluate_tree` of a named value: :data:`expr.FAILED` when an expression in it
+    failed (its uses then fail quietly instead of adding knock-on problems)."""
+    before = ctx.failures
+    value = evaluate_tree(node, scope, ctx, src, rel)
+    return _expr.FAILED if ctx.failures > before else value
 
 
 # ---------------------------------------------------------------- arguments
@@ -197,7 +223,11 @@ def declare_args(block, scope: dict, ctx: Context, src: Source):
         if isinstance(default, (dict, list)) or default is None:
             ctx.report(src, where, f"a default must be a number, true/false or text (got {default!r})")
             continue
-        default = evaluate_tree(default, local, ctx, src, where)
+        default = evaluated(default, local, ctx, src, where)
+        if default is _expr.FAILED:
+            out[name] = ("text", default, None)
+            local[name] = default
+            continue
         kind = _kind(default)
         value = _si(default) if kind not in ("bool", "number", "text") else default
         if choices is not None and default not in choices and value not in choices:
@@ -223,6 +253,9 @@ def bind_args(declared: dict, given: dict, ctx: Context, what: str, locate, from
             ctx.report(src, rel, f"unknown argument '{name}' of {what}{hint}")
             continue
         kind, _, choices = declared[name]
+        if failed_here(ctx, src, rel):
+            values[name] = _expr.FAILED  # its expression's problem is reported: no knock-on ones
+            continue
         try:
             v = coerce(value, kind, from_text)
         except ValueError as exc:
@@ -248,7 +281,7 @@ def declare_values(block, scope: dict, ctx: Context, src: Source) -> dict:
             ctx.report(src, (name,), "a value name must be a plain identifier (letters, digits, '_'), "
                                      "not a function or constant name")
             continue
-        scope[name] = _si(evaluate_tree(v, scope, ctx, src, (name,)))
+        scope[name] = _si(evaluated(v, scope, ctx, src, (name,)))
     return scope
 
 

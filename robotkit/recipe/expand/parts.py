@@ -28,7 +28,7 @@ from robotkit.errors import display_path
 from robotkit.geometry import matrix_rpy, rpy_rows
 from robotkit.recipe import schema
 from robotkit.recipe.expand.language import (
-    ITEM_SECTIONS, Source, bind_args, declare_args, declare_values, evaluate_tree, keep,
+    ITEM_SECTIONS, WHOLE_RE, Source, bind_args, declare_args, declare_values, dotted, evaluate_tree, keep,
 )
 from robotkit.recipe.expand.units import convert_tree
 
@@ -111,7 +111,10 @@ def _instance(name, spec, isrc: Source, scope, parts_env, ctx, flat, items, defa
         if key not in PART_KEYS:
             ctx.report(bsrc, (key,), f"unknown key (expected one of: {', '.join(PART_KEYS)})")
     pscope = _part_scope(spec, body, bsrc, def_scope, prefix, isrc, ctx)
-    local, local_items = _part_items(body, bsrc, pscope, ctx)
+    args = spec.get("args") if isinstance(spec.get("args"), dict) else {}
+    given = {"parent": ("parent",)} | {a: ("args", a) for a in args}
+    given = {n: (*isrc.locate(rel), dotted(isrc.prefix + rel), isrc.via) for n, rel in given.items()}
+    local, local_items = _part_items(body, bsrc, pscope, ctx, given, spec["part"])
     expand_instances(body.get("instances"), bsrc.sub("instances"), pscope, env, ctx, local, local_items,
                      default_units, chain)
     renamed = _rename(local, prefix)
@@ -196,9 +199,11 @@ def _part_scope(spec: dict, body: dict, bsrc: Source, def_scope: dict, prefix: s
     return declare_values(body.get("values"), pscope, ctx, bsrc.sub("values"))
 
 
-def _part_items(body: dict, bsrc: Source, pscope: dict, ctx) -> tuple[dict, dict]:
+def _part_items(body: dict, bsrc: Source, pscope: dict, ctx, given: dict, part: str) -> tuple[dict, dict]:
     """The part's own items evaluated in ``pscope`` (those whose ``if:`` holds), by section, and
-    where each was written."""
+    where each was written: (source, key path, redirects).  ``given``: {name: (file, line, key,
+    the instance's own chain of instances)} of what the instance gives (``parent``, its ``args``); a key whose whole value is ``${name}``
+    of one of them is redirected there (a problem with that value is the instance's)."""
     local = {s: {} for s in ITEM_SECTIONS}
     local_items: dict = {}
     for section in ITEM_SECTIONS:
@@ -210,14 +215,31 @@ def _part_items(body: dict, bsrc: Source, pscope: dict, ctx) -> tuple[dict, dict
             continue
         for n, item in block.items():
             isrc_item = bsrc.sub(section, n)
+            redirects = _redirects(item, given, isrc_item, part)
             item = evaluate_tree(item, pscope, ctx, isrc_item)
             if not keep(item, ctx, isrc_item, ()):
                 continue
             if isinstance(item, dict):
                 convert_tree(item, MODELS[section], (), None, lambda p, m, s=isrc_item: ctx.report(s, p, m))
             local[section][n] = item if item is not None else {}
-            local_items[(section, n)] = (bsrc, bsrc.prefix + (section, n))
+            local_items[(section, n)] = (bsrc, bsrc.prefix + (section, n), redirects)
     return local, local_items
+
+
+def _redirects(node, given: dict, src: Source, part: str, rel=()) -> dict:
+    """{key path in the item: (file, line, key, note)} of the keys of ``node`` whose whole value is
+    ``${name}`` of a name in ``given``: the instance's line, and a note naming the part's."""
+    if isinstance(node, dict):
+        return {k: v for key, sub in node.items() for k, v in _redirects(sub, given, src, part, rel + (key,)).items()}
+    if isinstance(node, list):
+        return {k: v for i, sub in enumerate(node) for k, v in _redirects(sub, given, src, part, rel + (i,)).items()}
+    m = WHOLE_RE.match(node) if isinstance(node, str) else None
+    if m is None or m.group(1).strip() not in given:
+        return {}
+    file, line = src.locate(rel)
+    where = f"{display_path(file)}:{line}: " if file is not None else ""
+    ifile, iline, ikey, chain = given[m.group(1).strip()]
+    return {rel: (ifile, iline, ikey, f" (via part '{part}': {where}{dotted(src.prefix + rel)}){chain}")}
 
 
 def _attach(renamed: dict, part: str, parent: str, pose, isrc: Source, ctx):
