@@ -5,10 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from robotkit.check import kinematics as k
+from robotkit.check.findings import EQUIVALENCE_CONFIGS
 from robotkit.emit.layout import robot_layout
 
 
-def equivalence(robot_dir: str | Path, tol: float = 1e-9, configs: int = 100,
+def equivalence(robot_dir: str | Path, tol: float = 1e-9, configs: int = EQUIVALENCE_CONFIGS,
                 notes: list[str] | None = None) -> dict[str, list[str]]:
     """Compare the URDF, SDF and MJCF of a build folder pairwise; {comparison: differences}.
 

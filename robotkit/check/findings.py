@@ -10,6 +10,8 @@ SEVERITIES = ("error", "warning")
 STAGES = ("check_urdf", "ign sdf -k", "mujoco", "equivalence", "consumer", "consumers", "simulation", "build",
           "input", "motion", "self-collision")
 """The checks that are stages; every other rule is a physics lint (robotkit.check.lints)."""
+EQUIVALENCE_CONFIGS = 100
+"""The configurations at which the equivalence stage compares URDF, model.sdf and MJCF."""
 
 
 @dataclass(frozen=True)

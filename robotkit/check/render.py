@@ -7,7 +7,7 @@ import json
 import xml.etree.ElementTree as ET
 from dataclasses import asdict, dataclass, replace
 
-from robotkit.check.findings import STAGES, Finding
+from robotkit.check.findings import EQUIVALENCE_CONFIGS, STAGES, Finding
 from robotkit.errors import display_path
 
 
@@ -105,6 +105,8 @@ class Stage:
     def label(self) -> str:
         if self.name == "lints" and self.subjects:
             return f"lints ({self.subjects} links and joints)"
+        if self.name == "equivalence":
+            return f"equivalence (URDF, model.sdf, MJCF and Gazebo's URDF at {EQUIVALENCE_CONFIGS} configurations)"
         if self.name in ("check_urdf", "ign sdf -k", "mujoco") and self.subjects > 1:
             return f"{self.name} ({self.subjects} files)"
         return self.name
