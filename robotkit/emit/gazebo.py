@@ -133,8 +133,11 @@ def _to_link(out: Carried, ref: str, elem, robot: Robot, frames: set[str]) -> No
     """One element of a <gazebo reference="link"> block into the SDF link that carries ``ref``."""
     from robotkit.emit.sensors import host_of
 
-    value = (elem.text or "").strip()
-    if elem.tag in SURFACE:
+    value = _value(elem)
+    if elem.tag in ("visual", "collision"):  # libsdformat merges one only into a visual/collision of its name
+        out.losses.append(f'<gazebo reference="{ref}">: <{elem.tag}> not in model.sdf: the SDF {elem.tag}s are '
+                          "the recipe's, named by robotkit")
+    elif elem.tag in SURFACE:
         out.surfaces.setdefault(ref, {})[SURFACE[elem.tag]] = value
     elif elem.tag in COLLISION:
         out.collision.setdefault(ref, []).append(_leaf(COLLISION[elem.tag], value))
@@ -171,7 +174,7 @@ def _to_joint(out: Carried, ref: str, elem, robot: Robot, frames: set[str], phys
         node = physics
         for tag in JOINT_PHYSICS[elem.tag]:
             node = node.find(tag) if node.find(tag) is not None else ET.SubElement(node, tag)
-        node.text = (elem.text or "").strip()
+        node.text = _value(elem)
     else:
         out.joints.setdefault(ref, []).append(_text(_rebodied(elem, robot, frames)))
 
@@ -210,6 +213,12 @@ def _rebodied(elem, robot: Robot, frames: set[str]):
             for tag, v in (("xyzOffset", pose.xyz), ("rpyOffset", pose.rpy)):
                 ET.SubElement(plugin, tag).text = vec(v)
     return elem
+
+
+def _value(elem) -> str:
+    """A URDF <gazebo> tag's value: its ``value`` attribute when it has one (``<kp value="1e6"/>``),
+    else its text (libsdformat's GetKeyValueAsString)."""
+    return (elem.get("value") if elem.get("value") is not None else elem.text or "").strip()
 
 
 def _link_tag(tag: str, value: str) -> str:

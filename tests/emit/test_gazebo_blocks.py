@@ -43,7 +43,8 @@ urdf_extras:
   - >-
     <gazebo reference="wheel"><mu1>0.8</mu1><mu2>0.7</mu2><fdir1>1 0 0</fdir1><maxVel>0.1</maxVel>
     <maxContacts>4</maxContacts><material>Gazebo/Black</material><turnGravityOff>true</turnGravityOff>
-    <dampingFactor>0.01</dampingFactor>
+    <dampingFactor>0.01</dampingFactor><kp value="1000000.0"/><kd>1</kd>
+    <visual><plugin filename="draw.so" name="draw"/></visual>
     <sensor name="wheel_imu" type="imu"><pose>0 0 0.01 0 0 0</pose></sensor></gazebo>
   - >-
     <gazebo reference="wheel_joint"><provideFeedback>true</provideFeedback><stopErp>0.2</stopErp>
@@ -85,6 +86,10 @@ def test_gazebo_blocks_go_where_libsdformat_puts_them(blocks, tmp_path):
     assert [(e.tag, e.text) for e in collision.find("surface/friction/ode")] == [
         ("mu", "0.8"), ("mu2", "0.7"), ("fdir1", "1 0 0")]
     assert collision.findtext("surface/contact/ode/max_vel") == "0.1"
+    # a tag's value attribute is its value (<kp value="1e6"/>, as libsdformat reads it)
+    assert (collision.findtext("surface/contact/ode/kp"), collision.findtext("surface/contact/ode/kd")) == (
+        "1000000.0", "1")
+    assert "draw.so" not in text  # a <visual> block: listed (test_only_what_cannot_be_carried_is_a_loss)
     assert collision.findtext("max_contacts") == "4"
     assert link["wheel"].findtext("visual/material/script/name") == "Gazebo/Black"
     assert link["base"].find("visual/material") is None
@@ -106,6 +111,8 @@ def test_only_what_cannot_be_carried_is_a_loss(blocks):
     assert [x for x in losses(blocks) if "gazebo" in x or "urdf_extras" in x] == [
         "<gazebo reference=\"imu_link\">: <gravity> not in model.sdf: 'imu_link' is a frame there (massless, "
         "fixed), carried by 'base'",
+        "<gazebo reference=\"wheel\">: <visual> not in model.sdf: the SDF visuals are the recipe's, named by "
+        "robotkit",
         "<gazebo reference=\"wheel_joint\">: <springStiffness> not in model.sdf: model.sdf writes the recipe's "
         "joint dynamics",
         "<gazebo reference=\"nowhere\">: <sensor> not in model.sdf: 'nowhere' names no link or joint of the robot",
