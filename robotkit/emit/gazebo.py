@@ -122,6 +122,9 @@ def _carry(robot: Robot, ET) -> Carried:
 
 
 def _to_model(out: Carried, elem, robot: Robot, frames: set[str]) -> None:
+    if elem.tag not in MODEL_CHILDREN:
+        out.losses.append(f"<gazebo>: <{elem.tag}> not in model.sdf: an SDF model has no <{elem.tag}>")
+        return
     if elem.tag in MODEL_OWN and (robot.self_collide is not None or robot.collision_matrix is not None):
         out.losses.append(f"<gazebo>: <{elem.tag}> not in model.sdf: its self-collision comes from the recipe "
                           "(self_collide, the self-collision matrix)")
@@ -149,8 +152,12 @@ def _to_link(out: Carried, ref: str, elem, robot: Robot, frames: set[str]) -> No
                               f"'{ref}' is a frame there (massless, fixed), carried by '{host_of(robot, ref)[0]}'")
         else:
             out.links.setdefault(ref, []).append(_link_tag(elem.tag, value))
+    elif elem.tag not in LINK_CHILDREN:  # libsdformat copies it with a warning; Drake refuses the file
+        out.losses.append(f'<gazebo reference="{ref}">: <{elem.tag}> not in model.sdf: an SDF link has no '
+                          f"<{elem.tag}>")
     else:
         elem = _rebodied(elem, robot, frames)
+        out.losses += [f'<gazebo reference="{ref}">: {x}' for x in _outdated(elem)]
         host = ref
         if ref in frames:
             host = host_of(robot, ref)[0]
@@ -213,6 +220,29 @@ def _rebodied(elem, robot: Robot, frames: set[str]):
             for tag, v in (("xyzOffset", pose.xyz), ("rpyOffset", pose.rpy)):
                 ET.SubElement(plugin, tag).text = vec(v)
     return elem
+
+
+LINK_CHILDREN = {"sensor", "projector", "audio_sink", "audio_source", "battery", "light", "particle_emitter",
+                 "enable_wind", "must_be_base_link"}
+"""What a <gazebo reference="link"> block may add to an SDF 1.9 link as it is (libsdformat's
+link.sdf; the link tags of LINK_TAGS are translated)."""
+MODEL_CHILDREN = {"static", "self_collide", "allow_auto_disable", "enable_wind", "plugin", "gripper", "frame",
+                  "include", "model"}
+"""What a <gazebo> block without reference may add to an SDF 1.9 model (libsdformat's model.sdf)."""
+OUTDATED = {("imu", "noise"): "SDF 1.5 moved an IMU's noise into <angular_velocity> and <linear_acceleration>"}
+"""(parent, child) elements of Gazebo classic's old sensor syntax that today's SDF does not define
+(libsdformat only warns, Drake refuses the file): dropped from a carried sensor, and listed."""
+
+
+def _outdated(elem) -> list[str]:
+    """Remove the OUTDATED elements below ``elem`` (a carried <sensor>); what was removed."""
+    said = []
+    for (parent, child), why in OUTDATED.items():
+        for node in list(elem.iter(parent)):
+            for old in node.findall(child):
+                node.remove(old)
+                said.append(f"<{elem.tag} name=\"{elem.get('name', '')}\">: <{parent}><{child}> not in model.sdf: {why}")
+    return said
 
 
 def _value(elem) -> str:

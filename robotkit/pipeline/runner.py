@@ -171,7 +171,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         result.errors.append(("doit", "\n".join(recorder.runtime_errors)))
     published = _publish(out, robots, tasks, result, recorder)
     if result.failed and not keep_going:
-        raise _failure(result)
+        raise _failure(result, {robot.name: str(loaded.file) for loaded, robot in robots})
     if rc not in (0,) and not result.errors and not result.failed:
         result.errors.append(("doit", f"doit exited with status {rc}"))
     warnings = build_warnings(robots, out)  # (text, file:line: key: warning: text) pairs
@@ -209,16 +209,19 @@ def run_doit(tasks: list[dict], out: Path, recorder: "_Recorder", jobs: int = 1)
         recorder.progress.clear()  # no progress line left behind, whatever happened
 
 
-def _failure(result: BuildResult) -> RobotkitError:
-    """The failed tasks' user errors as one error (each line once), with their exit status."""
+def _failure(result: BuildResult, recipes: dict[str, str]) -> RobotkitError:
+    """The failed tasks' user errors as one error (each line once), with their exit status; the
+    files left out of a robot's folder named after its recipe (``recipes``: robot -> file)."""
     lines = []
     for _, msg in result.failed:
         for line in msg.splitlines():
             if line not in lines:
                 lines.append(line)
+    problems = [Problem(line) for line in lines]
     for robot, files in result.left_out.items():
-        lines.append(f"{robot}: left out (refused by a consumer, or naming a file that is): " + ", ".join(files))
-    error = RobotkitError([Problem(line) for line in lines])
+        problems.append(Problem(f"{robot}: left out (refused by a consumer, or naming a file that is): "
+                                + ", ".join(files), file=recipes.get(robot)))
+    error = RobotkitError(problems)
     error.exit_status = result.exit_status or 2
     return error
 

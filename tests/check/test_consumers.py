@@ -178,7 +178,7 @@ def test_a_robot_a_consumer_refuses_fails_the_build_naming_the_link(tmp_path):
         "robot.yaml:5: links.forearm: link 'forearm' moves (joint 'elbow') but has no mass: MuJoCo refuses to "
         "load it and Gazebo drops it with everything below it; give it an inertial (links.forearm.inertial: "
         "{mass: ...}, or geometry and a density)",
-        "arm: left out (refused by a consumer, or naming a file that is): " + ", ".join(
+        "robot.yaml: arm: left out (refused by a consumer, or naming a file that is): " + ", ".join(
             f"arm/{f}" for f in ("urdf/arm.urdf", "urdf/arm.urdf.xacro", "model.sdf", "mjcf/arm.xml", "mjcf/scene.xml",
                                  "srdf/arm.srdf", "model.config", "package.xml", "CMakeLists.txt", "hooks/arm.dsv.in",
                                  "launch/display.launch.py", "launch/gazebo.launch.py", "rviz/arm.rviz",
@@ -207,7 +207,7 @@ def test_a_chain_of_1000_links(tmp_path):
     assert problems == [
         "chain.yaml:1002: links.l999: link 'l999' sits 1000 links deep: MuJoCo's XML reader stops at 496 nested "
         "bodies, so it could not load the MJCF (a body per link); make the chain shorter",
-        "chain: left out (refused by a consumer, or naming a file that is): chain/mjcf/chain.xml, "
+        "chain.yaml: chain: left out (refused by a consumer, or naming a file that is): chain/mjcf/chain.xml, "
         "chain/mjcf/scene.xml, chain/report/report.html"]
     b = build_of(tmp_path / "out", "chain")
     assert b.urdf.is_file() and b.sdf.is_file() and not b.mjcf.exists() and not b.dir.joinpath("mjcf").exists()

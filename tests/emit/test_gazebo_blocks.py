@@ -38,7 +38,8 @@ joints:
     axis: [0, 1, 0]
 urdf_extras:
   - >-
-    <gazebo reference="imu_link"><sensor name="imu" type="imu"><always_on>true</always_on></sensor>
+    <gazebo reference="imu_link"><sensor name="imu" type="imu"><always_on>true</always_on>
+    <imu><noise><type>gaussian</type></noise></imu></sensor>
     <gravity>false</gravity></gazebo>
   - >-
     <gazebo reference="wheel"><mu1>0.8</mu1><mu2>0.7</mu2><fdir1>1 0 0</fdir1><maxVel>0.1</maxVel>
@@ -109,6 +110,8 @@ def test_only_what_cannot_be_carried_is_a_loss(blocks):
     from robotkit.emit.sdf import losses
 
     assert [x for x in losses(blocks) if "gazebo" in x or "urdf_extras" in x] == [
+        "<gazebo reference=\"imu_link\">: <sensor name=\"imu\">: <imu><noise> not in model.sdf: SDF 1.5 moved an "
+        "IMU's noise into <angular_velocity> and <linear_acceleration>",
         "<gazebo reference=\"imu_link\">: <gravity> not in model.sdf: 'imu_link' is a frame there (massless, "
         "fixed), carried by 'base'",
         "<gazebo reference=\"wheel\">: <visual> not in model.sdf: the SDF visuals are the recipe's, named by "

@@ -288,7 +288,7 @@ def test_a_recipe_with_a_massless_welded_link_above_a_moving_joint_builds_no_urd
     assert proc.stderr.splitlines() == [
         "robot.yaml:4: links.mount: link 'mount' has no mass, nor the links welded below it, and joint 'slide' moves "
         "below it: Gazebo's URDF conversion drops everything that moves below it; give links.mount an inertial",
-        "gripper: left out (refused by a consumer, or naming a file that is): " + ", ".join(
+        "robot.yaml: gripper: left out (refused by a consumer, or naming a file that is): " + ", ".join(
             f"gripper/{f}" for f in ("urdf/gripper.urdf", "urdf/gripper.urdf.xacro", "srdf/gripper.srdf",
                                      "package.xml", "CMakeLists.txt", "hooks/gripper.dsv.in", "launch/display.launch.py",
                                      "launch/gazebo.launch.py", "rviz/gripper.rviz", "report/report.html"))]

@@ -70,7 +70,7 @@ def test_a_refused_robot_publishes_no_file_naming_a_missing_one(tmp_path):
         "m.yaml:4: links.a: link 'a' is the root and has no mass, nor the links welded to it ('b'): Gazebo's URDF "
         "conversion drops it and everything below it (an empty model); name the root 'world' to fix the robot to "
         "the world, or give links.a an inertial",
-        "m: left out (refused by a consumer, or naming a file that is): " + ", ".join(f"m/{f}" for f in left)]
+        "m.yaml: m: left out (refused by a consumer, or naming a file that is): " + ", ".join(f"m/{f}" for f in left)]
     robot = tmp_path / "out" / "m"
     assert files(robot) == {"mjcf/m.xml", "mjcf/scene.xml", "report.json"}
     assert dangling(robot, every) == []
