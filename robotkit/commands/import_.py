@@ -1,12 +1,15 @@
 """``robotkit import FILE [--package-path PKG=DIR]... [--arg NAME:=VALUE]... -o RECIPE.yaml``:
-a URDF or xacro file into a recipe (:func:`robotkit.importer.import_file`)."""
+a URDF or xacro file into a recipe (:func:`robotkit.importer.import_file`), or an MJCF file
+(:func:`robotkit.importer.import_mjcf`, verified by building the recipe in a temporary folder)."""
 
 from __future__ import annotations
 
 import os
 import shlex
 import sys
+from pathlib import Path
 
+from robotkit.commands.inputs import SUFFIXES
 from robotkit.importer import import_file
 
 NOTES = ("metadata from ",)
@@ -14,6 +17,8 @@ NOTES = ("metadata from ",)
 
 
 def run(args) -> int:
+    if SUFFIXES.get(Path(args.file).suffix.lower()) == "mjcf":
+        return run_mjcf(args)
     if args.density is not None and not args.recompute_inertials:
         print("robotkit: error: --density needs --recompute-inertials", file=sys.stderr)
         return 2
@@ -32,3 +37,29 @@ def run(args) -> int:
     print(f"wrote {recipe} (robot {result.robot}); build it with:")
     print(f"robotkit build {shlex.quote(recipe)}")
     return 0
+
+
+def build_mjcf(recipe: Path, folder: str) -> Path:
+    """Build ``recipe`` into ``folder`` (no report); the rebuilt MJCF's path."""
+    from robotkit.emit.layout import robot_layout
+    from robotkit.pipeline.runner import build
+
+    result = build([recipe], folder, report=False)
+    return robot_layout(Path(folder) / result.robots[0]).mjcf
+
+
+def run_mjcf(args) -> int:
+    """An MJCF import: the ledger and the verification printed; 1 when the rebuild disagrees."""
+    from robotkit.importer import import_mjcf
+
+    result = import_mjcf(args.file, args.output, build=build_mjcf)
+    for line in result.notes:
+        print(f"note: {line}", file=sys.stderr)
+    for line in result.ledger:
+        print(f"ledger: {line}", file=sys.stderr)
+    for line in result.verdict.lines():
+        print(line)
+    recipe = os.path.relpath(result.recipe_path)
+    print(f"wrote {recipe} (robot {result.robot}); build it with:")
+    print(f"robotkit build {shlex.quote(recipe)}")
+    return 0 if result.verdict.ok else 1

@@ -279,3 +279,10 @@ def _element_lines(urdf_text: str) -> dict[tuple[str, str], int]:
         return {}
     return {(tag + "s", e.get("name")): e.sourceline for tag in ("link", "joint") for e in root.iter(tag)
             if e.get("name")}
+
+
+def import_mjcf(path, out_recipe, build=None):
+    """Import an MJCF file (robotkit.importer.mjcf.import_mjcf: MuJoCo is imported on first use)."""
+    from robotkit.importer.mjcf import import_mjcf as _import
+
+    return _import(path, out_recipe, build)

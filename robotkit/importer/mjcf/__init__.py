@@ -1,0 +1,132 @@
+"""Import an MJCF file into a recipe (``robotkit import model.xml``), read through MuJoCo.
+
+    model.xml ──MuJoCo (MjSpec, compiled MjModel)──▶ links, joints, shapes, inertials,
+    actuators, poses, excludes, mimics ──▶ RECIPE.yaml (+ a ledger of what it cannot hold)
+
+:func:`import_mjcf` is the entry point.  What the recipe cannot hold is on the ledger (one line
+per element: where, what, which formats, what happened), printed and in the recipe's header.
+With a ``build`` (recipe, folder -> the rebuilt MJCF), the recipe is built in a temporary
+folder and the rebuilt MJCF compared with the original in MuJoCo
+(:mod:`robotkit.importer.mjcf.verify`); the result is in the header too.  Nothing is written
+when MuJoCo refuses the file or the recipe would be invalid."""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from pydantic import ValidationError
+
+from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.importer.defaults import factor_defaults
+from robotkit.importer.mjcf.actuators import add_actuators
+from robotkit.importer.mjcf.extras import add_equalities, add_excludes, add_poses, ledger_rest
+from robotkit.importer.mjcf.geoms import add_geoms
+from robotkit.importer.mjcf.inertials import add_inertials
+from robotkit.importer.mjcf.ledger import Ledger
+from robotkit.importer.mjcf.source import read
+from robotkit.importer.mjcf.tree import build_tree
+from robotkit.importer.mjcf.verify import Verdict, verify
+from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
+from robotkit.model.load import load_robots
+from robotkit.paths import recipe_policy, widened
+from robotkit.recipe.schema import Recipe
+
+
+@dataclass
+class MjcfImport:
+    recipe_path: Path
+    robot: str
+    ledger: list[str] = field(default_factory=list)
+    verdict: Verdict | None = None
+    inputs: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, object]:
+    """(recipe dict, ledger, the source, the link tree) of an MJCF file."""
+    src = read(path)
+    ledger = Ledger()
+    tree = build_tree(src, ledger)
+    materials: dict = {}
+    add_geoms(src, tree, out, ledger, materials)
+    add_inertials(src, tree)
+    recipe: dict = {"robot": _robot_name(src)}
+    if tree.base == "free":
+        recipe["base"] = "free"
+    add_actuators(src, tree, recipe, ledger)
+    add_equalities(src, tree, recipe, ledger)
+    add_poses(src, tree, recipe, ledger)
+    add_excludes(src, tree, recipe, ledger)
+    ledger_rest(src, tree, ledger)
+    if materials:
+        recipe["materials"] = materials
+    recipe["links"], recipe["joints"] = tree.links, tree.joints
+    return recipe, ledger, src, tree
+
+
+def _robot_name(src) -> str:
+    name = re.sub(r"[^A-Za-z0-9_.\-]", "_", src.spec.modelname or src.path.stem)
+    return name if re.match(r"[A-Za-z_]", name) else "_" + name
+
+
+def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=None) -> MjcfImport:
+    """Import the MJCF file ``path`` into ``out_recipe``; ``build(recipe, folder)`` builds a
+    recipe into a folder and returns the rebuilt MJCF's path (the verification's)."""
+    out = Path(out_recipe).absolute()
+    recipe, ledger, src, tree = convert(path, out)
+    name_mesh_folders(recipe)
+    _validate(recipe, src.path)
+    factor_defaults(recipe)
+    comments = {"links": {n: "a massless link of a body's joint chain (MuJoCo moves a body through its joints in "
+                          "order): a point mass of a millionth of the lightest body, as MuJoCo needs"
+                          for n in tree.chain_links}}
+    header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (MJCF, "
+              "read through MuJoCo: inertials, shapes and poses as MuJoCo compiled them)"] + _ledger_block(ledger)
+    files = [str(src.mesh_file(d)) for d in range(src.model.nmesh) if src.mesh_file(d) is not None]
+    read = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
+    notes = [f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: build it "
+             f"with --root {display_path(os.path.commonpath(read))}"] if read else []
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.tmp")
+    try:
+        with widened(read):  # the original's meshes, where they are
+            tmp.write_text(dump_recipe(recipe, header, comments), encoding="utf-8")
+            load_robots([tmp])
+            verdict = _verified(src, tree, tmp, build)
+        if verdict is not None:
+            tmp.write_text(dump_recipe(recipe, header + verdict.lines(), comments), encoding="utf-8")
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    os.replace(tmp, out)
+    return MjcfImport(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes)
+
+
+def _verified(src, tree, recipe: Path, build) -> Verdict | None:
+    if build is None:
+        return None
+    with tempfile.TemporaryDirectory(prefix="robotkit-import-") as folder:
+        return verify(src, tree, build(recipe, folder))
+
+
+def _ledger_block(ledger: Ledger) -> list[str]:
+    if not len(ledger):
+        return ["ledger: nothing of the original is lost"]
+    lines = [f"ledger: {len(ledger)} element{'s' if len(ledger) > 1 else ''} of the original not carried unchanged "
+             "(where: element: formats: what happened)"]
+    for line in ledger.lines():
+        lines.extend("  " + part for part in wrap(line, 110))
+    return lines
+
+
+def _validate(recipe: dict, source: Path) -> None:
+    try:
+        Recipe.model_validate(recipe)
+    except ValidationError as exc:
+        problems = [Problem(f"the imported recipe would be invalid: {'.'.join(str(p) for p in err['loc'])}: "
+                            f"{err['msg']}", file=str(source)) for err in exc.errors(include_url=False)]
+        raise RobotkitError(problems) from None

@@ -1,0 +1,113 @@
+"""Keyframes as named poses, ``<contact><exclude>`` as self-collision pairs never checked,
+joint equalities as mimic joints, and the ledger lines of everything the recipe has no key for
+(tendons, other equality constraints, sensors, sites, cameras, lights, flexes, joint springs)."""
+
+from __future__ import annotations
+
+import math
+
+from robotkit.importer.mjcf.frames import quat_matrix
+from robotkit.importer.names import valid_name
+
+FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
+EQ_KINDS = {0: "connect", 1: "weld", 2: "joint", 3: "tendon", 4: "flex"}
+
+
+def ball_angles(q) -> list[float]:
+    """The angles (x, y, z) of the three revolute joints a ball joint becomes: R = Rx Ry Rz."""
+    R = quat_matrix(q)
+    b = math.asin(max(-1.0, min(1.0, float(R[0, 2]))))
+    return [math.atan2(-float(R[1, 2]), float(R[2, 2])), b, math.atan2(-float(R[0, 1]), float(R[0, 0]))]
+
+
+def joint_values(m, tree, qpos) -> dict[str, float]:
+    """The recipe joints' values at a MuJoCo configuration (free joints left out)."""
+    out = {}
+    for j, names in tree.joint_map.items():
+        adr, t = int(m.jnt_qposadr[j]), int(m.jnt_type[j])
+        if t in (HINGE, SLIDE):
+            out[names[0]] = float(qpos[adr])
+        elif t == BALL:
+            out.update(zip(names, ball_angles(qpos[adr:adr + 4])))
+    return out
+
+
+def add_poses(src, tree, recipe: dict, ledger) -> None:
+    m = src.model
+    poses, keys = {}, list(src.spec.keys)
+    for k in range(m.nkey):
+        name = m.key(k).name
+        name = name if valid_name(name) and name not in poses else f"key{k}"
+        where = src.where(keys[k]) if k < len(keys) else src.where()
+        values = {j: v for j, v in joint_values(m, tree, m.key_qpos[k]).items() if v != 0}
+        poses[name] = values
+        if any(int(m.jnt_type[j]) == FREE for j in range(m.njnt)):
+            ledger.add(where, f"keyframe '{name}'", "all", "the free joint's position and orientation dropped "
+                       "(a pose holds joint values)")
+        if m.nu and any(m.key_ctrl[k]):
+            ledger.add(where, f"keyframe '{name}'", "all", "ctrl dropped (the MJCF keyframe's ctrl is the pose's "
+                       "position targets)")
+        if m.key_time[k] or m.na and any(m.key_act[k]) or m.nmocap:
+            ledger.add(where, f"keyframe '{name}'", "all", "time, act or mocap dropped")
+    if poses:
+        recipe["poses"] = poses
+
+
+def add_excludes(src, tree, recipe: dict, ledger) -> None:
+    m = src.model
+    link_by_body = {m.body(b).name: tree.link_of[b] for b in range(m.nbody) if b in tree.link_of}
+    pairs = []
+    for e in src.spec.excludes:
+        a, b = link_by_body.get(e.bodyname1), link_by_body.get(e.bodyname2)
+        if a is None or b is None:
+            ledger.add(src.where(e), f"exclude {e.bodyname1} {e.bodyname2}", "all", "dropped: a body not imported")
+            continue
+        pairs.append([a, b, "MJCF <contact><exclude>"])
+    if pairs:
+        recipe["self_collision"] = {"allow": pairs}
+
+
+def add_equalities(src, tree, recipe: dict, ledger) -> None:
+    m = src.model
+    eqs = list(src.spec.equalities)
+    for e in range(m.neq):
+        t = int(m.eq_type[e])
+        name = m.eq(e).name or f"equality {e}"
+        where = src.where(eqs[e]) if e < len(eqs) else src.where()
+        a, b = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+        coef = [float(v) for v in m.eq_data[e][:5]]
+        if t == 2 and b >= 0 and not any(coef[2:]) and bool(m.eq_active0[e]) and _one_dof(m, a, b):
+            child, leader = tree.joint_map[a][0], tree.joint_map[b][0]
+            mimic = {"joint": leader}
+            if coef[1] != 1:
+                mimic["multiplier"] = coef[1]
+            if coef[0]:
+                mimic["offset"] = coef[0]
+            tree.joints[child]["mimic"] = mimic
+            continue
+        ledger.add(where, f"equality {EQ_KINDS.get(t, t)} '{name}'", "all",
+                   "dropped: the recipe has no loop closures or couplings of this kind")
+
+
+def _one_dof(m, a: int, b: int) -> bool:
+    return all(int(m.jnt_type[j]) in (HINGE, SLIDE) for j in (a, b))
+
+
+def ledger_rest(src, tree, ledger) -> None:
+    """What the recipe has no key for, one line each."""
+    spec, m = src.spec, src.model
+    for kind, what in (("tendon", "tendon"), ("sensor", "sensor"), ("site", "site"), ("camera", "camera"),
+                       ("light", "light"), ("flex", "flex"), ("skin", "skin"), ("pair", "contact pair"),
+                       ("hfield", "height field"), ("text", "custom text"), ("numeric", "custom numeric")):
+        for e in getattr(spec, "flexes" if kind == "flex" else kind + "s", []):
+            label = f"{what} '{e.name}'" if e.name else what
+            ledger.add(src.where(e), label, "all", "dropped: the recipe has no " + what + "s"
+                       + (" (sites are frames: none in the recipe)" if kind == "site" else ""))
+    for j in range(m.njnt):
+        if m.jnt_stiffness[j]:
+            ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}'", "all",
+                       f"spring dropped (stiffness {float(m.jnt_stiffness[j]):g}): the recipe has no joint springs")
+        if int(m.jnt_type[j]) == BALL:
+            ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}' (ball)", "all",
+                       "approximated: three revolute joints about the body's x, y, z through two massless links"
+                       + (" (its cone limit as each angle's range)" if m.jnt_limited[j] else ""))

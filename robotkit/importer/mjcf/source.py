@@ -1,0 +1,78 @@
+"""Reading an MJCF file through MuJoCo itself: the compiled model (default classes,
+``childclass``, mesh scale, ``fromto``, frames and compiler options resolved as MuJoCo resolves
+them) and its MjSpec (file names, source lines).  A file MuJoCo refuses is one problem with its
+file and line, nothing else read."""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from robotkit import mj
+from robotkit.errors import Problem, RobotkitError
+
+_LINE = re.compile(r"line (\d+)")
+
+
+@dataclass
+class Source:
+    path: Path
+    spec: object  # mujoco.MjSpec
+    model: object  # mujoco.MjModel
+    textured_noted: set = field(default_factory=set)
+
+    def line(self, element) -> int | None:
+        """The source line MuJoCo recorded for a spec element (``info``: 'line 26')."""
+        found = _LINE.search(getattr(element, "info", "") or "")
+        return int(found.group(1)) if found else None
+
+    def where(self, element=None) -> str:
+        """``file:line`` of an element (the file alone when MuJoCo gives no line)."""
+        line = self.line(element) if element is not None else None
+        return f"{self.path.name}:{line}" if line else self.path.name
+
+
+    def where_named(self, kind: str, name: str) -> str:
+        """``file:line`` of the spec element ``kind`` (body, geom, material...) called ``name``."""
+        for element in getattr(self.spec, kind + "s", []):
+            if element.name == name:
+                return self.where(element)
+        return self.where()
+
+    def geom_where(self, g: int) -> str:
+        geoms = list(self.spec.geoms)
+        return self.where(geoms[g]) if g < len(geoms) and geoms[g].name == self.model.geom(g).name else self.where()
+
+    def mesh_file(self, d: int) -> Path | None:
+        """The file of compiled mesh ``d`` (None for a mesh given by its vertices)."""
+        name = self.model.mesh(d).name
+        mesh = next((e for e in self.spec.meshes if e.name == name), None)
+        if mesh is None or not mesh.file:
+            return None
+        folder = Path(self.spec.modelfiledir or self.path.parent) / (self.spec.meshdir or "")
+        return (folder / mesh.file).resolve()
+
+
+def refused(path: Path, message: str) -> RobotkitError:
+    """MuJoCo's refusal as one line: its first line, at the line it names."""
+    first = message.strip().splitlines()[0] if message.strip() else "MuJoCo refused the file"
+    first = re.sub(r"^(XML )?Error:\s*", "", first)
+    found = _LINE.search(message)
+    return RobotkitError(Problem(f"MuJoCo refuses the file: {first}", file=str(path),
+                                 line=int(found.group(1)) if found else None))
+
+
+def read(path: str | os.PathLike) -> Source:
+    """The file's MjSpec and compiled MjModel; RobotkitError (one line) when MuJoCo refuses it."""
+    source = Path(path).absolute()
+    if not source.is_file():
+        raise RobotkitError(Problem("file not found", file=str(source)))
+    mujoco = mj.load()
+    try:
+        spec = mujoco.MjSpec.from_file(str(source))
+        model = spec.compile()
+    except ValueError as exc:
+        raise refused(source, str(exc)) from None
+    return Source(source, spec, model)
