@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 import re
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from pydantic import ValidationError
@@ -95,7 +95,7 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
     try:
         with widened(read):  # the original's meshes, where they are
             tmp.write_text(dump_recipe(recipe, header, comments), encoding="utf-8")
-            load_robots([tmp])
+            _resolves(tmp, src.path)
             verdict = _verified(src, tree, tmp, build)
         if verdict is not None:
             tmp.write_text(dump_recipe(recipe, header + verdict.lines(), comments), encoding="utf-8")
@@ -111,6 +111,15 @@ def _verified(src, tree, recipe: Path, build) -> Verdict | None:
         return None
     with tempfile.TemporaryDirectory(prefix="robotkit-import-") as folder:
         return verify(src, tree, build(recipe, folder))
+
+
+def _resolves(recipe: Path, source: Path) -> None:
+    """Load and resolve the written recipe as the build will; problems name the MJCF file."""
+    try:
+        load_robots([recipe])
+    except RobotkitError as exc:
+        raise RobotkitError([replace(p, file=str(source), line=None) if p.file == str(recipe) else p
+                             for p in exc.problems]) from None
 
 
 def _ledger_block(ledger: Ledger) -> list[str]:

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from robotkit.importer.mjcf.frames import quat_matrix
 from robotkit.importer.names import valid_name
 
@@ -39,18 +41,43 @@ def add_poses(src, tree, recipe: dict, ledger) -> None:
         name = m.key(k).name
         name = name if valid_name(name) and name not in poses else f"key{k}"
         where = src.where(keys[k]) if k < len(keys) else src.where()
-        values = {j: v for j, v in joint_values(m, tree, m.key_qpos[k]).items() if v != 0}
-        poses[name] = values
+        values = joint_values(m, tree, m.key_qpos[k])
+        _mimics_followed(tree, values, where, name, ledger)
+        poses[name] = {j: v for j, v in values.items() if v != 0}
         if any(int(m.jnt_type[j]) == FREE for j in range(m.njnt)):
             ledger.add(where, f"keyframe '{name}'", "all", "the free joint's position and orientation dropped "
                        "(a pose holds joint values)")
-        if m.nu and any(m.key_ctrl[k]):
+        if m.nu and not _ctrl_is_targets(m, tree, recipe, k):
             ledger.add(where, f"keyframe '{name}'", "all", "ctrl dropped (the MJCF keyframe's ctrl is the pose's "
                        "position targets)")
         if m.key_time[k] or m.na and any(m.key_act[k]) or m.nmocap:
             ledger.add(where, f"keyframe '{name}'", "all", "time, act or mocap dropped")
     if poses:
         recipe["poses"] = poses
+
+
+def _mimics_followed(tree, values: dict, where: str, pose: str, ledger) -> None:
+    """Drop the values of mimic joints (the pose's leaders set them); one that disagrees is on the ledger."""
+    for name, joint in tree.joints.items():
+        mimic = joint.get("mimic")
+        if mimic is None or name not in values:
+            continue
+        given = values.pop(name)
+        follows = mimic.get("multiplier", 1.0) * values.get(mimic["joint"], 0.0) + mimic.get("offset", 0.0)
+        if abs(given - follows) > 1e-9:
+            ledger.add(where, f"keyframe '{pose}'", "all", f"joint '{name}' at {given:g}, written as its mimic's "
+                       f"{follows:g}")
+
+
+def _ctrl_is_targets(m, tree, recipe: dict, k: int) -> bool:
+    """Whether a keyframe's ctrl is what the rebuilt keyframe writes: each position servo's joint value."""
+    values = joint_values(m, tree, m.key_qpos[k])
+    expected = []
+    for a in range(m.nu):
+        joint = tree.joint_map.get(int(m.actuator_trnid[a][0]), [None])[0] if m.actuator_trntype[a] == 0 else None
+        act = recipe.get("actuators", {}).get(joint)
+        expected.append(values.get(joint, 0.0) if act and act["interface"] == "position" else float(m.key_ctrl[k][a]))
+    return bool(abs(np.array(expected) - m.key_ctrl[k]).max() <= 1e-9)
 
 
 def add_excludes(src, tree, recipe: dict, ledger) -> None:
@@ -72,20 +99,25 @@ def add_equalities(src, tree, recipe: dict, ledger) -> None:
     eqs = list(src.spec.equalities)
     for e in range(m.neq):
         t = int(m.eq_type[e])
-        name = m.eq(e).name or f"equality {e}"
+        name = m.eq(e).name
         where = src.where(eqs[e]) if e < len(eqs) else src.where()
         a, b = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
         coef = [float(v) for v in m.eq_data[e][:5]]
         if t == 2 and b >= 0 and not any(coef[2:]) and bool(m.eq_active0[e]) and _one_dof(m, a, b):
+            actuated = set(recipe.get("actuators", {}))
             child, leader = tree.joint_map[a][0], tree.joint_map[b][0]
-            mimic = {"joint": leader}
-            if coef[1] != 1:
-                mimic["multiplier"] = coef[1]
-            if coef[0]:
-                mimic["offset"] = coef[0]
-            tree.joints[child]["mimic"] = mimic
-            continue
-        ledger.add(where, f"equality {EQ_KINDS.get(t, t)} '{name}'", "all",
+            if child in actuated and leader not in actuated and coef[1]:  # the driven joint leads
+                child, leader, coef = leader, child, [-coef[0] / coef[1], 1 / coef[1]]
+            if child not in actuated and "mimic" not in tree.joints[leader]:
+                mimic = {"joint": leader}
+                if coef[1] != 1:
+                    mimic["multiplier"] = coef[1]
+                if coef[0]:
+                    mimic["offset"] = coef[0]
+                tree.joints[child]["mimic"] = mimic
+                continue
+        label = f"equality {EQ_KINDS.get(t, t)}" + (f" '{name}'" if name else f" #{e}")
+        ledger.add(where, label, "all",
                    "dropped: the recipe has no loop closures or couplings of this kind")
 
 
@@ -109,5 +141,6 @@ def ledger_rest(src, tree, ledger) -> None:
                        f"spring dropped (stiffness {float(m.jnt_stiffness[j]):g}): the recipe has no joint springs")
         if int(m.jnt_type[j]) == BALL:
             ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}' (ball)", "all",
-                       "approximated: three revolute joints about the body's x, y, z through two massless links"
+                       "approximated: three revolute joints about the body's x, y, z through two massless links; "
+                       "its armature, damping and friction act on each angle, not on the angular velocity"
                        + (" (its cone limit as each angle's range)" if m.jnt_limited[j] else ""))

@@ -25,8 +25,10 @@ KINDS = {PLANE: "plane", HFIELD: "hfield", SPHERE: "sphere", CAPSULE: "capsule",
 SHOWN_GROUPS = (0, 1, 2)
 
 
-def geom_name(m, g: int) -> str:
-    return m.geom(g).name or f"geom {g}"
+def geom_label(m, g: int, kind: str = "") -> str:
+    """``geom 'name' (kind)``, or ``geom #id (kind)`` for an unnamed one."""
+    name = m.geom(g).name
+    return (f"geom '{name}'" if name else f"geom #{g}") + (f" ({kind})" if kind else "")
 
 
 def add_geoms(src, tree, out: Path, ledger, materials: dict) -> None:
@@ -38,14 +40,14 @@ def add_geoms(src, tree, out: Path, ledger, materials: dict) -> None:
         b = int(m.geom_bodyid[g])
         link = tree.link_of.get(b)
         if link is None:
-            ledger.add(src.geom_where(g), f"geom '{geom_name(m, g)}'", "all", "dropped: a shape of the world body "
+            ledger.add(src.geom_where(g), geom_label(m, g), "all", "dropped: a shape of the world body "
                        "(the recipe describes the robot)")
             continue
         collides = bool(m.geom_contype[g] or m.geom_conaffinity[g])
         shown = int(m.geom_group[g]) in SHOWN_GROUPS
         kind = KINDS.get(int(m.geom_type[g]), str(m.geom_type[g]))
         if not (collides or shown):
-            ledger.add(src.geom_where(g), f"geom '{geom_name(m, g)}' ({kind})", "all",
+            ledger.add(src.geom_where(g), geom_label(m, g, kind), "all",
                        f"dropped: group {int(m.geom_group[g])} and no contacts (neither seen nor colliding)")
             continue
         made = _shapes(src, g, tree.offset[b], out, ledger)
@@ -83,12 +85,12 @@ def _shapes(src, g: int, offset, out: Path, ledger) -> list[dict]:
         return [_at({"cylinder": {"radius": size[0], "length": 2 * size[1]}}, pos, R)] + [
             _at({"sphere": {"radius": size[0]}}, e, np.eye(3)) for e in ends]
     if t == ELLIPSOID:
-        ledger.add(src.geom_where(g), f"geom '{geom_name(m, g)}' (ellipsoid)", "all",
+        ledger.add(src.geom_where(g), geom_label(m, g, "ellipsoid"), "all",
                    "approximated: the box of its half-axes " + " ".join(f"{s:g}" for s in size))
         return [_at({"box": {"size": [2 * s for s in size]}}, pos, R)]
     if t == MESH:
         return _mesh(src, g, pos, R, out, ledger)
-    ledger.add(src.geom_where(g), f"geom '{geom_name(m, g)}' ({KINDS.get(t, t)})", "all",
+    ledger.add(src.geom_where(g), geom_label(m, g, KINDS.get(t, str(t))), "all",
                "dropped: the recipe has no such shape")
     return []
 
@@ -103,7 +105,7 @@ def _mesh(src, g: int, pos, R, out: Path, ledger) -> list[dict]:
     d = int(m.geom_dataid[g])
     file = src.mesh_file(d)
     if file is None:
-        ledger.add(src.geom_where(g), f"geom '{geom_name(m, g)}' (mesh '{m.mesh(d).name}')", "all",
+        ledger.add(src.geom_where(g), geom_label(m, g, f"mesh '{m.mesh(d).name}'"), "all",
                    "dropped: a mesh given by its vertices in the file (no mesh file to name)")
         return []
     back_p, back_R = inverse(m.mesh_pos[d], quat_matrix(m.mesh_quat[d]))

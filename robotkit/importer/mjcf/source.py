@@ -22,11 +22,31 @@ class Source:
     spec: object  # mujoco.MjSpec
     model: object  # mujoco.MjModel
     textured_noted: set = field(default_factory=set)
+    _lines: dict | None = None
 
     def line(self, element) -> int | None:
-        """The source line MuJoCo recorded for a spec element (``info``: 'line 26')."""
+        """The source line MuJoCo recorded for a spec element (``info``: 'line 26'), else the
+        line of the element of that name in the file's own text (a light scan)."""
         found = _LINE.search(getattr(element, "info", "") or "")
-        return int(found.group(1)) if found else None
+        if found:
+            return int(found.group(1))
+        name = getattr(element, "name", "")
+        return self.named_lines().get(name) if name else None
+
+    def named_lines(self) -> dict[str, int]:
+        """Line of each named element of the main file (the first of a name)."""
+        if self._lines is None:
+            from robotkit import urdfxml
+
+            try:
+                root = urdfxml.parse_text(self.path.read_text(encoding="utf-8")).getroot()
+                self._lines = {}
+                for e in root.iter():
+                    if urdfxml.is_element(e) and e.get("name"):
+                        self._lines.setdefault(e.get("name"), e.sourceline)
+            except (OSError, UnicodeDecodeError, urdfxml.MalformedXML):
+                self._lines = {}
+        return self._lines
 
     def where(self, element=None) -> str:
         """``file:line`` of an element (the file alone when MuJoCo gives no line)."""

@@ -4,7 +4,9 @@ A body is a link.  Its joints (hinge, slide) are the recipe's joints; a body wit
 joints becomes a chain through massless links, one per joint but the last, as MuJoCo moves a
 body through its joints in order.  A ball joint is three revolute joints (x, y, z of the body)
 through two massless links.  A free joint is the recipe's ``base: free`` (the only body of the
-world) or a floating joint from ``world``.  A hinge about an axis that misses the body's origin
+world) or a floating joint from ``world``; otherwise the recipe is rooted in a ``world`` link
+(the robot stays where the file puts it: a robot rooted elsewhere stands on the floor in the
+rebuilt MJCF).  A hinge about an axis that misses the body's origin
 puts the link frame on the axis: the body's contents are written in that frame (``offset``)."""
 
 from __future__ import annotations
@@ -57,8 +59,7 @@ def build_tree(src, ledger) -> Tree:
     tops = [b for b in range(1, m.nbody) if m.body_parentid[b] == 0]
     single = len(tops) == 1
     top = tops[0] if single else None
-    own_root = single and (m.body_jntnum[top] == 0 and _identity(m, top)
-                           or m.body_jntnum[top] == 1 and m.jnt_type[m.body_jntadr[top]] == FREE)
+    own_root = single and m.body_jntnum[top] == 1 and m.jnt_type[m.body_jntadr[top]] == FREE
     if own_root:
         tree.link_of[top] = bodies[top]
         tree.offset[top] = np.zeros(3)
@@ -75,10 +76,6 @@ def build_tree(src, ledger) -> Tree:
         if b not in tree.link_of:
             _body(src, tree, b, bodies, jnames, lightest * CHAIN_MASS)
     return tree
-
-
-def _identity(m, b) -> bool:
-    return not np.any(m.body_pos[b]) and np.allclose(m.body_quat[b], [1, 0, 0, 0])
 
 
 def _stages(m, b, jnames: list[str]) -> list[tuple[str, int, np.ndarray, np.ndarray, int]]:

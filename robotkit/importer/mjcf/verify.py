@@ -4,8 +4,9 @@ At the original's keyframes, its zero configuration and :data:`SAMPLES` seeded r
 (joints within their ranges, unlimited hinges within a turn, free and ball joints at random
 orientations), each configuration set on both models (a ball joint as its three angles), and
 compared: every original body's mass, centre of mass, inertia tensor (world axes) and frame
-pose; the total mass; the joint-space mass matrix (``mj_fullM``) and the bias forces at rest
-(gravity), the rebuilt ones mapped to the original's velocities.  Tolerances (:data:`TOL`):
+pose; the total mass (the point masses of joint chains' links apart); the joint-space mass
+matrix (``mj_fullM``, armature apart) and the bias forces at rest (gravity), the rebuilt ones
+mapped to the original's velocities; each hinge's and slide's armature.  Tolerances (:data:`TOL`):
 relative to the largest value of the same kind, plus an absolute floor for lengths."""
 
 from __future__ import annotations
@@ -48,7 +49,8 @@ def verify(src, tree, rebuilt_path) -> Verdict:
     od, rd = mujoco.MjData(om), mujoco.MjData(rm)
     verdict = Verdict(worst={k: (0.0, "") for k in TOL})
     configs = _configurations(om)
-    total_o, total_r = float(om.body_mass.sum()), float(rm.body_mass.sum())
+    chain = sum(float(rm.body_mass[rm.body(n).id]) for n in tree.chain_links)
+    total_o, total_r = float(om.body_mass.sum()), float(rm.body_mass.sum()) - chain
     _check(verdict, "mass", abs(total_o - total_r) / total_o if total_o else 0.0, "total mass")
     T = None
     for label, q in configs:
@@ -158,14 +160,23 @@ def _rot(axis: int, angle: float) -> np.ndarray:
 
 
 def _dynamics(verdict, mujoco, om, od, rm, rd, T, label: str) -> None:
+    """The rigid-body mass matrix (armature apart: a ball joint's acts on its angular velocity, the
+    three joints' on their angles, which the ledger says) and the gravity forces, and the armature
+    of every other joint."""
     Mo, Mr = np.zeros((om.nv, om.nv)), np.zeros((rm.nv, rm.nv))
     mujoco.mj_fullM(om, od, Mo)
     mujoco.mj_fullM(rm, rd, Mr)
-    chained = [i for i in range(rm.nv) if not T[:, i].any()]
-    keep = [i for i in range(rm.nv) if i not in chained]
-    expect = (T.T @ Mo @ T)[np.ix_(keep, keep)]
+    Mo -= np.diag(om.dof_armature)
+    Mr -= np.diag(rm.dof_armature)
+    expect = T.T @ Mo @ T
     scale = max(np.abs(expect).max(), 1e-300)
-    _check(verdict, "matrix", float(np.abs(expect - Mr[np.ix_(keep, keep)]).max() / scale), f"mass matrix at {label}")
+    _check(verdict, "matrix", float(np.abs(expect - Mr).max() / scale), f"mass matrix at {label}")
     go, gr = T.T @ od.qfrc_bias, rd.qfrc_bias
     scale = max(np.abs(go).max(), 1e-12)
-    _check(verdict, "matrix", float(np.abs(go[keep] - gr[keep]).max() / scale), f"gravity forces at {label}")
+    _check(verdict, "matrix", float(np.abs(go - gr).max() / scale), f"gravity forces at {label}")
+    single = [(i, r) for i in range(om.nv) for r in np.flatnonzero(T[i]) if np.count_nonzero(T[:, r]) == 1
+              and np.count_nonzero(T[i]) == 1 and om.jnt_type[om.dof_jntid[i]] in (SLIDE, HINGE)]
+    for i, r in single:
+        scale = max(float(om.dof_armature[i]), 1e-300)
+        _check(verdict, "matrix", abs(float(om.dof_armature[i] - rm.dof_armature[r])) / scale if om.dof_armature[i]
+               else float(rm.dof_armature[r]), f"armature of joint '{om.joint(int(om.dof_jntid[i])).name}'")
