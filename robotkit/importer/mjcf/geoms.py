@@ -122,14 +122,14 @@ def _material(src, g: int, materials: dict, ledger) -> str | None:
     m = src.model
     mat = int(m.geom_matid[g])
     if mat >= 0:
-        rgba = [float(v) for v in m.mat_rgba[mat]]
+        rgba = _colour(m.mat_rgba[mat])
         name = m.material(mat).name or f"material{mat}"
         if name not in src.textured_noted and int(m.mat_texid[mat].max()) >= 0:
             src.textured_noted.add(name)
             ledger.add(src.where_named("material", name), f"material '{name}'", "all",
                        "texture dropped: the recipe's material is a colour (its rgba kept)")
     else:
-        rgba = [float(v) for v in m.geom_rgba[g]]
+        rgba = _colour(m.geom_rgba[g])
         name = None
     for known, value in materials.items():
         if value["rgba"] == rgba and (name is None or known == name):
@@ -137,3 +137,9 @@ def _material(src, g: int, materials: dict, ledger) -> str | None:
     key = material_name(name or "rgba_" + "_".join(f"{v:g}" for v in rgba).replace(".", "p"), set(materials))
     materials[key] = {"rgba": rgba}
     return key
+
+
+def _colour(rgba) -> list[float]:
+    """MuJoCo keeps colours in float32: each as the shortest decimal that float32 reads back (0.690196,
+    not 0.6901959776878357), as the file wrote it."""
+    return [float(str(np.float32(v))) for v in rgba]

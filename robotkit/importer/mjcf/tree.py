@@ -150,8 +150,22 @@ def _joint(kind: str, parent: str, child: str, pos, R) -> dict:
     return out
 
 
+def _axis_rotation(axis, angle: float) -> np.ndarray:
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
 def _moving(src, t: int, parent: str, child: str, pos, R, axis, j: int) -> dict:
+    """A hinge or slide (or one angle of a ball).  MuJoCo places the body as the file does at the
+    joint's ``ref`` (qpos0), and moves it by the value minus ``ref``: the origin takes the move back
+    to the value 0, so the recipe's joint values are MuJoCo's (limits, keyframes)."""
     m = src.model
+    ref = float(m.qpos0[m.jnt_qposadr[j]]) if t in (HINGE, SLIDE) else 0.0
+    if ref and t == HINGE:
+        R = R @ _axis_rotation(axis, -ref)
+    elif ref:
+        pos = pos - R @ np.asarray(axis, float) * ref
     limited = bool(m.jnt_limited[j])
     lo, hi = (float(v) for v in m.jnt_range[j])
     if t == BALL:

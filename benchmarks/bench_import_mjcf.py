@@ -1,0 +1,96 @@
+"""MJCF import over the shared MuJoCo Menagerie set: per model, the import (read through MuJoCo,
+convert, write, and the verification's comparison in MuJoCo), the build of the recipe the
+verification makes, whether the rebuild agrees with the original, and the ledger's size; then
+the totals and the distribution.
+
+Every ``<model>/*.xml`` that is not a scene (``scene*.xml``) and holds a robot is imported into a
+temporary folder.  The build is robotkit's full build (URDF, SDF, MJCF, ROS package), timed
+apart from the import.  For comparison, the figures the other converters publish: MJCF to USD
+converts 85 of 85 Menagerie variants at 0.63 s each on average, unverified (its authors checked
+75 by hand); Pinocchio's MJCF reader loads 25 of 34 Menagerie descriptions.
+
+Usage (from the repository root):
+
+    python benchmarks/bench_import_mjcf.py [--menagerie DIR] [--only NAME...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from robotkit.commands.import_ import build_mjcf  # noqa: E402
+from robotkit.errors import RobotkitError  # noqa: E402
+from robotkit.importer import import_mjcf  # noqa: E402
+
+MENAGERIE = REPO.parent / "shared" / "assets" / "menagerie"
+
+
+def models(folder: Path, only: list[str]) -> list[Path]:
+    found = []
+    for d in sorted(p for p in folder.iterdir() if p.is_dir()):
+        if only and d.name not in only:
+            continue
+        found.extend(f for f in sorted(d.glob("*.xml")) if not f.name.startswith("scene")
+                     and "<worldbody" in f.read_text(encoding="utf-8", errors="replace"))
+    return found
+
+
+def one(model: Path, out: Path) -> dict:
+    built = {}
+
+    def build(recipe, folder):
+        start = time.perf_counter()
+        path = build_mjcf(recipe, folder)
+        built["s"] = time.perf_counter() - start
+        return path
+
+    start = time.perf_counter()
+    try:
+        result = import_mjcf(model, out / f"{model.stem}.yaml", build=build)
+    except RobotkitError as exc:
+        return {"model": f"{model.parent.name}/{model.name}", "error": str(exc).splitlines()[0]}
+    total = time.perf_counter() - start
+    v = result.verdict
+    return {"model": f"{model.parent.name}/{model.name}", "import": total - built.get("s", 0.0),
+            "build": built.get("s", 0.0), "ok": v.ok, "configs": v.configurations,
+            "worst": max(e for e, _ in v.worst.values()), "ledger": len(result.ledger)}
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--menagerie", type=Path, default=MENAGERIE)
+    ap.add_argument("--only", nargs="*", default=[], help="model folder names")
+    args = ap.parse_args()
+    rows = []
+    print(f"{'model':52} {'import s':>9} {'build s':>8} {'verified':>9} {'largest rel. diff':>18} {'ledger':>7}")
+    with tempfile.TemporaryDirectory(prefix="bench-mjcf-") as tmp:
+        for i, model in enumerate(models(args.menagerie, args.only)):
+            row = one(model, Path(tmp) / str(i))
+            rows.append(row)
+            if "error" in row:
+                print(f"{row['model']:52} refused: {row['error']}")
+                continue
+            print(f"{row['model']:52} {row['import']:9.2f} {row['build']:8.2f} "
+                  f"{'yes' if row['ok'] else 'NO':>9} {row['worst']:18.1e} {row['ledger']:7d}", flush=True)
+    done = [r for r in rows if "error" not in r]
+    if done:
+        imports = [r["import"] for r in done]
+        builds = [r["build"] for r in done]
+        print(f"\n{len(done)} of {len(rows)} imported, {sum(r['ok'] for r in done)} verified; "
+              f"ledger lines {sum(r['ledger'] for r in done)}")
+        print(f"import + verification: mean {statistics.mean(imports):.2f} s, median {statistics.median(imports):.2f} s, "
+              f"max {max(imports):.2f} s; build: mean {statistics.mean(builds):.2f} s, "
+              f"median {statistics.median(builds):.2f} s, max {max(builds):.2f} s")
+    return 0 if all(r.get("ok") for r in rows) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
