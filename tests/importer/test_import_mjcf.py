@@ -46,7 +46,16 @@ def test_bodies_are_links_rooted_in_world(features):
 def test_hinge_off_the_origin_moves_the_link_frame_onto_its_axis(features):
     joints = features[0]["joints"]
     assert joints["shoulder"]["origin"] == {"xyz": [0.02, 0, 0.1]}  # the body at 0 0 0.1, the joint at 0.02 0 0
-    assert joints["elbow"]["origin"] == {"xyz": [-0.02, 0, 0.3]}  # the child written in the shifted frame
+    assert joints["elbow"]["origin"]["xyz"] == [-0.02, 0, 0.3]  # the child written in the shifted frame
+
+
+def test_joint_ref_is_baked_into_the_origin(features):
+    """MuJoCo places a body as the file does at the joint's ``ref`` and moves it by value - ref: the
+    origin takes the move back, so joint values (limits, keyframes) stay MuJoCo's."""
+    joints = features[0]["joints"]
+    assert joints["elbow"]["origin"]["rpy"] == [0, pytest.approx(-math.radians(10)), 0]  # ref="10" (degrees)
+    assert joints["elbow"]["limit"]["lower"] == pytest.approx(-math.radians(120))
+    assert joints["extend"]["origin"] == {"xyz": [0, 0, -0.02]}  # a slide's ref="0.02"
 
 
 def test_several_joints_in_one_body_are_a_chain(features):
