@@ -23,6 +23,7 @@ from pydantic import ValidationError
 from robotkit.errors import Problem, RobotkitError, display_path
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.actuators import add_actuators
+from robotkit.importer.mjcf.contacts import add_contacts
 from robotkit.importer.mjcf.extras import add_equalities, add_excludes, add_poses, ledger_rest
 from robotkit.importer.mjcf.geoms import add_geoms
 from robotkit.importer.mjcf.inertials import add_inertials
@@ -54,6 +55,7 @@ def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, o
     materials: dict = {}
     add_geoms(src, tree, out, ledger, materials)
     add_inertials(src, tree)
+    add_contacts(src, tree, ledger)
     recipe: dict = {"robot": _robot_name(src)}
     if tree.base == "free":
         recipe["base"] = "free"
