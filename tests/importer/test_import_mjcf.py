@@ -190,15 +190,20 @@ def test_missing_file_is_refused(tmp_path):
     assert str(exc.value).endswith("none.xml: file not found")
 
 
-def test_skydio_x2_free_joint_and_site_actuators(tmp_path):
-    result = import_mjcf(X2, tmp_path / "x2.yaml", build=build_mjcf)
+def test_skydio_x2_on_the_command_line(tmp_path):
+    """A free-flying Menagerie model: ``base: free``, its site actuators on the ledger (stderr),
+    the verdict and the build command on stdout."""
+    proc = run_cli("import", X2, "-o", "x2.yaml", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    out = proc.stdout.splitlines()
+    assert out[0] == "verified in MuJoCo against the original at 22 configurations: every quantity agrees"
+    assert out[-2:] == ["wrote x2.yaml (robot Skydio_X2); build it with:", "robotkit build x2.yaml"]
+    assert ("ledger: x2.xml:56: actuator 'thrust1': all: dropped: a site transmission (the recipe's actuators "
+            "drive joints)") in proc.stderr.splitlines()
+    assert ("ledger: x2.xml:26: material 'phong3SG': all: texture dropped: the recipe's material is a colour "
+            "(its rgba kept)") in proc.stderr.splitlines()
     recipe = yaml.safe_load((tmp_path / "x2.yaml").read_text())
     assert recipe["base"] == "free" and list(recipe["links"]) == ["x2"]
-    assert result.verdict.ok, result.verdict.lines()
-    assert "x2.xml:56: actuator 'thrust1': all: dropped: a site transmission (the recipe's actuators drive joints)" \
-        in result.ledger
-    assert "x2.xml:26: material 'phong3SG': all: texture dropped: the recipe's material is a colour (its rgba kept)" \
-        in result.ledger
     mesh = next(s for s in recipe["links"]["x2"]["visual"] if "mesh" in s)
     assert mesh["scale"] == 0.01  # set in the default class
 

@@ -6,7 +6,8 @@ orientations), each configuration set on both models (a ball joint as its three 
 compared: every original body's mass, centre of mass, inertia tensor (world axes) and frame
 pose; the total mass (the point masses of joint chains' links apart); the joint-space mass
 matrix (``mj_fullM``, armature apart) and the bias forces at rest (gravity), the rebuilt ones
-mapped to the original's velocities; each hinge's and slide's armature.  Tolerances (:data:`TOL`):
+mapped to the original's velocities; each hinge's and slide's armature; each kept actuator's
+gain and bias (kp, kv).  Tolerances (:data:`TOL`):
 relative to the largest value of the same kind, plus an absolute floor for lengths."""
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from robotkit.importer.mjcf.extras import ball_angles
 
 SAMPLES = 20
 SEED = 0
-TOL = {"mass": 1e-9, "pose": 1e-9, "inertia": 1e-9, "matrix": 1e-6}
+TOL = {"mass": 1e-9, "pose": 1e-9, "inertia": 1e-9, "matrix": 1e-6, "actuator": 1e-9}
 """Relative tolerances (pose: metres and rotation-matrix entries, absolute). The mass matrix's is
 looser: the massless links of joint chains carry a millionth of the lightest body's mass."""
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
@@ -63,7 +64,23 @@ def verify(src, tree, rebuilt_path) -> Verdict:
         T = _velocity_map(om, rm, tree, q)
         _dynamics(verdict, mujoco, om, od, rm, rd, T, label)
     verdict.configurations = len(configs)
+    _actuators(verdict, om, rm, tree)
     return verdict
+
+
+def _actuators(verdict: Verdict, om, rm, tree) -> None:
+    """Each original actuator the recipe kept: the rebuilt one on its joint has its gain and bias."""
+    rebuilt = {rm.joint(int(rm.actuator_trnid[a][0])).name: a for a in range(rm.nu) if rm.actuator_trntype[a] == 0}
+    for a in range(om.nu):
+        if om.actuator_trntype[a] != 0 or int(om.actuator_trnid[a][0]) not in tree.joint_map:
+            continue
+        r = rebuilt.get(tree.joint_map[int(om.actuator_trnid[a][0])][0])
+        if r is None:
+            continue  # not kept: on the ledger
+        mine = np.concatenate([om.actuator_gainprm[a][:3], om.actuator_biasprm[a][:3]])
+        theirs = np.concatenate([rm.actuator_gainprm[r][:3], rm.actuator_biasprm[r][:3]])
+        err = float(np.abs(mine - theirs).max() / max(np.abs(mine).max(), 1e-300))
+        _check(verdict, "actuator", err, f"actuator '{om.actuator(a).name or a}' gain and bias")
 
 
 def _check(verdict: Verdict, kind: str, err: float, where: str) -> None:
