@@ -88,9 +88,30 @@ def test_shapes_capsule_mesh_scale_and_visual_only_geoms(features):
     assert upper["visual"][0]["cylinder"] == {"radius": 0.03, "length": pytest.approx(0.3)}
     mesh = upper["visual"][3]
     assert mesh["scale"] == 0.5 and mesh["material"] == "blue"  # the default class's mesh scale
-    assert mesh["origin"]["xyz"] == pytest.approx([-0.02, 0, 0.15], abs=1e-15)  # the file's own frame
     assert [next(iter(s)) for s in upper["collision"]] == ["cylinder", "sphere", "sphere"]  # the mesh does not collide
     assert links["wrist"]["visual"]["box"] == {"size": [0.06, 0.04, 0.02]}  # the ellipsoid, stated
+
+
+def test_mesh_sits_where_mujoco_puts_it(features):
+    """MuJoCo reads the file's vertices as scale * refquat^-1 (v - refpos), then moves them to their
+    inertial frame: the recipe's origin undoes both, so the file's vertices at that origin are
+    MuJoCo's compiled vertices where MuJoCo places them (to float32)."""
+    import trimesh
+
+    from robotkit.geometry import rpy_matrix
+    from robotkit.importer.mjcf.frames import quat_matrix
+
+    recipe, _, src, tree = features
+    m = src.model
+    g = m.geom("upper_rotor").id
+    d = m.geom_dataid[g]
+    compiled = m.mesh_vert[m.mesh_vertadr[d]:m.mesh_vertadr[d] + m.mesh_vertnum[d]].astype(float)
+    theirs = compiled @ quat_matrix(m.geom_quat[g]).T + m.geom_pos[g] - tree.offset[m.geom_bodyid[g]]
+    shape = recipe["links"]["upper"]["visual"][3]
+    raw = trimesh.load(FEATURES.parent / "rotor.stl").vertices * shape["scale"]
+    mine = raw @ rpy_matrix(shape["origin"]["rpy"]).T + np.array(shape["origin"]["xyz"])
+    assert len(mine) == len(theirs)
+    assert np.abs(np.sort(mine, axis=0) - np.sort(theirs, axis=0)).max() < 1e-7
 
 
 def test_inertials_as_mujoco_computed_them(features):

@@ -110,8 +110,13 @@ def _mesh(src, g: int, pos, R, out: Path, ledger) -> list[dict]:
         return []
     back_p, back_R = inverse(m.mesh_pos[d], quat_matrix(m.mesh_quat[d]))
     p, Rm = compose(pos, R, back_p, back_R)  # undo MuJoCo's move of the mesh to its inertial frame
-    shape = {"mesh": Path(os.path.relpath(file, out.parent)).as_posix()}
     scale = [float(v) for v in m.mesh_scale[d]]
+    ref_p, ref_R = src.mesh_ref(d)  # MuJoCo reads the file's vertices as scale * ref_R^T (v - ref_p)
+    if len(set(scale)) > 1 and not np.allclose(ref_R, np.eye(3)):
+        ledger.add(src.geom_where(g), geom_label(m, g, f"mesh '{m.mesh(d).name}'"), "all",
+                   "approximated: refquat with a non-uniform scale (the scale taken along the file's axes)")
+    p, Rm = compose(p, Rm, *inverse(np.asarray(scale) * ref_p, ref_R))
+    shape = {"mesh": Path(os.path.relpath(file, out.parent)).as_posix()}
     if scale != [1.0, 1.0, 1.0]:
         shape["scale"] = scale[0] if len(set(scale)) == 1 else scale
     return [_at(shape, p, Rm)]

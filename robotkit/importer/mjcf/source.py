@@ -75,6 +75,19 @@ class Source:
         return (folder / mesh.file).resolve()
 
 
+    def mesh_ref(self, d: int):
+        """The ``refpos`` and ``refquat`` (as a matrix) of compiled mesh ``d``."""
+        import numpy as np
+
+        from robotkit.importer.mjcf.frames import quat_matrix
+
+        name = self.model.mesh(d).name
+        mesh = next((e for e in self.spec.meshes if e.name == name), None)
+        if mesh is None:
+            return np.zeros(3), np.eye(3)
+        return np.array(mesh.refpos, float), quat_matrix(mesh.refquat)
+
+
 def refused(path: Path, message: str) -> RobotkitError:
     """MuJoCo's refusal as one line: its first line, at the line it names."""
     first = message.strip().splitlines()[0] if message.strip() else "MuJoCo refused the file"
