@@ -35,7 +35,6 @@ class Tree:
     base: str = "fixed"
     chain_links: list = field(default_factory=list)
     notes: dict = field(default_factory=dict)  # joint name -> comment above it
-    link_notes: dict = field(default_factory=dict)
     ledger: list = field(default_factory=list)
 
 
@@ -113,6 +112,7 @@ def _body(src, tree: Tree, b: int, bodies, jnames, chain_mass: float) -> None:
             at = pos + R @ anchor if prev_anchor is None else anchor - prev_anchor
             tree.joints[jname] = _moving(src, t, prev_link, child, at, R if prev_anchor is None else np.eye(3), axis,
                                          j)
+        _note(src, tree, jname, t, j, anchor)
         tree.links.setdefault(child, {})
         if not last:
             tree.chain_links.append(child)
@@ -121,6 +121,24 @@ def _body(src, tree: Tree, b: int, bodies, jnames, chain_mass: float) -> None:
     for jname, *_, j in stages:
         tree.joint_map.setdefault(j, []).append(jname)
     tree.link_of[b], tree.offset[b] = name, stages[-1][3]
+
+
+def _note(src, tree: Tree, name: str, t: int, j: int, anchor) -> None:
+    """The comment above a joint the recipe writes otherwise than the file."""
+    m = src.model
+    notes = []
+    if t == BALL:
+        notes.append(f"one of the three revolute joints ball joint '{m.joint(j).name}' becomes (x, y, z of its body)")
+    if t == HINGE and np.any(anchor):
+        notes.append("the link frame is on the joint's axis (MJCF joint pos " +
+                     " ".join(f"{v:g}" for v in m.jnt_pos[j]) + "): the body's shapes, inertial and children are "
+                     "written in that frame")
+    ref = float(m.qpos0[m.jnt_qposadr[j]]) if t in (HINGE, SLIDE) else 0.0
+    if ref:
+        notes.append(f"MJCF ref {ref:g}: the origin takes the body back to the joint's zero, so joint values "
+                     "(limits, poses) are MuJoCo's")
+    if notes:
+        tree.notes[name] = "; ".join(notes)
 
 
 def _point(mass: float) -> dict:
