@@ -208,6 +208,25 @@ def test_refused_mjcf_is_one_line_at_its_line_and_nothing_written(tmp_path):
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
 
 
+@pytest.mark.parametrize("name, text, expected", [
+    ("loop.xml", '<mujoco>\n<include file="loop.xml"/>\n</mujoco>\n',
+     "loop.xml:2: MuJoCo refuses the file: File 'loop.xml' already included"),
+    ("broken.xml", "<mujoco>\n<worldbody>\n<body>\n</worldbody>\n</mujoco>\n",
+     "broken.xml:3: MuJoCo refuses the file: XML parse error 14: XML_ERROR_MISMATCHED_ELEMENT XMLElement name=body"),
+    ("truncated.xml", '<mujoco>\n<asset><mesh file="cut.stl"/></asset>\n'
+     '<worldbody><body><geom type="mesh" mesh="cut"/></body></worldbody>\n</mujoco>\n',
+     "truncated.xml:2: MuJoCo refuses the file: stl_decoder: STL file '{dir}/cut.stl' has wrong size; perhaps this "
+     "is an ASCII file?"),
+])
+def test_bad_input_is_one_line_and_nothing_written(tmp_path, name, text, expected):
+    (tmp_path / "cut.stl").write_bytes((FEATURES.parent / "rotor.stl").read_bytes()[:300])
+    (tmp_path / name).write_text(text)
+    with pytest.raises(RobotkitError) as exc:
+        import_mjcf(tmp_path / name, tmp_path / "out" / "r.yaml")
+    assert [str(p) for p in exc.value.problems] == [str(tmp_path / expected.format(dir=tmp_path))]
+    assert not (tmp_path / "out").exists()
+
+
 def test_missing_file_is_refused(tmp_path):
     with pytest.raises(RobotkitError) as exc:
         import_mjcf(tmp_path / "none.xml", tmp_path / "r.yaml")

@@ -14,6 +14,7 @@ from robotkit import mj
 from robotkit.errors import Problem, RobotkitError
 
 _LINE = re.compile(r"line (\d+)")
+_TINYXML_LINE = re.compile(r"Line number=(\d+)")
 
 
 @dataclass
@@ -89,10 +90,14 @@ class Source:
 
 
 def refused(path: Path, message: str) -> RobotkitError:
-    """MuJoCo's refusal as one line: its first line, at the line it names."""
-    first = message.strip().splitlines()[0] if message.strip() else "MuJoCo refused the file"
-    first = re.sub(r"^(XML )?Error:\s*", "", first)
-    found = _LINE.search(message)
+    """MuJoCo's refusal as one line: its first line (with tinyxml2's detail when that line is only a
+    heading), at the line it names."""
+    lines = [line.strip() for line in message.strip().splitlines() if line.strip()] or ["MuJoCo refused the file"]
+    first = re.sub(r"^(XML )?Error:\s*", "", lines[0])
+    if first.endswith(":") and len(lines) > 1:  # "XML parse error 14:" then tinyxml2's own line
+        detail = re.sub(r"Error=|ErrorID=\S+ \(\S+\)\s*|Line number=\d+:?\s*", "", lines[1]).strip()
+        first = f"{first} {detail}"
+    found = _LINE.search(message) or _TINYXML_LINE.search(message)
     return RobotkitError(Problem(f"MuJoCo refuses the file: {first}", file=str(path),
                                  line=int(found.group(1)) if found else None))
 
