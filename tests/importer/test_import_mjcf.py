@@ -254,7 +254,7 @@ def test_skydio_x2_on_the_command_line(tmp_path):
 MENAGERIE = ASSETS / "menagerie"
 SHARED = ["dynamixel_2r/dynamixel_2r.xml", "low_cost_robot_arm/low_cost_robot_arm.xml", "trs_so_arm100/so_arm100.xml",
           "ufactory_xarm7/xarm7.xml", "trossen_vx300s/vx300s.xml", "kinova_gen3/gen3.xml", "robotiq_2f85/2f85.xml",
-          "bitcraze_crazyflie_2/cf2.xml"]
+          "bitcraze_crazyflie_2/cf2.xml", "agility_cassie/cassie.xml", "umi_gripper/umi_gripper.xml"]
 
 
 @pytest.mark.slow
