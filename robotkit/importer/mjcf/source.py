@@ -43,8 +43,10 @@ class Source:
                 root = urdfxml.parse_text(self.path.read_text(encoding="utf-8")).getroot()
                 self._lines = {}
                 for e in root.iter():
-                    if urdfxml.is_element(e) and e.get("name"):
-                        self._lines.setdefault(e.get("name"), e.sourceline)
+                    if urdfxml.is_element(e):
+                        self._lines.setdefault(f"<{e.tag}>", e.sourceline)
+                        if e.get("name"):
+                            self._lines.setdefault(e.get("name"), e.sourceline)
             except (OSError, UnicodeDecodeError, urdfxml.MalformedXML):
                 self._lines = {}
         return self._lines
@@ -54,6 +56,11 @@ class Source:
         line = self.line(element) if element is not None else None
         return f"{self.path.name}:{line}" if line else self.path.name
 
+
+    def where_tag(self, tag: str) -> str:
+        """``file:line`` of the file's first ``<tag>`` element (the file alone without one)."""
+        line = self.named_lines().get(f"<{tag}>")
+        return f"{self.path.name}:{line}" if line else self.path.name
 
     def where_named(self, kind: str, name: str) -> str:
         """``file:line`` of the spec element ``kind`` (body, geom, material...) called ``name``."""
