@@ -20,6 +20,7 @@ from robotkit.importer.names import valid_frame_name
 
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 WORLD = "world"
+UNLIMITED_SLIDE = 1e3
 CHAIN_MASS = 1e-6
 """The mass of a chain's massless link, as a fraction of the lightest body's (MuJoCo refuses a
 moving body without mass): a point mass, stated in the recipe."""
@@ -110,7 +111,7 @@ def _body(src, tree: Tree, b: int, bodies, jnames, chain_mass: float) -> None:
             tree.joints[jname] = _joint("floating", prev_link, child, pos, R)
         else:
             at = pos + R @ anchor if prev_anchor is None else anchor - prev_anchor
-            tree.joints[jname] = _moving(src, t, prev_link, child, at, R if prev_anchor is None else np.eye(3), axis,
+            tree.joints[jname] = _moving(src, tree, t, prev_link, child, at, R if prev_anchor is None else np.eye(3), axis,
                                          j)
         _note(src, tree, jname, t, j, anchor)
         tree.links.setdefault(child, {})
@@ -174,7 +175,7 @@ def _axis_rotation(axis, angle: float) -> np.ndarray:
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
-def _moving(src, t: int, parent: str, child: str, pos, R, axis, j: int) -> dict:
+def _moving(src, tree: Tree, t: int, parent: str, child: str, pos, R, axis, j: int) -> dict:
     """A hinge or slide (or one angle of a ball).  MuJoCo places the body as the file does at the
     joint's ``ref`` (qpos0), and moves it by the value minus ``ref``: the origin takes the move back
     to the value 0, so the recipe's joint values are MuJoCo's (limits, keyframes)."""
@@ -195,7 +196,10 @@ def _moving(src, t: int, parent: str, child: str, pos, R, axis, j: int) -> dict:
     out["axis"] = clean(axis)
     if kind != "continuous":
         if not limited:  # an unlimited slide: the recipe's prismatic joint needs limits
-            lo, hi = -1e3, 1e3
+            lo, hi = -UNLIMITED_SLIDE, UNLIMITED_SLIDE
+            tree.ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}' (slide)", "all",
+                            f"unlimited: written with limits -{UNLIMITED_SLIDE:g} to {UNLIMITED_SLIDE:g} m (a "
+                            "prismatic joint has limits)")
         out["limit"] = {"lower": lo, "upper": hi}
     d = int(m.jnt_dofadr[j])
     dyn = {"damping": float(m.dof_damping[d]), "friction": float(m.dof_frictionloss[d]),
