@@ -40,8 +40,9 @@ def add_contacts(src, tree, ledger) -> None:
     for name in OPTIONS:
         mine, theirs = getattr(m.opt, name), getattr(ref.opt, name)
         if not np.array_equal(np.asarray(mine), np.asarray(theirs)):
-            ledger.add(src.where_tag("option"), f"option {name}", "all", f"{_option(name, mine)} dropped: the rebuilt MJCF has "
-                       f"{_option(name, theirs)} (the recipe has no simulation options)")
+            ledger.add(src.where_tag("option"), f"option {name}", "all",
+                       f"{_option(name, mine)} dropped: the rebuilt MJCF has {_option(name, theirs)} (the recipe has "
+                       "no simulation options)")
     for b in range(m.nbody):
         geoms = [g for g in range(m.ngeom) if m.geom_bodyid[g] == b and (m.geom_contype[g] or m.geom_conaffinity[g])]
         if geoms and b in tree.link_of:

@@ -110,9 +110,8 @@ def _body(src, tree: Tree, b: int, bodies, jnames, chain_mass: float) -> None:
         if t == FREE:  # a free joint below the world's own bodies: floating from world
             tree.joints[jname] = _joint("floating", prev_link, child, pos, R)
         else:
-            at = pos + R @ anchor if prev_anchor is None else anchor - prev_anchor
-            tree.joints[jname] = _moving(src, tree, t, prev_link, child, at, R if prev_anchor is None else np.eye(3), axis,
-                                         j)
+            at, turn = (pos + R @ anchor, R) if prev_anchor is None else (anchor - prev_anchor, np.eye(3))
+            tree.joints[jname] = _moving(src, tree, t, prev_link, child, at, turn, axis, j)
         _note(src, tree, jname, t, j, anchor)
         tree.links.setdefault(child, {})
         if not last:
