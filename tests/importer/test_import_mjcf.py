@@ -141,7 +141,8 @@ def test_actuators_mimic_pose_and_excludes(features):
 
 def test_ledger_word_for_word(features):
     assert features[1].lines() == [
-        "features.xml:32: geom 'wrist_ellipsoid' (ellipsoid): all: approximated: the box of its half-axes 0.03 0.02 0.01",
+        "features.xml:32: geom 'wrist_ellipsoid' (ellipsoid): all: approximated: the box of its half-axes "
+        "0.03 0.02 0.01",
         "features.xml: option integrator: all: Euler dropped: the rebuilt MJCF has implicitfast (the recipe has no "
         "simulation options)",
         "features.xml:58: actuator 'shoulder_servo': all: ctrlrange [-1.2, 1.2] written as the joint's range "
