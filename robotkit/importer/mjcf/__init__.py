@@ -12,6 +12,7 @@ when MuJoCo refuses the file or the recipe would be invalid."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import tempfile
@@ -116,15 +117,30 @@ def _verified(src, tree, recipe: Path, build) -> Verdict | None:
 
 
 def _factor_defaults(recipe: dict) -> None:
-    """:func:`factor_defaults` with each link's visual shapes set aside: no candidate reads them
-    and they weigh the same before and after, but measuring them is most of its time (a Menagerie
-    arm's hundred meshes)."""
-    shapes = {name: link.get("visual") for name, link in recipe["links"].items()}
-    recipe["links"] = {name: {k: (0 if k == "visual" else v) for k, v in link.items()}
-                       for name, link in recipe["links"].items()}
+    """:func:`factor_defaults` with each link's shapes and inertial set aside (a short token for
+    each distinct collision value, which is a candidate): they weigh the same before and after,
+    but measuring them is most of its time (a Menagerie robot's hundreds of shapes)."""
+    kept: dict[str, object] = {}
+    tokens: dict[str, str] = {}
+
+    def token(value):
+        if isinstance(value, str):
+            return value
+        key = json.dumps(value, sort_keys=True)
+        tokens.setdefault(key, f"shapes{len(tokens)}")
+        kept[tokens[key]] = value
+        return tokens[key]
+
+    aside = {name: {k: link[k] for k in ("visual", "inertial") if k in link} for name, link in recipe["links"].items()}
+    recipe["links"] = {name: {k: (0 if k in ("visual", "inertial") else token(v) if k == "collision" else v)
+                              for k, v in link.items()} for name, link in recipe["links"].items()}
     factor_defaults(recipe)
-    recipe["links"] = {name: {k: (shapes[name] if k == "visual" else v) for k, v in link.items()}
-                       for name, link in recipe["links"].items()}
+    back = lambda k, v: kept.get(v, v) if k == "collision" and isinstance(v, str) else v  # noqa: E731
+    recipe["links"] = {name: {k: (aside[name][k] if k in ("visual", "inertial") else back(k, v))
+                              for k, v in link.items()} for name, link in recipe["links"].items()}
+    link_defaults = recipe.get("defaults", {}).get("link", {})
+    if "collision" in link_defaults:
+        link_defaults["collision"] = back("collision", link_defaults["collision"])
 
 
 def _resolves(recipe: Path, source: Path) -> None:
