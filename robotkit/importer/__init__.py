@@ -277,5 +277,5 @@ def _element_lines(urdf_text: str) -> dict[tuple[str, str], int]:
         root = urdfxml.parse_text(urdf_text).getroot()
     except urdfxml.MalformedXML:
         return {}
-    return {(tag + "s", e.get("name")): e.sourceline for tag in ("link", "joint") for e in root.iter(tag)
-            if e.get("name")}
+    return {(tag + "s", e.get("name").lstrip("/")): e.sourceline for tag in ("link", "joint")
+            for e in root.iter(tag) if e.get("name")}  # '/base_link' is imported as base_link
