@@ -31,6 +31,7 @@ from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
 from robotkit.importer.urdf_to_recipe import Converted, urdf_to_recipe
 from robotkit.importer.xacro_expand import check_package_paths, expand
 from robotkit.model.load import load_robots
+from robotkit.model.plausible import DENSITY_RANGE
 from robotkit.paths import inside, recipe_policy, widened
 from robotkit.recipe.schema import Recipe
 
@@ -102,8 +103,9 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     physical inertial is kept as given and one that no real body has gets ``inertia_policy``
     (keep, repair, recompute, estimate; see robotkit.importer.inertials.chosen_inertial), with a
     comment above its link saying what was wrong; by default (None) the repair, and where the
-    repaired tensor does not fit the link's geometry by check's rule, a recompute
-    (robotkit.importer.fit).  ``copy_meshes`` copies every mesh below the recipe's folder
+    tensor, given or repaired, does not fit the link's geometry by check's rule, a recompute, and
+    where the mass is too light for the geometry's volume (check's implied density), mass and
+    tensor from the geometry at the recipe's density (robotkit.importer.fit); ``keep`` keeps them.  ``copy_meshes`` copies every mesh below the recipe's folder
     (``meshes/PKG/...``) instead of referencing it where it is; the meshes outside the recipe's
     project, which its build may not read, are copied whatever it says, with their package's
     licence files.
@@ -143,8 +145,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         tmp.unlink()
         overrides.update(more)
     os.replace(tmp, out)
-    warnings.extend(f"{_where(source, lines, name)}link '{name}': the given inertial does not fit its geometry: {why}"
-                    for name, why in kept.items())
+    warnings.extend(f"{_where(source, lines, name)}link '{name}': {why}" for name, why in kept.items())
     result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
                           repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes),
                           left_out=list(conv.left_out))
@@ -215,8 +216,9 @@ def _header(source: Path, out: Path, args: dict[str, str] | None, recompute_iner
         header.append("inertials as given in the original (explicit); those no real body has: "
                       f"{inertia_policy} (--inertia-policy)")
         if fit:
-            header.append("a repair that does not fit the link's geometry (check's inertia-box rule): recompute, "
-                          "or estimate without a closed geometry")
+            header.append("a tensor, given or repaired, that does not fit the link's geometry (check's inertia-box "
+                          "rule): recompute, or estimate without a closed geometry; a mass below "
+                          f"{DENSITY_RANGE[0]:g} kg/m^3 of its geometry: computed from it at the recipe's density")
     return header
 
 

@@ -19,6 +19,7 @@ from robotkit.importer.recipe_writer import fmt
 from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
 from robotkit.model import massprops
+from robotkit.model.plausible import DENSITY_RANGE
 from robotkit.model.resolve import geom_mass_props
 
 
@@ -49,20 +50,29 @@ def _points(geom) -> np.ndarray:
     return P @ T[:3, :3].T + T[:3, 3]
 
 
-def link_fit(link) -> inertia_policy.BoxFit | None:
+def _closed(geoms) -> tuple[float, np.ndarray] | None:
+    """(volume, unit-density inertia) of the geometry when it is all closed, else None."""
+    if not all(g.shape.kind != "mesh" or mesh_is_closed(g.shape.mesh.source, g.shape.mesh.scale) for g in geoms):
+        return None
+    facts = {g.shape.mesh.key: _facts(g.shape.mesh) for g in geoms if g.shape.kind == "mesh"}
+    volume, _, I = massprops.combine([geom_mass_props(g, facts) for g in geoms])
+    return volume, I
+
+
+def link_fit(link) -> tuple[inertia_policy.BoxFit, float | None] | None:
     """The fit of a resolved link's explicit inertial to its visual (else collision) geometry,
-    as check judges it; None when it has no explicit inertial or no geometry."""
+    as check judges it, with the geometry's volume (None when not closed); None when it has no
+    explicit inertial or no geometry."""
     geoms = list(link.visuals or link.collisions)
     if link.inertial_spec.mode != "explicit" or not geoms:
         return None
     given = link.inertial_spec.explicit
-    closed = all(g.shape.kind != "mesh" or mesh_is_closed(g.shape.mesh.source, g.shape.mesh.scale) for g in geoms)
+    closed = _closed(geoms)
     if closed:
-        facts = {g.shape.mesh.key: _facts(g.shape.mesh) for g in geoms if g.shape.kind == "mesh"}
-        volume, _, I = massprops.combine([geom_mass_props(g, facts) for g in geoms])
-        return inertia_policy.box_fit_geometry(given.mass, given.tensor(), volume, I)
+        volume, I = closed
+        return inertia_policy.box_fit_geometry(given.mass, given.tensor(), volume, I), volume
     points = np.vstack([_points(g) for g in geoms])
-    return inertia_policy.box_fit_extent(given.mass, given.com, given.tensor(), points)
+    return inertia_policy.box_fit_extent(given.mass, given.com, given.tensor(), points), None
 
 
 def describe(fit: inertia_policy.BoxFit) -> str:
@@ -72,23 +82,51 @@ def describe(fit: inertia_policy.BoxFit) -> str:
             f"than {than} ({sides[1]} m), along {fit.axes}")
 
 
+def _too_light(mass: float, volume: float | None) -> str | None:
+    """Why ``mass`` over the closed ``volume`` is no solid part (check's implied-density rule, below
+    its range), else None."""
+    if not volume or mass / volume >= DENSITY_RANGE[0]:
+        return None
+    density = mass / volume
+    cause = ("the mass is the mesh volume at density 1, MeshLab's default" if abs(density - 1.0) < 0.05
+             else "the density or mass is far too low")
+    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {density:.3g} kg/m^3, "
+            f"below {DENSITY_RANGE[0]:g} ({cause})")
+
+
 def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
-    """(link -> (policy, why) for the repaired tensors that do not fit, when ``recompute``; link ->
-    why for the given physical ones that do not fit), judged as check's errors."""
+    """(link -> (policy, why) for the tensors, given or repaired, that do not fit and the masses no
+    solid part of that volume has, when ``recompute``; link -> why for those kept otherwise), judged
+    as check's errors.  A tensor that does not fit gets ``recompute`` (``estimate`` without a
+    closed geometry), a mass too light for its volume ``density`` (mass and tensor from the
+    geometry at the recipe's density)."""
     overrides, kept = {}, {}
     for link in robot.links:
         given = explicit.get(link.name)
-        fit = link_fit(link) if given is not None else None
-        if fit is None or fit.severity != "error":
+        found = link_fit(link) if given is not None else None
+        if found is None:
+            continue
+        fit, volume = found
+        light = _too_light(given["mass"], volume)
+        if light:
+            if recompute:
+                overrides[link.name] = ("density", light)
+            else:
+                kept[link.name] = (f"{light}; compute it from the geometry at the recipe's density (no inertial "
+                                   "on the link in the recipe)")
+            continue
+        if fit.severity != "error":
             continue
         t = given["inertia"]
         tensor = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]],
                            [t["ixz"], t["iyz"], t["izz"]]])
-        if inertia_policy.defects(given["mass"], tensor):
-            if recompute:
-                overrides[link.name] = ("recompute" if fit.slack == 1 else "estimate",
-                                        f"repaired, {describe(fit)}")
-        else:
-            kept[link.name] = (f"{describe(fit)}; recompute it from the geometry (inertial: {{mass: {fmt(given['mass'])}}} "
-                               "on the link in the recipe, or import with --recompute-inertials)")
+        repaired = bool(inertia_policy.defects(given["mass"], tensor))
+        if recompute:
+            overrides[link.name] = ("recompute" if fit.slack == 1 else "estimate",
+                                    f"repaired, {describe(fit)}" if repaired
+                                    else f"the given inertial does not fit its geometry: {describe(fit)}")
+        elif not repaired:
+            kept[link.name] = (f"the given inertial does not fit its geometry: {describe(fit)}; recompute it from the "
+                               f"geometry (inertial: {{mass: {fmt(given['mass'])}}} on the link in the recipe, or "
+                               "import with --recompute-inertials)")
     return overrides, kept
