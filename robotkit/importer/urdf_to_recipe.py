@@ -128,6 +128,7 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
     joints = _joints(children, links.links, r)
     _note_renamed(renamed, r)
     extras = _extras(children, root, links, joints, materials.materials, r)
+    _zero_limits(children, joints, r)
     r.problems.raise_if_any()
     give_moving_links_mass(links.links, joints, r.out)
     for link, why in r.out.repairs.items():
@@ -796,6 +797,38 @@ def _without_mimic(el, joint: dict, what: str, warnings: list[str]):
     el = copy.deepcopy(el)
     el.remove(el.find("mimic"))
     return el
+
+
+def _drivers(children: list) -> dict[str, tuple[str, object]]:
+    """Joint -> (what drives it, that element): a <transmission> naming it, or a <ros2_control>
+    joint with a command interface (as robotkit.check.lints reads the build)."""
+    out: dict[str, tuple[str, object]] = {}
+    for el in children:
+        tag = local_name(el.tag)
+        for j in el.findall("joint") if tag in ("transmission", "ros2_control") else ():
+            if tag == "transmission" or j.find("command_interface") is not None:
+                out.setdefault(j.get("name"), (f"{tag} '{el.get('name')}'", el))
+    return out
+
+
+def _zero_limits(children: list, joints: dict[str, dict], r: _Reading) -> None:
+    """An effort or velocity limit of 0 is kept: on a joint nothing drives, a passive joint (stated
+    above it); on a driven one, a defect check reports (a warning naming the line)."""
+    drivers = _drivers(children)
+    elements = {el.get("name"): el for el in children if local_name(el.tag) == "joint"}
+    for name, joint in joints.items():
+        limit = joint.get("limit") or {}
+        zero = [k for k in ("effort", "velocity") if limit.get(k) == 0]
+        if joint["type"] not in ("revolute", "prismatic") or not zero:
+            continue
+        limits = f"{' and '.join(zero)} limit{'s' if len(zero) > 1 else ''} 0 in the original"
+        if name in drivers:
+            r.warnings.append(f"{r.where(elements[name])}joint '{name}': {limits}, and {drivers[name][0]} drives it: "
+                              f"a driven joint with zero {zero[0]} cannot move (check reports it; give it the "
+                              "motor's limit)")
+        else:
+            _note(name, f"{limits}: nothing drives it (no transmission or ros2_control command names it), so it "
+                        "is kept as a passive joint", r)
 
 
 # ---------------------------------------------------------------- everything else
