@@ -284,3 +284,23 @@ def test_with_keep_check_reports_the_kept_tensors(tmp_path):
     errors = [(f.check, f.subject) for f in check(str(tmp_path / "build" / result.robot)) if f.severity == "error"]
     assert errors == [("inertia-box", "link 'sensor'"), ("inertia-box", "link 'rotor'"),
                       ("implied-density", "link 'shell'")]
+
+
+def test_a_collision_shared_by_most_links_is_no_default_over_another_shape(tmp_path):
+    """The Iris: four rotors with the same collision cylinder, the body with a box; a default
+    cylinder would merge into the body's box (both in one geometry), so each keeps its own."""
+    def part(name: str, shape: str) -> str:
+        return (f'  <link name="{name}"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" '
+                f'iyz="0" izz="1e-4"/></inertial><visual><geometry><sphere radius="0.03"/></geometry></visual>'
+                f'<collision><geometry>{shape}</geometry></collision></link>\n')
+
+    rotors = [f"rotor_{i}" for i in range(4)]
+    body = part("base_link", '<box size="0.47 0.47 0.11"/>') + "".join(
+        part(r, '<cylinder length="0.005" radius="0.128"/>') + _joint(f"{r}_joint", "base_link", r) for r in rotors)
+    source = tmp_path / "rotors.urdf"
+    source.write_text(_robot("rotors", body), encoding="utf-8")
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    recipe = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
+    assert recipe["links"]["base_link"]["collision"] == {"box": {"size": [0.47, 0.47, 0.11]}}
+    assert recipe["links"]["rotor_0"]["collision"] == {"cylinder": {"radius": 0.128, "length": 0.005}}
+    assert "link" not in recipe.get("defaults", {})
