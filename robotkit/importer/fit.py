@@ -69,10 +69,27 @@ def link_fit(link) -> tuple[inertia_policy.BoxFit, float | None] | None:
     given = link.inertial_spec.explicit
     closed = _closed(geoms)
     if closed:
+        if max(_size(g) for g in geoms) <= MARKER:
+            return None
         volume, I = closed
         return inertia_policy.box_fit_geometry(given.mass, given.tensor(), volume, I), volume
     points = np.vstack([_points(g) for g in geoms])
+    if float(np.ptp(points, axis=0).max()) <= MARKER:
+        return None
     return inertia_policy.box_fit_extent(given.mass, given.com, given.tensor(), points), None
+
+
+MARKER = 1e-3
+"""m: geometry no larger marks a frame (an IMU's 1 mm box) and says nothing of the part; check
+reads it so too (robotkit.check.lints.MARKER)."""
+
+
+def _size(geom) -> float:
+    """The largest side of a geometry's bounding box (a closed mesh's from its cached facts)."""
+    if geom.shape.kind == "mesh":
+        f = _facts(geom.shape.mesh)
+        return float(np.max(np.asarray(f["bbox_max"]) - np.asarray(f["bbox_min"])))
+    return float(np.ptp(_points(geom), axis=0).max())
 
 
 def describe(fit: inertia_policy.BoxFit) -> str:

@@ -304,3 +304,16 @@ def test_a_collision_shared_by_most_links_is_no_default_over_another_shape(tmp_p
     assert recipe["links"]["base_link"]["collision"] == {"box": {"size": [0.47, 0.47, 0.11]}}
     assert recipe["links"]["rotor_0"]["collision"] == {"cylinder": {"radius": 0.128, "length": 0.005}}
     assert "link" not in recipe.get("defaults", {})
+
+
+def test_a_marker_says_nothing_of_the_part_and_the_tensor_is_kept(tmp_path):
+    """An IMU frame drawn as a 1 mm box: check reads no part in it (its MARKER), nor does import."""
+    source = tmp_path / "marker.urdf"
+    source.write_text(_robot("marker", _cube("base_link", 2.0, 0.1) + _link("imu_link", 0.015, (1e-5,) * 3,
+                                                                             "0.001 0.001 0.001")
+                             + _joint("imu_joint", "base_link", "imu_link", "fixed")), encoding="utf-8")
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    assert result.repairs == {}
+    recipe = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
+    assert recipe["links"]["imu_link"]["inertial"] == {"mass": 0.015, "inertia": {"ixx": 1e-5, "iyy": 1e-5,
+                                                                                  "izz": 1e-5}}
