@@ -111,6 +111,17 @@ def _too_light(mass: float, volume: float | None) -> str | None:
             f"below {DENSITY_RANGE[0]:g} ({cause})")
 
 
+def _too_heavy(mass: float, volume: float | None) -> str | None:
+    """Why ``mass`` over the closed ``volume`` is denser than any solid part (check's rule), else None."""
+    if not volume or mass / volume <= DENSITY_RANGE[1]:
+        return None
+    density = mass / volume
+    cause = ("the mass looks like grams written as kilograms" if density / 1000 < DENSITY_RANGE[1]
+             else "the geometry is far too small for the mass (units?)")
+    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {density:.4g} kg/m^3, "
+            f"above {DENSITY_RANGE[1]:g} ({cause})")
+
+
 def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
     """(link -> (policy, why) for the tensors, given or repaired, that do not fit and the masses no
     solid part of that volume has, when ``recompute``; link -> why for those kept otherwise), judged
@@ -124,6 +135,9 @@ def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str
         if found is None:
             continue
         fit, volume = found
+        heavy = _too_heavy(given["mass"], volume)
+        if heavy:  # a placeholder mass on a marker, or a part drawn smaller than it is: no one reading
+            kept[link.name] = f"{heavy}: kept (check reports it)"
         light = _too_light(given["mass"], volume)
         if light:
             if recompute:

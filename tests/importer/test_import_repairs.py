@@ -317,3 +317,15 @@ def test_a_marker_says_nothing_of_the_part_and_the_tensor_is_kept(tmp_path):
     recipe = yaml.safe_load(result.recipe_path.read_text(encoding="utf-8"))
     assert recipe["links"]["imu_link"]["inertial"] == {"mass": 0.015, "inertia": {"ixx": 1e-5, "iyy": 1e-5,
                                                                                   "izz": 1e-5}}
+
+
+def test_a_mass_too_heavy_for_its_geometry_is_kept_and_reported(tmp_path):
+    """1 kg on a 1 cm box (TIAGo's base_footprint): no one reading (a placeholder on a marker, or a
+    part drawn smaller than it is), so the mass is the vendor's, and the import says check's verdict."""
+    source = tmp_path / "heavy.urdf"
+    source.write_text(_robot("heavy", _cube("base_footprint", 1.0, 0.01)), encoding="utf-8")
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    assert result.repairs == {}
+    assert [w for w in result.warnings if "link '" in w] == [
+        "heavy.urdf:3: link 'base_footprint': the original's mass 1 kg over its geometry's 1e-06 m^3 implies 1e+06 "
+        "kg/m^3, above 25000 (the mass looks like grams written as kilograms): kept (check reports it)"]
