@@ -4,7 +4,9 @@
     FILE.urdf  ────────────────▶
 
 :func:`import_file` is the entry point.  Inertials are kept as given (explicit) unless
-``recompute_inertials``; what the recipe cannot express is carried verbatim in
+``recompute_inertials``, or unless check would report them (no real body has them, they do not
+fit their geometry, their mass is too light for it: robotkit.importer.fit), each change stated;
+what the recipe cannot express is carried verbatim in
 ``urdf_extras`` or reported in ``ImportResult.warnings``.  Nothing is written when the
 input has problems (RobotkitError, one line each).
 """
