@@ -5,7 +5,8 @@
 
 :func:`import_file` is the entry point.  Inertials are kept as given (explicit) unless
 ``recompute_inertials``, or unless check would report them (no real body has them, they do not
-fit their geometry, their mass is too light for it: robotkit.importer.fit), each change stated;
+fit their geometry, their mass is MeshLab's volume at density 1: robotkit.importer.fit), each
+change stated;
 what the recipe cannot express is carried verbatim in
 ``urdf_extras`` or reported in ``ImportResult.warnings``.  Nothing is written when the
 input has problems (RobotkitError, one line each).
@@ -33,7 +34,6 @@ from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
 from robotkit.importer.urdf_to_recipe import Converted, urdf_to_recipe
 from robotkit.importer.xacro_expand import check_package_paths, expand
 from robotkit.model.load import load_robots
-from robotkit.model.plausible import DENSITY_RANGE
 from robotkit.paths import inside, recipe_policy, widened
 from robotkit.recipe.schema import Recipe
 
@@ -106,8 +106,9 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     (keep, repair, recompute, estimate; see robotkit.importer.inertials.chosen_inertial), with a
     comment above its link saying what was wrong; by default (None) the repair, and where the
     tensor, given or repaired, does not fit the link's geometry by check's rule, a recompute, and
-    where the mass is too light for the geometry's volume (check's implied density), mass and
-    tensor from the geometry at the recipe's density (robotkit.importer.fit); ``keep`` keeps them.  ``copy_meshes`` copies every mesh below the recipe's folder
+    where the mass is the geometry's volume at density 1 (MeshLab's; check's implied density),
+    mass and tensor from the geometry at the recipe's density (robotkit.importer.fit); ``keep``
+    keeps them.  ``copy_meshes`` copies every mesh below the recipe's folder
     (``meshes/PKG/...``) instead of referencing it where it is; the meshes outside the recipe's
     project, which its build may not read, are copied whatever it says, with their package's
     licence files.
@@ -219,8 +220,8 @@ def _header(source: Path, out: Path, args: dict[str, str] | None, recompute_iner
                       f"{inertia_policy} (--inertia-policy)")
         if fit:
             header.append("a tensor, given or repaired, that does not fit the link's geometry (check's inertia-box "
-                          "rule): recompute, or estimate without a closed geometry; a mass below "
-                          f"{DENSITY_RANGE[0]:g} kg/m^3 of its geometry: computed from it at the recipe's density")
+                          "rule): recompute, or estimate without a closed geometry; a mass that is its geometry's "
+                          "volume at density 1 (MeshLab's): computed from it at the recipe's density")
     return header
 
 

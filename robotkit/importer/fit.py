@@ -99,14 +99,16 @@ def describe(fit: inertia_policy.BoxFit) -> str:
             f"than {than} ({sides[1]} m), along {fit.axes}")
 
 
+MESHLAB = "the mass is the mesh volume at density 1, MeshLab's default"
+
+
 def _too_light(mass: float, volume: float | None) -> str | None:
     """Why ``mass`` over the closed ``volume`` is no solid part (check's implied-density rule, below
     its range), else None."""
     if not volume or mass / volume >= DENSITY_RANGE[0]:
         return None
     density = mass / volume
-    cause = ("the mass is the mesh volume at density 1, MeshLab's default" if abs(density - 1.0) < 0.05
-             else "the density or mass is far too low")
+    cause = MESHLAB if abs(density - 1.0) < 0.05 else "the density or mass is far too low"
     return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {density:.3g} kg/m^3, "
             f"below {DENSITY_RANGE[0]:g} ({cause})")
 
@@ -126,8 +128,9 @@ def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str
     """(link -> (policy, why) for the tensors, given or repaired, that do not fit and the masses no
     solid part of that volume has, when ``recompute``; link -> why for those kept otherwise), judged
     as check's errors.  A tensor that does not fit gets ``recompute`` (``estimate`` without a
-    closed geometry), a mass too light for its volume ``density`` (mass and tensor from the
-    geometry at the recipe's density)."""
+    closed geometry), a mass that is the volume at density 1 (MeshLab's) ``density`` (mass and
+    tensor from the geometry at the recipe's density); another too light or too heavy for its
+    volume is kept (the geometry may be what is wrong)."""
     overrides, kept = {}, {}
     for link in robot.links:
         given = explicit.get(link.name)
@@ -139,13 +142,12 @@ def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str
         if heavy:  # a placeholder mass on a marker, or a part drawn smaller than it is: no one reading
             kept[link.name] = f"{heavy}: kept (check reports it)"
         light = _too_light(given["mass"], volume)
-        if light:
-            if recompute:
-                overrides[link.name] = ("density", light)
-            else:
-                kept[link.name] = (f"{light}; compute it from the geometry at the recipe's density (no inertial "
-                                   "on the link in the recipe)")
+        if light and recompute and MESHLAB in light:  # the one obvious reading: MeshLab's volume as the mass
+            overrides[link.name] = ("density", light)
             continue
+        if light:  # else the geometry may be what is wrong (simple_humanoid's 4 m^3 body of 27 kg)
+            kept[link.name] = (f"{light}; compute it from the geometry at the recipe's density (no inertial "
+                               "on the link in the recipe)" if MESHLAB in light else f"{light}: kept (check reports it)")
         if fit.severity != "error":
             continue
         t = given["inertia"]

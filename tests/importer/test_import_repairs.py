@@ -329,3 +329,15 @@ def test_a_mass_too_heavy_for_its_geometry_is_kept_and_reported(tmp_path):
     assert [w for w in result.warnings if "link '" in w] == [
         "heavy.urdf:3: link 'base_footprint': the original's mass 1 kg over its geometry's 1e-06 m^3 implies 1e+06 "
         "kg/m^3, above 25000 (the mass looks like grams written as kilograms): kept (check reports it)"]
+
+
+def test_a_mass_too_light_but_not_meshlabs_is_kept_and_reported(tmp_path):
+    """simple_humanoid's body: 27 kg in 4.1 m^3 of geometry is no MeshLab mass; the geometry may be
+    what is wrong, so the mass is the vendor's and the import says check's verdict."""
+    source = tmp_path / "light.urdf"
+    source.write_text(_robot("light", _cube("body", 27.0, 1.6)), encoding="utf-8")
+    result = import_file(source, tmp_path / "recipe" / "robot.yaml", {}, {})
+    assert result.repairs == {}
+    assert [w for w in result.warnings if "link '" in w] == [
+        "light.urdf:3: link 'body': the original's mass 27 kg over its geometry's 4.096 m^3 implies 6.59 kg/m^3, "
+        "below 10 (the density or mass is far too low): kept (check reports it)"]
