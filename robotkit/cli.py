@@ -206,7 +206,9 @@ def _add_import(subparsers) -> argparse.ArgumentParser:
                         "as the build would), repair it with the smallest change, recompute it from "
                         "the link's geometry or estimate it from its bounding primitive, keeping the mass "
                         "(a link without geometry is repaired); default: repair, and recompute (estimate "
-                        "without a closed geometry) where the repaired tensor does not fit the geometry")
+                        "without a closed geometry) where a tensor, given or repaired, does not fit the geometry, "
+                        "and compute at the recipe's density a mass that is its geometry's volume at density 1 "
+                        "(MeshLab's); keep keeps those too")
     p.add_argument("--recompute-inertials", action="store_true",
                    help="compute every link's inertial from its geometry, physical or not (keeping each "
                         "link's mass, or at --density) and report the difference per link")

@@ -80,6 +80,7 @@ class JointFacts:
     mimic: str | None = None
     parent: str | None = None
     child: str | None = None
+    driven_by: str | None = None  # what drives it: "transmission 'T'" or "ros2_control 'R'"; None: passive
 
 
 # ---------------------------------------------------------------- reading a URDF
@@ -242,6 +243,9 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
         joints.append(JointFacts(el.get("name"), el.get("type"), num("lower"), num("upper"), num("effort"),
                                  num("velocity"), mimic.get("joint") if mimic is not None else None,
                                  ends["parent"], ends["child"]))
+    drivers = _drivers(root)
+    for j in joints:
+        j.driven_by = drivers.get(j.name)
     names = {j.name for j in joints}
     for el in root.findall("transmission"):  # the Jackal's name 'front_left_wheel' for 'front_left_wheel_joint'
         for j in el.findall("joint"):
@@ -251,6 +255,20 @@ def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
                                         "refuses the URDF and ros_control the transmission",
                                         "name one of the robot's joints; robotkit import leaves it out"))
     return links, joints, problems
+
+
+def _drivers(root) -> dict[str, str]:
+    """Joint -> what drives it: a <transmission> naming it, or a <ros2_control> joint with a
+    command interface (one with state interfaces only is read, not driven)."""
+    out: dict[str, str] = {}
+    for el in root.findall("transmission"):
+        for j in el.findall("joint"):
+            out.setdefault(j.get("name"), f"transmission '{el.get('name')}'")
+    for el in root.findall("ros2_control"):
+        for j in el.findall("joint"):
+            if j.find("command_interface") is not None:
+                out.setdefault(j.get("name"), f"ros2_control '{el.get('name')}'")
+    return out
 
 
 # ---------------------------------------------------------------- the rules
@@ -501,6 +519,28 @@ def lint_massless_moving(links: list[LinkFacts], joints: list[JointFacts]) -> li
     return out
 
 
+def _zero_limits(j: JointFacts, s: str) -> list[Finding]:
+    """An effort or velocity limit that is not positive.  A limit of 0 on a joint that nothing
+    drives (no transmission, no ros2_control command) is a statement: a passive joint, moved by
+    what it carries (the SolidWorks exporter and ROS-Industrial's kinematic files write 0); on a
+    driven joint it is an error, as is a negative one anywhere."""
+    out = []
+    for key, v in (("effort", j.effort), ("velocity", j.velocity)):
+        if v is None or v > 0:
+            continue
+        if v < 0:
+            out.append(Finding("error", "joint-limits", s, f"{key} limit {v:g} is not positive"))
+        elif j.driven_by is not None:
+            out.append(Finding("error", "joint-limits", s, f"{key} limit 0 is not positive, and {j.driven_by} "
+                               f"drives it: a driven joint with zero {key} cannot move",
+                               f"give it the motor's {key} limit"))
+        else:
+            out.append(Finding("warning", "passive-joint", s, f"{key} limit 0: nothing drives it (no transmission "
+                               "or ros2_control command names it), a passive joint",
+                               f"give it the motor's {key} limit if a motor drives it"))
+    return out
+
+
 def lint_joints(joints: list[JointFacts]) -> list[Finding]:
     out = []
     by_name = {j.name: j for j in joints}
@@ -509,11 +549,7 @@ def lint_joints(joints: list[JointFacts]) -> list[Finding]:
         if j.type in ("revolute", "prismatic"):
             if j.lower is not None and j.upper is not None and j.lower >= j.upper:
                 out.append(Finding("error", "joint-limits", s, f"lower limit {j.lower:g} is not below upper {j.upper:g}"))
-            if j.effort is not None and j.effort <= 0:
-                out.append(Finding("error", "joint-limits", s, f"effort limit {j.effort:g} is not positive",
-                                   "a joint with zero effort cannot be driven"))
-            if j.velocity is not None and j.velocity <= 0:
-                out.append(Finding("error", "joint-limits", s, f"velocity limit {j.velocity:g} is not positive"))
+            out += _zero_limits(j, s)
         if j.mimic is not None and j.mimic not in by_name:  # check_urdf accepts it (Alex's hands)
             out.append(Finding("error", "mimic-missing", s, f"mimics joint '{j.mimic}', which the robot does not "
                                "have: Drake refuses the URDF", "name one of the robot's joints; robotkit import "

@@ -4,7 +4,10 @@
     FILE.urdf  ────────────────▶
 
 :func:`import_file` is the entry point.  Inertials are kept as given (explicit) unless
-``recompute_inertials``; what the recipe cannot express is carried verbatim in
+``recompute_inertials``, or unless check would report them (no real body has them, they do not
+fit their geometry, their mass is MeshLab's volume at density 1: robotkit.importer.fit), each
+change stated;
+what the recipe cannot express is carried verbatim in
 ``urdf_extras`` or reported in ``ImportResult.warnings``.  Nothing is written when the
 input has problems (RobotkitError, one line each).
 """
@@ -102,8 +105,10 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
     physical inertial is kept as given and one that no real body has gets ``inertia_policy``
     (keep, repair, recompute, estimate; see robotkit.importer.inertials.chosen_inertial), with a
     comment above its link saying what was wrong; by default (None) the repair, and where the
-    repaired tensor does not fit the link's geometry by check's rule, a recompute
-    (robotkit.importer.fit).  ``copy_meshes`` copies every mesh below the recipe's folder
+    tensor, given or repaired, does not fit the link's geometry by check's rule, a recompute, and
+    where the mass is the geometry's volume at density 1 (MeshLab's; check's implied density),
+    mass and tensor from the geometry at the recipe's density (robotkit.importer.fit); ``keep``
+    keeps them.  ``copy_meshes`` copies every mesh below the recipe's folder
     (``meshes/PKG/...``) instead of referencing it where it is; the meshes outside the recipe's
     project, which its build may not read, are copied whatever it says, with their package's
     licence files.
@@ -143,8 +148,7 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
         tmp.unlink()
         overrides.update(more)
     os.replace(tmp, out)
-    warnings.extend(f"{_where(source, lines, name)}link '{name}': the given inertial does not fit its geometry: {why}"
-                    for name, why in kept.items())
+    warnings.extend(f"{_where(source, lines, name)}link '{name}': {why}" for name, why in kept.items())
     result = ImportResult(out, recipe["robot"], warnings, inputs, copied, extras=list(conv.extras),
                           repairs=dict(conv.repairs), joint_notes=dict(conv.joint_notes),
                           left_out=list(conv.left_out))
@@ -215,8 +219,9 @@ def _header(source: Path, out: Path, args: dict[str, str] | None, recompute_iner
         header.append("inertials as given in the original (explicit); those no real body has: "
                       f"{inertia_policy} (--inertia-policy)")
         if fit:
-            header.append("a repair that does not fit the link's geometry (check's inertia-box rule): recompute, "
-                          "or estimate without a closed geometry")
+            header.append("a tensor, given or repaired, that does not fit the link's geometry (check's inertia-box "
+                          "rule): recompute, or estimate without a closed geometry; a mass that is its geometry's "
+                          "volume at density 1 (MeshLab's): computed from it at the recipe's density")
     return header
 
 
@@ -277,8 +282,8 @@ def _element_lines(urdf_text: str) -> dict[tuple[str, str], int]:
         root = urdfxml.parse_text(urdf_text).getroot()
     except urdfxml.MalformedXML:
         return {}
-    return {(tag + "s", e.get("name")): e.sourceline for tag in ("link", "joint") for e in root.iter(tag)
-            if e.get("name")}
+    return {(tag + "s", e.get("name").lstrip("/")): e.sourceline for tag in ("link", "joint")
+            for e in root.iter(tag) if e.get("name")}  # '/base_link' is imported as base_link
 
 
 def import_mjcf(path, out_recipe, build=None):

@@ -75,6 +75,7 @@ def _shared(items: dict, path: tuple, kind: str, base: dict):
     """The value at ``path`` that more than half of the items it applies to hold (and at least
     three), or _NONE."""
     counts: dict[str, int] = {}
+    mappings = False  # an item's own mapping is merged into a default mapping, not put in its place
     applicable = 0
     for item in items.values():
         if not isinstance(item, dict) or not _applies(path, item, kind, base):
@@ -84,12 +85,16 @@ def _shared(items: dict, path: tuple, kind: str, base: dict):
         if found is not _NONE and found is not None:
             key = json.dumps(found, sort_keys=True)
             counts[key] = counts.get(key, 0) + 1
+            mappings = mappings or isinstance(found, dict)
     if not counts:
         return _NONE
     key, count = min(counts.items(), key=lambda kv: (-kv[1], kv[0]))
     if count < MIN_SHARED or 2 * count <= applicable:
         return _NONE
-    return json.loads(key)
+    value = json.loads(key)
+    if isinstance(value, dict) and len(counts) > 1 and mappings:  # the Iris: rotors' cylinder, the body's box
+        return _NONE
+    return value
 
 
 def _without(item, path: tuple, value, kind: str, base: dict):

@@ -19,6 +19,7 @@ from robotkit.importer.recipe_writer import fmt
 from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
 from robotkit.model import massprops
+from robotkit.model.plausible import DENSITY_RANGE
 from robotkit.model.resolve import geom_mass_props
 
 
@@ -49,20 +50,46 @@ def _points(geom) -> np.ndarray:
     return P @ T[:3, :3].T + T[:3, 3]
 
 
-def link_fit(link) -> inertia_policy.BoxFit | None:
+def _closed(geoms) -> tuple[float, np.ndarray] | None:
+    """(volume, unit-density inertia) of the geometry when it is all closed, else None."""
+    if not all(g.shape.kind != "mesh" or mesh_is_closed(g.shape.mesh.source, g.shape.mesh.scale) for g in geoms):
+        return None
+    facts = {g.shape.mesh.key: _facts(g.shape.mesh) for g in geoms if g.shape.kind == "mesh"}
+    volume, _, I = massprops.combine([geom_mass_props(g, facts) for g in geoms])
+    return volume, I
+
+
+def link_fit(link) -> tuple[inertia_policy.BoxFit, float | None] | None:
     """The fit of a resolved link's explicit inertial to its visual (else collision) geometry,
-    as check judges it; None when it has no explicit inertial or no geometry."""
+    as check judges it, with the geometry's volume (None when not closed); None when it has no
+    explicit inertial or no geometry."""
     geoms = list(link.visuals or link.collisions)
     if link.inertial_spec.mode != "explicit" or not geoms:
         return None
     given = link.inertial_spec.explicit
-    closed = all(g.shape.kind != "mesh" or mesh_is_closed(g.shape.mesh.source, g.shape.mesh.scale) for g in geoms)
+    closed = _closed(geoms)
     if closed:
-        facts = {g.shape.mesh.key: _facts(g.shape.mesh) for g in geoms if g.shape.kind == "mesh"}
-        volume, _, I = massprops.combine([geom_mass_props(g, facts) for g in geoms])
-        return inertia_policy.box_fit_geometry(given.mass, given.tensor(), volume, I)
+        if max(_size(g) for g in geoms) <= MARKER:
+            return None
+        volume, I = closed
+        return inertia_policy.box_fit_geometry(given.mass, given.tensor(), volume, I), volume
     points = np.vstack([_points(g) for g in geoms])
-    return inertia_policy.box_fit_extent(given.mass, given.com, given.tensor(), points)
+    if float(np.ptp(points, axis=0).max()) <= MARKER:
+        return None
+    return inertia_policy.box_fit_extent(given.mass, given.com, given.tensor(), points), None
+
+
+MARKER = 1e-3
+"""m: geometry no larger marks a frame (an IMU's 1 mm box) and says nothing of the part; check
+reads it so too (robotkit.check.lints.MARKER)."""
+
+
+def _size(geom) -> float:
+    """The largest side of a geometry's bounding box (a closed mesh's from its cached facts)."""
+    if geom.shape.kind == "mesh":
+        f = _facts(geom.shape.mesh)
+        return float(np.max(np.asarray(f["bbox_max"]) - np.asarray(f["bbox_min"])))
+    return float(np.ptp(_points(geom), axis=0).max())
 
 
 def describe(fit: inertia_policy.BoxFit) -> str:
@@ -72,23 +99,67 @@ def describe(fit: inertia_policy.BoxFit) -> str:
             f"than {than} ({sides[1]} m), along {fit.axes}")
 
 
+MESHLAB = "the mass is the mesh volume at density 1, MeshLab's default"
+
+
+def _too_light(mass: float, volume: float | None) -> str | None:
+    """Why ``mass`` over the closed ``volume`` is no solid part (check's implied-density rule, below
+    its range), else None."""
+    if not volume or mass / volume >= DENSITY_RANGE[0]:
+        return None
+    density = mass / volume
+    cause = MESHLAB if abs(density - 1.0) < 0.05 else "the density or mass is far too low"
+    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {density:.3g} kg/m^3, "
+            f"below {DENSITY_RANGE[0]:g} ({cause})")
+
+
+def _too_heavy(mass: float, volume: float | None) -> str | None:
+    """Why ``mass`` over the closed ``volume`` is denser than any solid part (check's rule), else None."""
+    if not volume or mass / volume <= DENSITY_RANGE[1]:
+        return None
+    density = mass / volume
+    cause = ("the mass looks like grams written as kilograms" if density / 1000 < DENSITY_RANGE[1]
+             else "the geometry is far too small for the mass (units?)")
+    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {density:.4g} kg/m^3, "
+            f"above {DENSITY_RANGE[1]:g} ({cause})")
+
+
 def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
-    """(link -> (policy, why) for the repaired tensors that do not fit, when ``recompute``; link ->
-    why for the given physical ones that do not fit), judged as check's errors."""
+    """(link -> (policy, why) for the tensors, given or repaired, that do not fit and the masses no
+    solid part of that volume has, when ``recompute``; link -> why for those kept otherwise), judged
+    as check's errors.  A tensor that does not fit gets ``recompute`` (``estimate`` without a
+    closed geometry), a mass that is the volume at density 1 (MeshLab's) ``density`` (mass and
+    tensor from the geometry at the recipe's density); another too light or too heavy for its
+    volume is kept (the geometry may be what is wrong)."""
     overrides, kept = {}, {}
     for link in robot.links:
         given = explicit.get(link.name)
-        fit = link_fit(link) if given is not None else None
-        if fit is None or fit.severity != "error":
+        found = link_fit(link) if given is not None else None
+        if found is None:
+            continue
+        fit, volume = found
+        heavy = _too_heavy(given["mass"], volume)
+        if heavy:  # a placeholder mass on a marker, or a part drawn smaller than it is: no one reading
+            kept[link.name] = f"{heavy}: kept (check reports it)"
+        light = _too_light(given["mass"], volume)
+        if light and recompute and MESHLAB in light:  # the one obvious reading: MeshLab's volume as the mass
+            overrides[link.name] = ("density", light)
+            continue
+        if light:  # else the geometry may be what is wrong (simple_humanoid's 4 m^3 body of 27 kg)
+            kept[link.name] = (f"{light}; compute it from the geometry at the recipe's density (no inertial "
+                               "on the link in the recipe)" if MESHLAB in light else f"{light}: kept (check reports it)")
+        if fit.severity != "error":
             continue
         t = given["inertia"]
         tensor = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]],
                            [t["ixz"], t["iyz"], t["izz"]]])
-        if inertia_policy.defects(given["mass"], tensor):
-            if recompute:
-                overrides[link.name] = ("recompute" if fit.slack == 1 else "estimate",
-                                        f"repaired, {describe(fit)}")
-        else:
-            kept[link.name] = (f"{describe(fit)}; recompute it from the geometry (inertial: {{mass: {fmt(given['mass'])}}} "
-                               "on the link in the recipe, or import with --recompute-inertials)")
+        repaired = bool(inertia_policy.defects(given["mass"], tensor))
+        if recompute:
+            overrides[link.name] = ("recompute" if fit.slack == 1 else "estimate",
+                                    f"repaired, {describe(fit)}" if repaired
+                                    else f"the given inertial does not fit its geometry: {describe(fit)}")
+        elif not repaired:
+            kept[link.name] = (f"the given inertial does not fit its geometry: {describe(fit)}; recompute it from the "
+                               f"geometry (inertial: {{mass: {fmt(given['mass'])}}} on the link in the recipe, or "
+                               "import with --recompute-inertials)")
     return overrides, kept

@@ -77,17 +77,22 @@ POLICIES = ("keep", "repair", "recompute", "estimate")
 
 
 def chosen_inertial(name: str, given: dict, source: str | None, policy: str, repairs: dict[str, str],
-                    why: str = "") -> dict:
+                    why: str = "") -> dict | None:
     """The recipe's inertial for link ``name`` whose original gives a positive mass: as given when
     it is physical, else by ``policy`` (``source``: the geometry a recompute or an estimate reads,
     None when the link has none, which gets the repair), with what was wrong and what was done in
-    ``repairs[name]`` (the comment above the link; ``why``: why not the repair, when the policy
-    replaces it).  ``keep`` writes the tensor as given: the import then stops on it, as the build
-    would."""
+    ``repairs[name]`` (the comment above the link; ``why``: why not the repair, or why a physical
+    tensor is replaced, when the import's fit (robotkit.importer.fit) gives the policy; ``density``:
+    no inertial, the geometry's at the recipe's density, None for the visual geometry).  ``keep``
+    writes the tensor as given: the import then stops on a defect, as the build would."""
     wrong = inertia_policy.defects(given["mass"], _tensor(given["inertia"]))
-    if not wrong or policy == "keep":
+    if policy == "keep" or not (wrong or why):  # ``why``: the import's fit overrides a physical one too
         return _explicit_dict(given)
-    what = f"the original's {'; '.join(wrong)}" + (f"; {why}" if why else "")
+    what = "; ".join(filter(None, (f"the original's {'; '.join(wrong)}" if wrong else "", why)))
+    if policy == "density" and source is not None:  # a mass no solid part of its volume has
+        repairs[name] = (f"{what}: mass and inertia computed from its {source} geometry at the recipe's density "
+                         "(the given ones are unused)")
+        return {"source": source} if source != "visual" else None
     if policy in ("recompute", "estimate") and source is not None:
         spec = {**_explicit_dict(given), "policy": policy}  # the given values stay, for the record
         if source != "visual":

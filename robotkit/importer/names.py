@@ -30,3 +30,42 @@ def material_name(name: str, taken: set[str]) -> str:
 
 def name_hint() -> str:
     return FRAME_NAME_HINT
+
+
+REFERENCES = (("joint", "parent", "link"), ("joint", "child", "link"), ("joint", "mimic", "joint"),
+              ("transmission", "joint", "name"), ("ros2_control", "joint", "name"))
+"""(top-level element, its child, attribute): where a URDF names a link or joint."""
+
+
+def without_leading_slash(children: list) -> dict[str, tuple[str, str]]:
+    """Link and joint names with a leading '/' (the old tf_prefix style: ``/base_link``, the
+    Interbotix arms' ``${robot_name}/base_link`` with an empty name) lose it, in the elements
+    ``children`` of <robot> (edited in place) and wherever they are named: joints' parent,
+    child and mimic, gazebo references, transmissions and ros2_control, and a gazebo block's
+    text that is exactly the name (a plugin's frame).  A name whose bare form is taken or
+    still invalid keeps its slash (the import refuses it).  Returns old name -> (kind, new)."""
+    named = {(el.tag, el.get("name")) for el in children if el.tag in ("link", "joint")}
+    renamed: dict[str, tuple[str, str]] = {}
+    for el in children:
+        name = el.get("name")
+        if el.tag not in ("link", "joint") or not name or not name.startswith("/"):
+            continue
+        bare = name.lstrip("/")
+        if valid_frame_name(bare) and (el.tag, bare) not in named:
+            renamed[name] = (el.tag, bare)
+            named.add((el.tag, bare))
+    if not renamed:
+        return renamed
+    for el in children:
+        if el.tag in ("link", "joint") and el.get("name") in renamed:
+            el.set("name", renamed[el.get("name")][1])
+        if el.tag == "gazebo" and el.get("reference") in renamed:
+            el.set("reference", renamed[el.get("reference")][1])
+        for tag, child, attr in REFERENCES:
+            for ref in el.findall(child) if el.tag == tag else ():
+                if ref.get(attr) in renamed:
+                    ref.set(attr, renamed[ref.get(attr)][1])
+        for sub in el.iter() if el.tag == "gazebo" else ():
+            if sub is not el and isinstance(sub.tag, str) and (sub.text or "").strip() in renamed and not len(sub):
+                sub.text = renamed[sub.text.strip()][1]
+    return renamed

@@ -37,12 +37,12 @@ from robotkit.errors import Problem, RobotkitError, short_number
 from robotkit.importer.inertials import chosen_inertial, give_moving_links_mass, no_inertial_form, read_inertial
 from robotkit.importer import units as mesh_units
 from robotkit.importer.meshes import MeshResolver, MeshUse
-from robotkit.importer.names import material_name, name_hint, valid_frame_name, valid_name
+from robotkit.importer.names import material_name, name_hint, valid_frame_name, valid_name, without_leading_slash
 from robotkit.importer.parsing import (Problems, fmt_list, shown, local_name, origin_dict, read_float, read_floats,
                                        read_origin)
 from robotkit.importer.recipe_writer import fmt
 from robotkit.geometry import rpy_matrix
-from robotkit.recipe.schema import JOINT_TYPES, MIN_MASS, UNITS
+from robotkit.recipe.schema import JOINT_TYPES, MAX_LENGTH, MIN_MASS, UNITS
 
 GREY = [0.5, 0.5, 0.5, 1.0]
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
@@ -122,10 +122,13 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
     r = _Reading(Problems(str(source)), [], MeshResolver(source, recipe_dir, dict(package_paths or {}), copy_meshes),
                  Converted(recipe={}), recompute_inertials, density, inertia_policy, lines, dict(overrides or {}))
     robot_name = _robot_name(root.get("name") or source.name.split(".")[0], r.warnings)
+    renamed = without_leading_slash(children)
     materials = _Materials(children, r.problems, r.warnings)
     links = _links(children, materials, r)
     joints = _joints(children, links.links, r)
+    _note_renamed(renamed, r)
     extras = _extras(children, root, links, joints, materials.materials, r)
+    _zero_limits(children, joints, r)
     r.problems.raise_if_any()
     give_moving_links_mass(links.links, joints, r.out)
     for link, why in r.out.repairs.items():
@@ -143,6 +146,20 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
         recipe["urdf_extras"] = extras
     r.out.recipe, r.out.warnings, r.out.copies = recipe, r.warnings, dict(r.resolver.copies)
     return r.out
+
+
+def _note_renamed(renamed: dict[str, tuple[str, str]], r: _Reading) -> None:
+    """Each link and joint that lost its leading '/' (robotkit.importer.names.without_leading_slash),
+    stated above it in the recipe and in a warning."""
+    for old, (kind, new) in renamed.items():
+        where = "its joints and gazebo blocks" if kind == "link" else "mimics and transmissions"
+        note = (f"named '{old}' in the original: a recipe name cannot start with '/' (the old tf_prefix style), "
+                f"so the '/' is dropped here and where {where} name it")
+        if kind == "joint":
+            _note(new, note, r)
+        else:
+            r.notes.setdefault(new, []).append(note)
+            r.warnings.append(f"link '{new}': {note}")
 
 
 def _robot_element(text: str, source: Path):
@@ -604,6 +621,11 @@ def _joint(el, name: str, problems: Problems, warnings: list[str]) -> dict | Non
         return None
     _dynamics(el.find("dynamics"), joint, what, problems)
     _mimic(el.find("mimic"), joint, what, problems)
+    if jtype in ("fixed", "floating", "planar") and joint.get("mimic"):  # TALOS reduced: locked gripper joints
+        note = (f"a {jtype} joint mimicking joint '{joint.pop('mimic')['joint']}' in the original: a {jtype} joint "
+                "follows no other joint, so the mimic is dropped")
+        warnings.append(f"{what}: {note}")
+        joint["__note"] = note
     for child_el in el:
         tag = local_name(child_el.tag)
         if is_element(child_el) and tag not in ("parent", "child", "origin", "axis", "limit", "dynamics", "mimic"):
@@ -654,6 +676,8 @@ def _bounded_limit(el, limit_el, joint: dict, what: str, problems: Problems, war
             problems.add(f"{what}: <limit> needs {key} (URDF requires effort and velocity)")
             return None
         limit[key] = v
+    if _unlimited(limit, joint, what, warnings):
+        return el
     if limit["lower"] == limit["upper"] and joint["type"] == "revolute":
         note = (f"limit lower == upper ({limit['lower']!r}) in the original: read as no position limit "
                 "(lower and upper default to 0 in URDF), the joint is continuous")
@@ -674,6 +698,32 @@ def _bounded_limit(el, limit_el, joint: dict, what: str, problems: Problems, war
                 limit[key] = -limit[key]
         joint["limit"] = limit
     return el
+
+
+def _unlimited(limit: dict, joint: dict, what: str, warnings: list[str]) -> bool:
+    """Position limits beyond the recipe's range (MAX_LENGTH: 10 km, 10000 rad) mean "unlimited"
+    (the Iris drone's rotors and Neobotix's wheels: +-1e16): a revolute joint with both is read as
+    continuous (True: ``joint`` is done), a bound beyond it otherwise is clamped to it."""
+    beyond = [k for k in ("lower", "upper") if not abs(limit[k]) <= MAX_LENGTH]
+    if not beyond:
+        return False
+    shown_limits = " and ".join(f"{k} {limit[k]!r}" for k in beyond)
+    if joint["type"] == "revolute" and limit["lower"] < -MAX_LENGTH and limit["upper"] > MAX_LENGTH:
+        note = (f"limit {shown_limits} in the original, beyond any physical range (a recipe's is "
+                f"+-{short_number(MAX_LENGTH)}): read as no position limit, the joint is continuous")
+        joint["type"] = "continuous"
+        joint["limit"] = {k: abs(limit[k]) for k in ("effort", "velocity")}
+    else:
+        for k in beyond:
+            limit[k] = math.copysign(MAX_LENGTH, limit[k])
+        note = (f"limit {shown_limits} in the original, beyond any physical range (a recipe's is "
+                f"+-{short_number(MAX_LENGTH)}): read as no limit on that side, clamped to the recipe's")
+        for key in ("effort", "velocity"):
+            limit[key] = abs(limit[key])
+        joint["limit"] = limit
+    warnings.append(f"{what}: {note}")
+    joint["__note"] = note
+    return True
 
 
 def _fixed_at(el, joint: dict, at: float, what: str, problems: Problems, warnings: list[str]):
@@ -747,6 +797,38 @@ def _without_mimic(el, joint: dict, what: str, warnings: list[str]):
     el = copy.deepcopy(el)
     el.remove(el.find("mimic"))
     return el
+
+
+def _drivers(children: list) -> dict[str, tuple[str, object]]:
+    """Joint -> (what drives it, that element): a <transmission> naming it, or a <ros2_control>
+    joint with a command interface (as robotkit.check.lints reads the build)."""
+    out: dict[str, tuple[str, object]] = {}
+    for el in children:
+        tag = local_name(el.tag)
+        for j in el.findall("joint") if tag in ("transmission", "ros2_control") else ():
+            if tag == "transmission" or j.find("command_interface") is not None:
+                out.setdefault(j.get("name"), (f"{tag} '{el.get('name')}'", el))
+    return out
+
+
+def _zero_limits(children: list, joints: dict[str, dict], r: _Reading) -> None:
+    """An effort or velocity limit of 0 is kept: on a joint nothing drives, a passive joint (stated
+    above it); on a driven one, a defect check reports (a warning naming the line)."""
+    drivers = _drivers(children)
+    elements = {el.get("name"): el for el in children if local_name(el.tag) == "joint"}
+    for name, joint in joints.items():
+        limit = joint.get("limit") or {}
+        zero = [k for k in ("effort", "velocity") if limit.get(k) == 0]
+        if joint["type"] not in ("revolute", "prismatic") or not zero:
+            continue
+        limits = f"{' and '.join(zero)} limit{'s' if len(zero) > 1 else ''} 0 in the original"
+        if name in drivers:
+            r.warnings.append(f"{r.where(elements[name])}joint '{name}': {limits}, and {drivers[name][0]} drives it: "
+                              f"a driven joint with zero {zero[0]} cannot move (check reports it; give it the "
+                              "motor's limit)")
+        else:
+            _note(name, f"{limits}: nothing drives it (no transmission or ros2_control command names it), so it "
+                        "is kept as a passive joint", r)
 
 
 # ---------------------------------------------------------------- everything else

@@ -133,7 +133,8 @@ def test_joint_lints(tmp_path):
     found = findings_for(tmp_path, arm_urdf(joint_limit='lower="1" upper="-1" effort="0" velocity="-2"'))
     assert [(f.check, f.message) for f in found] == [
         ("joint-limits", "lower limit 1 is not below upper -1"),
-        ("joint-limits", "effort limit 0 is not positive"),
+        ("passive-joint", "effort limit 0: nothing drives it (no transmission or ros2_control command names it), "
+                          "a passive joint"),
         ("joint-limits", "velocity limit -2 is not positive"),
     ]
 

@@ -347,17 +347,15 @@ DEFECTS = {  # every error `robotkit check` names on each original; why each is 
     # the calf rotors' transverse moments exceed their axial one: a disc's are half of it
     "aliengo": {
         "inertia-box": ["FR_calf_rotor", "FL_calf_rotor", "RR_calf_rotor", "RL_calf_rotor"]},
-    # no <inertial> anywhere and effort 0 on every joint (ROS-Industrial's kinematics-only files)
+    # no <inertial> anywhere (ROS-Industrial's kinematics-only files; their effort 0 on every joint,
+    # which nothing drives, is a passive joint: a warning)
     "motoman_sda10f": {
-        "joint-limits": [f"arm_{side}_joint_{j}" for side in ("left", "right")
-                         for j in ("1_s", "2_l", "3_e", "4_u", "5_r", "6_b", "7_t")],
         # torso_base_link: massless, welded above the torso joint (libsdformat drops what moves below it)
         "massless-moving": ["torso_link_b1", "torso_link_b2"] + [f"arm_{side}_link_{j}" for side in ("left", "right")
                                                                  for j in ("1_s", "2_l", "3_e", "4_u", "5_r", "6_b",
                                                                            "7_t")] + ["torso_base_link"],
         "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"]},
     "fanuc_m10ia": {
-        "joint-limits": [f"joint_{i}" for i in range(1, 7)],
         "massless-moving": [f"link_{i}" for i in range(1, 7)],
         "consumer": ["Gazebo (URDF) refuses the robot: libsdformat's reading has no link at all (an empty model)"]},
     # the gripper links' tensor is a placeholder (the same moments on every axis: a 7.75 cm cube)

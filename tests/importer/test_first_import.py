@@ -158,12 +158,29 @@ def test_the_printed_build_command_builds_a_robot_that_passes_check(tmp_path, mo
     assert "error" not in checked.stdout.replace("0 errors", ""), checked.stdout
 
 
-def test_a_physical_tensor_that_does_not_fit_is_kept_with_a_warning(tmp_path, monkeypatch):
-    """A tensor some real body has is the vendor's: kept, with check's verdict and its fix."""
+def test_a_physical_tensor_that_does_not_fit_is_recomputed(tmp_path, monkeypatch):
+    """A tensor some real body has but not this part (check's inertia-box error) is recomputed from
+    the geometry by default, keeping the mass, stated above the link and in a warning."""
     urdf = workspace(tmp_path, inertial=TYRE.replace('izz="2"', 'izz="0.9"'))
     monkeypatch.delenv("ROBOTKIT_ROOT", raising=False)
     monkeypatch.chdir(tmp_path / "proj")
     result = import_file(urdf, "car.yaml")
+    why = ("the given inertial does not fit its geometry: its equivalent inertia box (5.2 x 5.2 x 1.73 m) is 96.2x "
+           "larger than the geometry's at uniform density (0.0571 x 0.0571 x 0.018 m), along x, y, z: recomputed "
+           "from its visual geometry, keeping the mass (policy: recompute; the given com and inertia are unused)")
+    assert [w for w in result.warnings if "car.urdf" in w] == [
+        UNITS_WARNING, f"../ws/tyre_pkg/urdf/car.urdf:7: link 'wheel': {why}"]
+    assert result.repairs["wheel"].endswith(why)
+    assert yaml.safe_load(Path("car.yaml").read_text(encoding="utf-8"))["links"]["wheel"]["inertial"] == {
+        "mass": 0.2, "inertia": {"ixx": 0.5, "iyy": 0.5, "izz": 0.9}, "policy": "recompute"}
+
+
+def test_keep_keeps_a_physical_tensor_that_does_not_fit_with_a_warning(tmp_path, monkeypatch):
+    """``--inertia-policy keep``: the vendor's tensor as given, with check's verdict and its fix."""
+    urdf = workspace(tmp_path, inertial=TYRE.replace('izz="2"', 'izz="0.9"'))
+    monkeypatch.delenv("ROBOTKIT_ROOT", raising=False)
+    monkeypatch.chdir(tmp_path / "proj")
+    result = import_file(urdf, "car.yaml", inertia_policy="keep")
     assert [w for w in result.warnings if "car.urdf" in w] == [UNITS_WARNING, (
         "../ws/tyre_pkg/urdf/car.urdf:7: link 'wheel': the given inertial does not fit its geometry: its equivalent "
         "inertia box (5.2 x 5.2 x 1.73 m) is 96.2x larger than the geometry's at uniform density (0.0571 x 0.0571 x "

@@ -241,7 +241,13 @@ def test_import_gives_the_welded_link_mass_and_gazebo_keeps_the_finger(tmp_path)
     assert result.repairs == {"mount": "no mass in the original (nor on the links welded below it), and joint 'slide' "
                                        "moves below it: Gazebo's URDF conversion drops everything that moves below "
                                        "it, though it is welded to a link with mass; computed from its visual "
-                                       "geometry at the recipe's density"}
+                                       "geometry at the recipe's density",
+                              # the finger's tensor, a 3.46 cm cube's on a 5 cm rod of 1 cm, is the part's
+                              "finger": "the given inertial does not fit its geometry: its equivalent inertia box "
+                                        "(0.0346 x 0.0346 x 0.0346 m) is 3.46x larger than the geometry's at uniform "
+                                        "density (0.01 x 0.01 x 0.05 m), along x, y, z: recomputed from its visual "
+                                        "geometry, keeping the mass (policy: recompute; the given com and inertia are "
+                                        "unused)"}
     assert "  # no mass in the original (nor on the links welded below it), and joint 'slide'" in \
         result.recipe_path.read_text(encoding="utf-8")
     built = build([result.recipe_path], tmp_path / "build")
