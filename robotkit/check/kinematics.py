@@ -26,6 +26,11 @@ from robotkit import mj, urdfxml
 
 WORLD = "world"
 NEGLIGIBLE = 1e-200  # kg: robotkit's URDF writes massless links as 1e-300 kg (see emit/urdf.py)
+# libsdformat turns a pose's rpy into a quaternion and prints it back as rpy (`ign sdf -p`): at a
+# pitch of +-pi/2 the asin loses half the digits (measured: 1.570796325 comes back 1.570796311893735,
+# 1.5e-8 in the rotation matrix, 2e-9 m at 0.15 m), so a reading through libsdformat holds poses
+# to sqrt(eps)
+LIBSDFORMAT_PRECISION = 1e-7
 
 
 def real_mass(m: float) -> float:
@@ -412,11 +417,30 @@ def _close(a, b, tol, scale=1.0) -> bool:
     return bool(np.all(np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)) <= tol * max(scale, 1e-300)))
 
 
+def pose_difference(A: np.ndarray, B: np.ndarray, tol: float) -> str | None:
+    """How frame ``B`` differs from ``A`` (4x4, same reference), or None when they agree: positions
+    to ``tol`` relative to the larger of 1 m and the distance (absolute near the origin),
+    orientations to ``tol`` in rotation-matrix entries."""
+    size = max(1.0, float(np.abs(A[:3, 3]).max()))
+    if not _close(A[:3, 3], B[:3, 3], tol, size):
+        return f"{A[:3, 3].tolist()} vs {B[:3, 3].tolist()}"
+    if not _close(A[:3, :3], B[:3, :3], tol):
+        return f"at {A[:3, 3].tolist()}, turned by {turn(A, B):.3g} rad"
+    return None
+
+
+def turn(A: np.ndarray, B: np.ndarray) -> float:
+    """The angle (rad) between the orientations of frames ``A`` and ``B``."""
+    cos = (np.trace(A[:3, :3].T @ B[:3, :3]) - 1) / 2
+    return math.acos(max(-1.0, min(1.0, float(cos))))
+
+
 def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: int = 0,
-            ignore: tuple[str, ...] = ()) -> list[str]:
+            ignore: tuple[str, ...] = (), pose_tol: float | None = None) -> list[str]:
     """Every difference between two readings of a robot, as sentences; [] when equivalent.
 
-    ``ignore`` names joint attributes one side cannot hold (e.g. "velocity" for MJCF)."""
+    ``ignore`` names joint attributes one side cannot hold (e.g. "velocity" for MJCF);
+    ``pose_tol`` is what the readers can hold of a link's pose (default ``tol``)."""
     diffs: list[str] = []
     la = {n for n in a.links if n != WORLD}
     lb = {n for n in b.links if n != WORLD}
@@ -480,10 +504,8 @@ def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: i
         Ta, Tb = a.fk(q), b.fk(q)
         ra, rb = np.linalg.inv(Ta[root_a]), np.linalg.inv(Tb[root_a if root_a in Tb else root_b])
         for name in sorted(la & lb):
-            A, B = ra @ Ta[name], rb @ Tb[name]
-            size = max(1.0, float(np.abs(A[:3, 3]).max()))
-            if not (_close(A[:3, 3], B[:3, 3], tol, size) and _close(A[:3, :3], B[:3, :3], tol)):
-                diffs.append(f"link '{name}': pose differs at configuration {q}: "
-                             f"{A[:3, 3].tolist()} vs {B[:3, 3].tolist()}")
+            differs = pose_difference(ra @ Ta[name], rb @ Tb[name], tol if pose_tol is None else pose_tol)
+            if differs:
+                diffs.append(f"link '{name}': pose differs at configuration {q}: {differs}")
                 return diffs
     return diffs

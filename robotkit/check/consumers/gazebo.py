@@ -8,7 +8,7 @@ import shutil
 import subprocess
 
 from robotkit.check.consumers import Missing, Refused, View
-from robotkit.check.kinematics import read_sdf_text
+from robotkit.check.kinematics import LIBSDFORMAT_PRECISION, read_sdf_text
 
 
 def _parsed(path) -> str:
@@ -35,7 +35,8 @@ def _view(text: str, source: str, lumped: bool) -> View:
         # model.sdf renames a joint named like a link (robotkit.emit.sdf.joint_names)
         return model.fk({n if n in model.joints else f"{n}_joint": v for n, v in q.items()})
 
-    return View({n: link.mass for n, link in model.links.items() if n != "world"}, poses, lumped=lumped)
+    return View({n: link.mass for n, link in model.links.items() if n != "world"}, poses, lumped=lumped,
+                pose_tol=LIBSDFORMAT_PRECISION)
 
 
 def from_urdf(build) -> View:
