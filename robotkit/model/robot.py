@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from robotkit.geometry import rpy_matrix
+from robotkit.geometry import matrix_rpy, rpy_matrix
 from robotkit.model.selfcollision import Matrix, Settings
 
 Vec3 = tuple[float, float, float]
@@ -340,6 +340,17 @@ class Robot:
                 return found
             todo = below
         return None
+
+    def anchor_pose(self) -> Pose:
+        """The pose of :meth:`anchor` in the massless root's frame: every fixed joint between
+        them (the PhantomX arm's ``base_link`` -> ``arm_base_link`` -> first servo)."""
+        parent_joint = {j.child: j for j in self.joints}
+        T, name = np.eye(4), self.anchor()
+        while name != self.root:
+            j = parent_joint[name]
+            T = j.origin.matrix() @ T
+            name = j.parent
+        return Pose(tuple(float(v) for v in T[:3, 3]), matrix_rpy(T[:3, :3]))
 
     def body_mass(self, name: str) -> float:
         """Mass of ``name`` and of everything welded to it by fixed joints below it: what a

@@ -4,6 +4,7 @@ where they once did not (issue 32's corpus): each test builds a small robot of t
 from __future__ import annotations
 
 import json
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -71,3 +72,34 @@ def test_pose_difference_names_a_turn_and_a_shift():
     assert pose_difference(A, B, 1e-9) is None
     B[:3, 3] = [0, 2e-9, 0]
     assert pose_difference(A, B, 1e-9) == "[0.0, 0.0, 0.0] vs [0.0, 2e-09, 0.0]"
+
+
+# ------------------------------------------------ 2. massless chains (PhantomX Pincher, TurtleBot arm)
+
+PINCHER = """
+    robot: pincher_like
+    defaults:
+      joint: {type: revolute, axis: [0, 1, 0], limit: {lower: -2.6, upper: 2.6, effort: 30, velocity: 1.5}}
+    links:
+      base_link: {}
+      arm_base_link: {}
+      servo: {visual: {box: {size: [0.025, 0.038, 0.047]}}, inertial: {mass: 0.055}}
+      pan: {visual: {box: {size: [0.025, 0.038, 0.009]}}, inertial: {mass: 0.008}}
+      f10: {visual: {box: {size: [0.025, 0.038, 0.004]}}, inertial: {mass: 0.004}}
+    joints:
+      arm_base_joint: {type: fixed, parent: base_link, child: arm_base_link, origin: {xyz: [0.1, 0.03, 0.435]}}
+      servo_joint: {type: fixed, parent: arm_base_link, child: servo, origin: {rpy: [1.570795, 0, 1.570795]}}
+      pan_joint: {parent: servo, child: pan, origin: {xyz: [0, 0.019, 0], rpy: [-1.570795, 1.570795, 3.14159]},
+                  axis: [0, 0, -1]}
+      f10_joint: {type: fixed, parent: pan, child: f10, origin: {xyz: [0, 0, 0.0545]}}
+    """
+
+
+@pytest.mark.slow
+def test_a_massless_root_two_fixed_joints_above_the_first_mass(tmp_path):
+    # the massless root is model.sdf's model frame; the link that carries it sits at every
+    # fixed joint between them, not at the last one only (0.45 m off on the PhantomX arm)
+    robot = built(tmp_path, PINCHER)
+    sdf = ET.parse(robot / "model.sdf").getroot()
+    assert sdf.find("model/link[@name='servo']/pose").text == "0.1 0.03 0.435 1.570795 0 1.570795"
+    assert_agree(robot)
