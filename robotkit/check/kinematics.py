@@ -322,14 +322,16 @@ def _sdf_frame_joint(f, world) -> KJoint | None:
 
 def _sdf_joint(name: str, j, world) -> KJoint | None:
     """A ``<joint>`` between its parent's and child's frames: axis in the joint frame, limits
-    (a revolute joint without them is continuous), damping and friction; None for a joint to
-    the world (the model's placement, not part of the robot)."""
+    (a revolute joint without them is continuous), damping and friction; None for a fixed joint
+    to the world (the model's placement, not part of the robot).  A joint that moves a link
+    against the world (Valkyrie's forearm descriptions) is the robot's: the world is taken
+    where the model frame is, as a URDF's ``world`` link is."""
     parent, child = j.find("parent").text.strip(), j.find("child").text.strip()
-    if parent == WORLD:
+    kind = j.get("type")
+    if parent == WORLD and kind == "fixed":
         return None
     X_j = world(name)
-    X_p, X_c = world(parent), world(child)
-    kind = j.get("type")
+    X_p, X_c = np.eye(4) if parent == WORLD else world(parent), world(child)
     axis_el = j.find("axis")
     axis = np.array([0, 0, 1.0])
     lower = upper = effort = velocity = damping = friction = None

@@ -14,6 +14,7 @@ from conftest import write_recipe
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.equivalence import equivalence
 from robotkit.check.kinematics import pose_difference, rpy_matrix
+from robotkit.check.simulation import smoke_test
 from robotkit.pipeline.runner import build
 from validators import mujoco, require
 
@@ -103,3 +104,32 @@ def test_a_massless_root_two_fixed_joints_above_the_first_mass(tmp_path):
     sdf = ET.parse(robot / "model.sdf").getroot()
     assert sdf.find("model/link[@name='servo']/pose").text == "0.1 0.03 0.435 1.570795 0 1.570795"
     assert_agree(robot)
+
+
+# ------------------------------------------------ 4. a joint to the world (Valkyrie forearm descriptions)
+
+FOREARM = """
+    robot: forearm_like
+    links:
+      world: {}
+      forearm: {visual: {box: {size: [0.1, 0.3, 0.13]}, origin: {xyz: [0, -0.13, 0]}}, inertial: {mass: 2.476}}
+      wrist: {visual: {box: {size: [0.03, 0.03, 0.03]}}, inertial: {mass: 0.14}}
+    joints:
+      yaw: {type: revolute, parent: world, child: forearm, origin: {xyz: [-0.0254, 0, 0]}, axis: [0, 1, 0],
+            limit: {lower: -2.019, upper: 3.14, effort: 26, velocity: 5}}
+      roll: {type: revolute, parent: forearm, child: wrist, origin: {xyz: [0, -0.2871, 0]}, axis: [1, 0, 0],
+             limit: {lower: -0.625, upper: 0.62, effort: 14, velocity: 1}}
+    """
+
+
+@pytest.mark.slow
+def test_a_joint_that_moves_a_link_against_the_world(tmp_path):
+    # model.sdf and libsdformat's URDF keep the joint to the world: the SDF reader keeps it too
+    robot = built(tmp_path, FOREARM)
+    sdf = ET.parse(robot / "model.sdf").getroot()
+    assert sdf.find("model/joint[@name='yaw']/parent").text == "world"
+    assert_agree(robot)
+    # the forearm hangs from the world at z = 0, 65 mm below it: the floor makes room
+    floor = ET.parse(robot / "mjcf" / "scene.xml").getroot().find("worldbody/geom[@name='robotkit_floor']")
+    assert floor.get("pos") == "0 0 -0.065"
+    assert smoke_test(robot / "mjcf" / "scene.xml", seconds=0.5) == []
