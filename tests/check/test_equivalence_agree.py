@@ -10,11 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import write_recipe
+from conftest import run_cli, write_recipe
 from robotkit.check.consumers import Build, consumer_findings
 from robotkit.check.equivalence import equivalence
 from robotkit.check.kinematics import pose_difference, rpy_matrix
 from robotkit.check.simulation import smoke_test
+from robotkit.model.inertia_policy import mujoco_ready
 from robotkit.pipeline.runner import build
 from validators import mujoco, require
 
@@ -133,3 +134,67 @@ def test_a_joint_that_moves_a_link_against_the_world(tmp_path):
     floor = ET.parse(robot / "mjcf" / "scene.xml").getroot().find("worldbody/geom[@name='robotkit_floor']")
     assert floor.get("pos") == "0 0 -0.065"
     assert smoke_test(robot / "mjcf" / "scene.xml", seconds=0.5) == []
+
+
+# ------------------------------------------------ 5. tensors MuJoCo refuses (Ginger Knee_Link, Valkyrie IMU frames)
+
+INERTIAS = """
+    robot: knee_like
+    defaults:
+      joint: {type: revolute, axis: [0, 1, 0], limit: {lower: -1, upper: 1, effort: 10, velocity: 1}}
+    links:
+      thigh: {visual: {box: {size: [0.05, 0.05, 0.3]}}}
+      knee:
+        visual: {box: {size: [0.05, 0.05, 0.3]}}
+        inertial:   # principal moments 0.001, 0.002 and 0.003 (1 + 5e-10): a + b < c, by rounding
+          mass: 1
+          inertia: {ixx: 0.00108733219254516, ixy: -0.000282321236697518, iyy: 0.00191266780745484,
+                    izz: 0.0030000000015}
+      imu:   # a rod: its least moment 1e-20 kg m^2, below MuJoCo's floor
+        inertial: {mass: 0.01, inertia: {ixx: 1e-20, iyy: 1e-6, izz: 1e-6}}
+    joints:
+      knee_joint: {parent: thigh, child: knee, origin: {xyz: [0, 0, -0.3]}}
+      imu_joint: {type: fixed, parent: knee, child: imu, origin: {xyz: [0, 0, -0.1]}}
+    """
+
+
+@pytest.mark.slow
+def test_tensors_that_round_outside_mujocos_inequality_are_written_inside_it(tmp_path):
+    robot = built(tmp_path, INERTIAS)
+    mj = mujoco()
+    model = mj.MjModel.from_xml_path(str(robot / "mjcf" / "scene.xml"))  # it loads
+    knee = model.body_inertia[mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, "knee")]
+    np.testing.assert_allclose(sorted(knee), [0.001, 0.002, 0.003], rtol=1e-9)
+    assert_agree(robot, consumers=("MuJoCo (MJCF)", "Gazebo (URDF)", "Gazebo (model.sdf)"))
+    urdf = ET.parse(robot / "urdf" / "knee_like.urdf").getroot()  # every format states the same numbers
+    mjcf = ET.parse(robot / "mjcf" / "knee_like.xml").getroot()
+    i = urdf.find("link[@name='knee']/inertial/inertia").attrib
+    assert mjcf.find(".//body[@name='knee']/inertial").get("fullinertia") == " ".join(
+        i[k] for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz"))
+
+
+def test_a_tensor_mujoco_refuses_beyond_rounding_stops_the_build(tmp_path):
+    recipe = write_recipe(tmp_path, """
+        robot: imu_like
+        links:
+          base: {visual: {box: {size: [0.1, 0.1, 0.1]}}}
+          imu: {inertial: {mass: 1e-6, inertia: {ixx: 1e-17, iyy: 1e-17, izz: 1e-17}}}
+        joints:
+          imu_joint: {type: fixed, parent: base, child: imu}
+        """)
+    proc = run_cli("build", recipe, "--out", tmp_path / "out")
+    assert proc.returncode == 1
+    assert (f"{recipe}:4: links.imu: link 'imu': MuJoCo refuses its inertia (principal moments 1e-17, 1e-17, "
+            "1e-17 kg m^2; it needs each at least 1e-13 and the two smaller summing to the largest); give links.imu "
+            "an inertia it accepts (inertial.policy: repair raises the moments)") in proc.stderr.splitlines()
+    assert not (tmp_path / "out" / "imu_like" / "mjcf" / "imu_like.xml").exists()
+
+
+def test_mujoco_ready_changes_a_tensor_by_rounding_only():
+    normal = np.diag([1.0, 2.0, 2.5])
+    assert mujoco_ready(normal) is normal
+    ready = mujoco_ready(np.diag([0.001, 0.002, 0.003 * (1 + 5e-10)]))
+    assert ready[2, 2] == pytest.approx(0.003 / (1 + 1e-12), rel=1e-15) and ready[0, 0] == 0.001
+    assert np.diag(mujoco_ready(np.diag([1e-20, 1e-6, 1e-6]))).tolist() == [1e-13, 1e-6, 1e-6]
+    assert mujoco_ready(np.diag([1e-17, 1e-17, 1e-17])) is None  # all below the floor: not rounding
+    assert mujoco_ready(np.diag([0.001, 0.002, 0.0031])) is None  # a + b < c by 3 %
