@@ -69,6 +69,7 @@ class KModel:
     source: str
     links: dict[str, KLink]
     joints: dict[str, KJoint]  # by name; fixed joints may be unnamed in some readers
+    kept: frozenset[str] = frozenset()  # fixed joints libsdformat keeps (<preserveFixedJoint>)
 
     def parent_of(self) -> dict[str, KJoint]:
         return {j.child: j for j in self.joints.values()}
@@ -221,7 +222,22 @@ def read_urdf(path) -> KModel:
         j = model.joints.pop(key)
         j.name = fixed.get(j.child, key)
         model.joints[j.name] = j
+    model.kept = kept_fixed(root)
     return model
+
+
+def kept_fixed(root) -> frozenset[str]:
+    """The joints a URDF (its parsed root element) asks libsdformat not to lump."""
+    return frozenset(g.get("reference") for g in root.iter("gazebo") if g.get("reference") and
+                     (g.findtext("preserveFixedJoint") or "").strip() in ("true", "1"))
+
+
+def extension_parts(path) -> tuple[set[str], set[str]]:
+    """Names of the links and joints a URDF's model-level <gazebo> blocks add to what Gazebo
+    simulates (the PR2's parallel-gripper linkage): not the robot's description."""
+    blocks = [g for g in urdfxml.parse_file(path).getroot().iter("gazebo") if not g.get("reference")]
+    return ({el.get("name") for g in blocks for el in g.iter("link")},
+            {el.get("name") for g in blocks for el in g.iter("joint")})
 
 
 # ---------------------------------------------------------------- SDF
@@ -235,17 +251,18 @@ def _pose(el) -> tuple[np.ndarray, str | None]:
     return _T(v[:3], rpy_matrix(*v[3:6])), p.get("relative_to")
 
 
-def read_sdf_text(text: str, source: str) -> KModel:
+def read_sdf_text(text: str, source: str, leave_out: tuple[set[str], set[str]] = (set(), set())) -> KModel:
     """An SDF model (our model.sdf, or libsdformat's printout of a URDF) as a KModel: its links
     with SDF's inertial defaults, its frames as massless links fixed where they are attached,
-    and its joints between link frames resolved through the pose graph."""
+    and its joints between link frames resolved through the pose graph; ``leave_out``: links and
+    joints not read (:func:`extension_parts`)."""
     # libsdformat prints namespaced elements (<ignition::corrected_offsets>, the PR2's Gazebo 1
     # <sensor:contact>) without their namespace declaration, which no XML parser accepts
     model = ET.fromstring(re.sub(r"(</?|\s)(\w+)::?(?=\w)", r"\1\2__", text)).find("model")
     link_els = {lk.get("name"): lk for lk in model.findall("link")}
     joint_els = {j.get("name"): j for j in model.findall("joint")}
     world = _frame_graph(link_els, joint_els, model.findall("frame"), source)
-    links = {name: _sdf_link(name, lk) for name, lk in link_els.items()}
+    links = {name: _sdf_link(name, lk) for name, lk in link_els.items() if name not in leave_out[0]}
     joints = {}
     for f in model.findall("frame"):  # a frame is a massless link fixed where it is attached
         links[f.get("name")] = KLink(f.get("name"))
@@ -253,6 +270,8 @@ def read_sdf_text(text: str, source: str) -> KModel:
         if joint is not None:
             joints[joint.name] = joint
     for name, j in joint_els.items():
+        if name in leave_out[1]:
+            continue
         joint = _sdf_joint(name, j, world)
         if joint is not None:
             joints[name] = joint
@@ -369,20 +388,22 @@ def read_urdf_via_libsdformat(path) -> KModel:
     proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
     if proc.returncode != 0 or "<sdf" not in proc.stdout:
         raise RuntimeError(f"ign sdf -p {path} failed: {proc.stderr.strip() or proc.stdout.strip()}")
-    return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)")
+    return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)", extension_parts(path))
 
 
-def lump(model: KModel) -> KModel:
+def lump(model: KModel, kept: frozenset[str] = frozenset()) -> KModel:
     """``model`` as libsdformat's URDF conversion (Gazebo's spawn path) sees it: every link
     joined to its parent by a fixed joint merged into that parent (masses added, centres of
-    mass combined, inertias moved by the parallel-axis theorem), the joints below re-attached."""
+    mass combined, inertias moved by the parallel-axis theorem), the joints below re-attached;
+    but the fixed joints ``kept`` (the URDF's ``<preserveFixedJoint>``: ``model.kept``)."""
     parent_of = model.parent_of()
 
     def carrier(name: str) -> tuple[str, np.ndarray]:
         T = np.eye(4)
         while True:
             j = parent_of.get(name)
-            if j is None or j.type != "fixed" or j.parent == WORLD or j.parent not in model.links:
+            if j is None or j.type != "fixed" or j.parent == WORLD or j.parent not in model.links or \
+                    j.name in kept:
                 return name, T
             T = j.T_pj @ j.T_jc @ T
             name = j.parent
@@ -405,7 +426,7 @@ def lump(model: KModel) -> KModel:
         links[top] = KLink(top, m, com, inertia)
     joints = {}
     for name, j in model.joints.items():
-        if j.type == "fixed" and j.parent != WORLD and j.parent in model.links:
+        if j.type == "fixed" and j.parent != WORLD and j.parent in model.links and name not in kept:
             continue
         top, T = carrier(j.parent) if j.parent in model.links else (j.parent, np.eye(4))
         joints[name] = KJoint(**{**j.__dict__, "parent": top, "T_pj": T @ j.T_pj})

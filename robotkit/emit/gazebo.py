@@ -286,3 +286,22 @@ def _head(text: str) -> str:
 
     m = re.match(r"\s*(<[^>]*>)", text)
     return m.group(1) if m else text[:40]
+
+
+def kept_fixed_joints(robot: Robot) -> list[str]:
+    """The fixed joints the URDF asks libsdformat to keep (``<preserveFixedJoint>``): those whose
+    child link a ``<joint>`` of a model-level <gazebo> block names as its parent or child (the
+    PR2's parallel-gripper joints name ``r_gripper_palm_link``).  Its URDF conversion would lump
+    the link into its parent and then refuse the block's joint, whose link and pose frame it no
+    longer has."""
+    import xml.etree.ElementTree as ET
+
+    named = set()
+    for text in robot.urdf_extras:
+        try:
+            block = ET.fromstring(text)
+        except ET.ParseError:
+            continue
+        if block.tag == "gazebo" and not block.get("reference"):
+            named |= {(el.text or "").strip() for j in block.iter("joint") for el in j if el.tag in ("parent", "child")}
+    return [j.name for j in robot.joints if j.type == "fixed" and j.child in named and j.parent != "world"]

@@ -4,6 +4,7 @@ where they once did not (issue 32's corpus): each test builds a small robot of t
 from __future__ import annotations
 
 import json
+import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -24,7 +25,7 @@ def built(tmp_path: Path, text: str) -> Path:
     recipe = write_recipe(tmp_path, text)
     result = build([recipe], tmp_path / "out")
     assert not result.errors, result.errors
-    return tmp_path / "out" / next(p.name for p in (tmp_path / "out").iterdir())
+    return next(p for p in sorted((tmp_path / "out").iterdir()) if not p.name.startswith("."))
 
 
 def assert_agree(robot: Path, consumers=("Gazebo (URDF)", "Gazebo (model.sdf)")):
@@ -198,3 +199,35 @@ def test_mujoco_ready_changes_a_tensor_by_rounding_only():
     assert np.diag(mujoco_ready(np.diag([1e-20, 1e-6, 1e-6]))).tolist() == [1e-13, 1e-6, 1e-6]
     assert mujoco_ready(np.diag([1e-17, 1e-17, 1e-17])) is None  # all below the floor: not rounding
     assert mujoco_ready(np.diag([0.001, 0.002, 0.0031])) is None  # a + b < c by 3 %
+
+
+# ------------------------------------------------ 3. a <gazebo> block's joint names a lumped link (PR2 grippers)
+
+PALM = """
+    robot: palm_like
+    links:
+      wrist: {visual: {box: {size: [0.05, 0.05, 0.05]}}, inertial: {mass: 0.1}}
+      palm: {visual: {box: {size: [0.08, 0.05, 0.03]}}, inertial: {mass: 0.58}}
+      parallel: {visual: {box: {size: [0.05, 0.02, 0.02]}}, inertial: {mass: 0.017}}
+    joints:
+      palm_joint: {type: fixed, parent: wrist, child: palm}
+      finger: {type: revolute, parent: palm, child: parallel, origin: {xyz: [0.07, 0.01, 0]}, axis: [0, 0, 1],
+               limit: {lower: 0, upper: 0.5, effort: 10, velocity: 1}}
+    urdf_extras:
+      - >-
+        <gazebo><link name="parallel_link"><inertial><mass>0.17</mass></inertial></link>
+        <joint name="parallel_root_joint" type="revolute"><parent>parallel</parent><child>palm</child>
+        <axis><xyz>0 0 1</xyz></axis><pose>0.05 0.03 0 0 0 0</pose></joint></gazebo>
+    """
+
+
+@pytest.mark.slow
+def test_a_gazebo_block_joint_keeps_the_link_it_names(tmp_path):
+    # libsdformat would lump 'palm' into 'wrist', then refuse the block's joint ("a pose is
+    # relative to 'palm', which the model does not define"): the URDF asks it to keep the link
+    robot = built(tmp_path, PALM)
+    urdf = ET.parse(robot / "urdf" / "palm_like.urdf").getroot()
+    assert urdf.find("gazebo[@reference='palm_joint']/preserveFixedJoint").text == "true"
+    proc = subprocess.run(["ign", "sdf", "-k", str(robot / "urdf" / "palm_like.urdf")], capture_output=True, text=True)
+    assert "Valid." in proc.stdout, proc.stdout + proc.stderr
+    assert_agree(robot)  # the block's link and joint are Gazebo's additions, not compared
