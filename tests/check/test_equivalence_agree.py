@@ -231,3 +231,16 @@ def test_a_gazebo_block_joint_keeps_the_link_it_names(tmp_path):
     proc = subprocess.run(["ign", "sdf", "-k", str(robot / "urdf" / "palm_like.urdf")], capture_output=True, text=True)
     assert "Valid." in proc.stdout, proc.stdout + proc.stderr
     assert_agree(robot)  # the block's link and joint are Gazebo's additions, not compared
+
+
+def test_a_gazebo_classic_joint_tag_stays_out_of_model_sdf():
+    # the PR2's <stopKd>/<stopKp>: libsdformat copies them with a warning, Drake refuses model.sdf
+    from robotkit.emit.gazebo import carry
+    from robotkit.model.robot import Joint, Link, Robot
+
+    robot = Robot(name="r", links=(Link("a"), Link("b")), joints=(Joint("j", "revolute", "a", "b"),),
+                  urdf_extras=('<gazebo reference="j"><stopKd value="1.0"/><provideFeedback>true</provideFeedback>'
+                               '</gazebo>',))
+    out = carry(robot)
+    assert out.losses == ['<gazebo reference="j">: <stopKd> not in model.sdf: an SDF joint has no <stopKd>']
+    assert out.joints == {"j": ["<physics>\n  <provide_feedback>true</provide_feedback>\n</physics>"]}
