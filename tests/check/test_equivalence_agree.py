@@ -244,3 +244,33 @@ def test_a_gazebo_classic_joint_tag_stays_out_of_model_sdf():
     out = carry(robot)
     assert out.losses == ['<gazebo reference="j">: <stopKd> not in model.sdf: an SDF joint has no <stopKd>']
     assert out.joints == {"j": ["<physics>\n  <provide_feedback>true</provide_feedback>\n</physics>"]}
+
+
+FOLDED = """
+    robot: folded
+    self_collide: true
+    links:
+      world: {}
+      base: {collision: {box: {size: [0.2, 0.2, 0.1]}}, visual: {box: {size: [0.2, 0.2, 0.1]}}}
+      arm: {collision: {box: {size: [0.05, 0.05, 0.05]}}, visual: {box: {size: [0.05, 0.05, 0.05]}}}
+      hand: {collision: {box: {size: [0.05, 0.05, 0.05]}}, visual: {box: {size: [0.05, 0.05, 0.05]}}}
+    joints:
+      mount: {type: fixed, parent: world, child: base, origin: {xyz: [0, 0, 0.05]}}
+      fold: {type: revolute, parent: base, child: arm, origin: {xyz: [0, 0, 0.35]}, axis: [1, 0, 0],
+             limit: {lower: -1.5, upper: 1.5, effort: 10, velocity: 1}}
+      wrist: {type: fixed, parent: arm, child: hand, origin: {xyz: [0, 0, -0.33]}}
+    """
+
+
+@pytest.mark.slow
+def test_links_that_touch_each_other_at_the_start_are_not_inside_the_floor(tmp_path):
+    # Kinova's j2s6s200 folds onto its base at its zero pose, 72.7 mm deep but above the floor
+    robot = built(tmp_path, FOLDED)
+    mjcf = robot / "mjcf" / "folded.xml"  # the hand inside the base, 50 mm deep: their contact kept
+    mjcf.write_text(mjcf.read_text().replace('<exclude body1="base" body2="hand"/>', ""))
+    mj = mujoco()
+    model = mj.MjModel.from_xml_path(str(robot / "mjcf" / "scene.xml"))
+    data = mj.MjData(model)
+    mj.mj_forward(model, data)
+    assert min(data.contact[i].dist for i in range(data.ncon)) < -0.04
+    assert not any("inside the floor" in p for p in smoke_test(robot / "mjcf" / "scene.xml", seconds=0.2))
