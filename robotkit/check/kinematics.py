@@ -26,6 +26,11 @@ from robotkit import mj, urdfxml
 
 WORLD = "world"
 NEGLIGIBLE = 1e-200  # kg: robotkit's URDF writes massless links as 1e-300 kg (see emit/urdf.py)
+# libsdformat turns a pose's rpy into a quaternion and prints it back as rpy (`ign sdf -p`): at a
+# pitch of +-pi/2 the asin loses half the digits (measured: 1.570796325 comes back 1.570796311893735,
+# 1.5e-8 in the rotation matrix, 2e-9 m at 0.15 m), so a reading through libsdformat holds poses
+# to sqrt(eps)
+LIBSDFORMAT_PRECISION = 1e-7
 
 
 def real_mass(m: float) -> float:
@@ -64,6 +69,7 @@ class KModel:
     source: str
     links: dict[str, KLink]
     joints: dict[str, KJoint]  # by name; fixed joints may be unnamed in some readers
+    kept: frozenset[str] = frozenset()  # fixed joints libsdformat keeps (<preserveFixedJoint>)
 
     def parent_of(self) -> dict[str, KJoint]:
         return {j.child: j for j in self.joints.values()}
@@ -216,7 +222,22 @@ def read_urdf(path) -> KModel:
         j = model.joints.pop(key)
         j.name = fixed.get(j.child, key)
         model.joints[j.name] = j
+    model.kept = kept_fixed(root)
     return model
+
+
+def kept_fixed(root) -> frozenset[str]:
+    """The joints a URDF (its parsed root element) asks libsdformat not to lump."""
+    return frozenset(g.get("reference") for g in root.iter("gazebo") if g.get("reference") and
+                     (g.findtext("preserveFixedJoint") or "").strip() in ("true", "1"))
+
+
+def extension_parts(path) -> tuple[set[str], set[str]]:
+    """Names of the links and joints a URDF's model-level <gazebo> blocks add to what Gazebo
+    simulates (the PR2's parallel-gripper linkage): not the robot's description."""
+    blocks = [g for g in urdfxml.parse_file(path).getroot().iter("gazebo") if not g.get("reference")]
+    return ({el.get("name") for g in blocks for el in g.iter("link")},
+            {el.get("name") for g in blocks for el in g.iter("joint")})
 
 
 # ---------------------------------------------------------------- SDF
@@ -230,17 +251,18 @@ def _pose(el) -> tuple[np.ndarray, str | None]:
     return _T(v[:3], rpy_matrix(*v[3:6])), p.get("relative_to")
 
 
-def read_sdf_text(text: str, source: str) -> KModel:
+def read_sdf_text(text: str, source: str, leave_out: tuple[set[str], set[str]] = (set(), set())) -> KModel:
     """An SDF model (our model.sdf, or libsdformat's printout of a URDF) as a KModel: its links
     with SDF's inertial defaults, its frames as massless links fixed where they are attached,
-    and its joints between link frames resolved through the pose graph."""
+    and its joints between link frames resolved through the pose graph; ``leave_out``: links and
+    joints not read (:func:`extension_parts`)."""
     # libsdformat prints namespaced elements (<ignition::corrected_offsets>, the PR2's Gazebo 1
     # <sensor:contact>) without their namespace declaration, which no XML parser accepts
     model = ET.fromstring(re.sub(r"(</?|\s)(\w+)::?(?=\w)", r"\1\2__", text)).find("model")
     link_els = {lk.get("name"): lk for lk in model.findall("link")}
     joint_els = {j.get("name"): j for j in model.findall("joint")}
     world = _frame_graph(link_els, joint_els, model.findall("frame"), source)
-    links = {name: _sdf_link(name, lk) for name, lk in link_els.items()}
+    links = {name: _sdf_link(name, lk) for name, lk in link_els.items() if name not in leave_out[0]}
     joints = {}
     for f in model.findall("frame"):  # a frame is a massless link fixed where it is attached
         links[f.get("name")] = KLink(f.get("name"))
@@ -248,6 +270,8 @@ def read_sdf_text(text: str, source: str) -> KModel:
         if joint is not None:
             joints[joint.name] = joint
     for name, j in joint_els.items():
+        if name in leave_out[1]:
+            continue
         joint = _sdf_joint(name, j, world)
         if joint is not None:
             joints[name] = joint
@@ -317,14 +341,16 @@ def _sdf_frame_joint(f, world) -> KJoint | None:
 
 def _sdf_joint(name: str, j, world) -> KJoint | None:
     """A ``<joint>`` between its parent's and child's frames: axis in the joint frame, limits
-    (a revolute joint without them is continuous), damping and friction; None for a joint to
-    the world (the model's placement, not part of the robot)."""
+    (a revolute joint without them is continuous), damping and friction; None for a fixed joint
+    to the world (the model's placement, not part of the robot).  A joint that moves a link
+    against the world (Valkyrie's forearm descriptions) is the robot's: the world is taken
+    where the model frame is, as a URDF's ``world`` link is."""
     parent, child = j.find("parent").text.strip(), j.find("child").text.strip()
-    if parent == WORLD:
+    kind = j.get("type")
+    if parent == WORLD and kind == "fixed":
         return None
     X_j = world(name)
-    X_p, X_c = world(parent), world(child)
-    kind = j.get("type")
+    X_p, X_c = np.eye(4) if parent == WORLD else world(parent), world(child)
     axis_el = j.find("axis")
     axis = np.array([0, 0, 1.0])
     lower = upper = effort = velocity = damping = friction = None
@@ -362,20 +388,22 @@ def read_urdf_via_libsdformat(path) -> KModel:
     proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
     if proc.returncode != 0 or "<sdf" not in proc.stdout:
         raise RuntimeError(f"ign sdf -p {path} failed: {proc.stderr.strip() or proc.stdout.strip()}")
-    return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)")
+    return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)", extension_parts(path))
 
 
-def lump(model: KModel) -> KModel:
+def lump(model: KModel, kept: frozenset[str] = frozenset()) -> KModel:
     """``model`` as libsdformat's URDF conversion (Gazebo's spawn path) sees it: every link
     joined to its parent by a fixed joint merged into that parent (masses added, centres of
-    mass combined, inertias moved by the parallel-axis theorem), the joints below re-attached."""
+    mass combined, inertias moved by the parallel-axis theorem), the joints below re-attached;
+    but the fixed joints ``kept`` (the URDF's ``<preserveFixedJoint>``: ``model.kept``)."""
     parent_of = model.parent_of()
 
     def carrier(name: str) -> tuple[str, np.ndarray]:
         T = np.eye(4)
         while True:
             j = parent_of.get(name)
-            if j is None or j.type != "fixed" or j.parent == WORLD or j.parent not in model.links:
+            if j is None or j.type != "fixed" or j.parent == WORLD or j.parent not in model.links or \
+                    j.name in kept:
                 return name, T
             T = j.T_pj @ j.T_jc @ T
             name = j.parent
@@ -398,7 +426,7 @@ def lump(model: KModel) -> KModel:
         links[top] = KLink(top, m, com, inertia)
     joints = {}
     for name, j in model.joints.items():
-        if j.type == "fixed" and j.parent != WORLD and j.parent in model.links:
+        if j.type == "fixed" and j.parent != WORLD and j.parent in model.links and name not in kept:
             continue
         top, T = carrier(j.parent) if j.parent in model.links else (j.parent, np.eye(4))
         joints[name] = KJoint(**{**j.__dict__, "parent": top, "T_pj": T @ j.T_pj})
@@ -412,11 +440,30 @@ def _close(a, b, tol, scale=1.0) -> bool:
     return bool(np.all(np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)) <= tol * max(scale, 1e-300)))
 
 
+def pose_difference(A: np.ndarray, B: np.ndarray, tol: float) -> str | None:
+    """How frame ``B`` differs from ``A`` (4x4, same reference), or None when they agree: positions
+    to ``tol`` relative to the larger of 1 m and the distance (absolute near the origin),
+    orientations to ``tol`` in rotation-matrix entries."""
+    size = max(1.0, float(np.abs(A[:3, 3]).max()))
+    if not _close(A[:3, 3], B[:3, 3], tol, size):
+        return f"{A[:3, 3].tolist()} vs {B[:3, 3].tolist()}"
+    if not _close(A[:3, :3], B[:3, :3], tol):
+        return f"at {A[:3, 3].tolist()}, turned by {turn(A, B):.3g} rad"
+    return None
+
+
+def turn(A: np.ndarray, B: np.ndarray) -> float:
+    """The angle (rad) between the orientations of frames ``A`` and ``B``."""
+    cos = (np.trace(A[:3, :3].T @ B[:3, :3]) - 1) / 2
+    return math.acos(max(-1.0, min(1.0, float(cos))))
+
+
 def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: int = 0,
-            ignore: tuple[str, ...] = ()) -> list[str]:
+            ignore: tuple[str, ...] = (), pose_tol: float | None = None) -> list[str]:
     """Every difference between two readings of a robot, as sentences; [] when equivalent.
 
-    ``ignore`` names joint attributes one side cannot hold (e.g. "velocity" for MJCF)."""
+    ``ignore`` names joint attributes one side cannot hold (e.g. "velocity" for MJCF);
+    ``pose_tol`` is what the readers can hold of a link's pose (default ``tol``)."""
     diffs: list[str] = []
     la = {n for n in a.links if n != WORLD}
     lb = {n for n in b.links if n != WORLD}
@@ -480,10 +527,8 @@ def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: i
         Ta, Tb = a.fk(q), b.fk(q)
         ra, rb = np.linalg.inv(Ta[root_a]), np.linalg.inv(Tb[root_a if root_a in Tb else root_b])
         for name in sorted(la & lb):
-            A, B = ra @ Ta[name], rb @ Tb[name]
-            size = max(1.0, float(np.abs(A[:3, 3]).max()))
-            if not (_close(A[:3, 3], B[:3, 3], tol, size) and _close(A[:3, :3], B[:3, :3], tol)):
-                diffs.append(f"link '{name}': pose differs at configuration {q}: "
-                             f"{A[:3, 3].tolist()} vs {B[:3, 3].tolist()}")
+            differs = pose_difference(ra @ Ta[name], rb @ Tb[name], tol if pose_tol is None else pose_tol)
+            if differs:
+                diffs.append(f"link '{name}': pose differs at configuration {q}: {differs}")
                 return diffs
     return diffs

@@ -177,6 +177,9 @@ def _to_joint(out: Carried, ref: str, elem, robot: Robot, frames: set[str], phys
         why = (f"the joint is not there (it fixes a frame to '{child}' or '{child}' to a link)" if unwritten else
                "model.sdf writes the recipe's joint dynamics")
         out.losses.append(f'<gazebo reference="{ref}">: <{elem.tag}> not in model.sdf: {why}')
+    elif elem.tag not in JOINT_PHYSICS and elem.tag not in JOINT_CHILDREN:  # Drake refuses it (the PR2's stopKd)
+        out.losses.append(f'<gazebo reference="{ref}">: <{elem.tag}> not in model.sdf: an SDF joint has no '
+                          f"<{elem.tag}>")
     elif elem.tag in JOINT_PHYSICS:
         node = physics
         for tag in JOINT_PHYSICS[elem.tag]:
@@ -226,6 +229,10 @@ LINK_CHILDREN = {"sensor", "projector", "audio_sink", "audio_source", "battery",
                  "enable_wind", "must_be_base_link"}
 """What a <gazebo reference="link"> block may add to an SDF 1.9 link as it is (libsdformat's
 link.sdf; the link tags of LINK_TAGS are translated)."""
+JOINT_CHILDREN = {"sensor", "gearbox_ratio", "gearbox_reference_body", "thread_pitch", "screw_thread_pitch"}
+"""What a <gazebo reference="joint"> block may add to an SDF 1.9 joint as it is (libsdformat's
+joint.sdf; the joint tags of JOINT_PHYSICS are translated, Gazebo classic's stopKp/stopKd are not
+SDF)."""
 MODEL_CHILDREN = {"static", "self_collide", "allow_auto_disable", "enable_wind", "plugin", "gripper", "frame",
                   "include", "model"}
 """What a <gazebo> block without reference may add to an SDF 1.9 model (libsdformat's model.sdf)."""
@@ -286,3 +293,22 @@ def _head(text: str) -> str:
 
     m = re.match(r"\s*(<[^>]*>)", text)
     return m.group(1) if m else text[:40]
+
+
+def kept_fixed_joints(robot: Robot) -> list[str]:
+    """The fixed joints the URDF asks libsdformat to keep (``<preserveFixedJoint>``): those whose
+    child link a ``<joint>`` of a model-level <gazebo> block names as its parent or child (the
+    PR2's parallel-gripper joints name ``r_gripper_palm_link``).  Its URDF conversion would lump
+    the link into its parent and then refuse the block's joint, whose link and pose frame it no
+    longer has."""
+    import xml.etree.ElementTree as ET
+
+    named = set()
+    for text in robot.urdf_extras:
+        try:
+            block = ET.fromstring(text)
+        except ET.ParseError:
+            continue
+        if block.tag == "gazebo" and not block.get("reference"):
+            named |= {(el.text or "").strip() for j in block.iter("joint") for el in j if el.tag in ("parent", "child")}
+    return [j.name for j in robot.joints if j.type == "fixed" and j.child in named and j.parent != "world"]

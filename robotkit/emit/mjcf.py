@@ -405,11 +405,22 @@ def render_mjcf(robot: Robot, points: dict[str, np.ndarray] | None = None) -> st
     return render("mjcf/robot.xml.j2", **context(robot, lift=lift_at(), lift_at=lift_at))
 
 
-def render_scene(robot: Robot) -> str:
-    return render("mjcf/scene.xml.j2", robot=robot)
+def floor_height(robot: Robot, points: dict[str, np.ndarray] | None = None) -> float:
+    """z of the scene's floor: 0, or for a robot fixed to the world that reaches below z = 0 at its
+    zero pose (Valkyrie's forearm, hung from the world at its elbow) its lowest collision point,
+    down to the micrometre: the robot stays where its description puts it, the floor makes room."""
+    if robot.root != WORLD:
+        return 0.0  # a free robot is raised onto the floor instead (render_mjcf)
+    low = lowest_point(robot, points)
+    return math.floor(low * 1e6) / 1e6 if low is not None and low < 0 else 0.0
+
+
+def render_scene(robot: Robot, points: dict[str, np.ndarray] | None = None) -> str:
+    return render("mjcf/scene.xml.j2", robot=robot, floor=floor_height(robot, points))
 
 
 FORMATS = [
     Format("mjcf", render_mjcf, layout.MJCF, ("mjcf/robot.xml.j2",), consumed=True, points=collision_meshes),
-    Format("mjcf-scene", render_scene, layout.SCENE, ("mjcf/scene.xml.j2",), reads="metadata", needs=("mjcf",)),
+    Format("mjcf-scene", render_scene, layout.SCENE, ("mjcf/scene.xml.j2",), needs=("mjcf",),
+           points=collision_meshes),
 ]

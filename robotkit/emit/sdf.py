@@ -162,7 +162,7 @@ def context(robot: Robot) -> dict:
         j = parent_joint.get(link.name)
         ctx_pose = None  # (relative_to, pose)
         if link.name == anchor:  # the massless root is a frame on this link: the model frame
-            ctx_pose = ("__model__", j.origin)
+            ctx_pose = ("__model__", robot.anchor_pose())
         elif j is not None:
             if j.type in JOINT_TYPES:
                 ctx_pose = (names[j.name], None)

@@ -33,7 +33,7 @@ def host_of(robot: Robot, link: str) -> tuple[str, Pose]:
         j = parent_joint.get(name)
         if j is None:  # a massless root: a frame on the link fixed below it
             anchor = robot.anchor()
-            T = np.linalg.inv(parent_joint[anchor].origin.matrix()) @ T
+            T = np.linalg.inv(robot.anchor_pose().matrix()) @ T
             name = anchor
             break
         T = j.origin.matrix() @ T

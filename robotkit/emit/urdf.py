@@ -7,6 +7,7 @@ from dataclasses import replace
 from robotkit.emit import layout
 from robotkit.emit.env import render
 from robotkit.emit.formats import Format
+from robotkit.emit.gazebo import kept_fixed_joints
 from robotkit.emit.meshfiles import collision_file
 from robotkit.emit.sensors import contexts
 from robotkit.model.robot import Geom, Robot, Shape
@@ -104,6 +105,7 @@ def context(robot: Robot) -> dict:
     return {
         "robot": robot,
         "extras": [typed_transmissions(x)[0] for x in robot.urdf_extras],
+        "kept_fixed": kept_fixed_joints(robot),
         "massless_note": any(link["massless"] for link in links),
         "massless_mass": MASSLESS,
         "sensors": contexts(robot),

@@ -717,8 +717,21 @@ def finalize(robot: Robot, facts: dict, inertials: dict | None = None) -> Robot:
             inertial = inertials[link.name]
         else:
             inertial = compute_inertial(link, facts)
-        links.append(replace(link, inertial=inertial))
+        links.append(replace(link, inertial=_mujoco_ready(inertial)))
     return replace(robot, links=tuple(links))
+
+
+def _mujoco_ready(inertial: Inertial | None) -> Inertial | None:
+    """The inertial with a tensor MuJoCo accepts as printed, when only rounding stands in the way
+    (inertia_policy.mujoco_ready), so that every format states the same numbers; as it is
+    otherwise (Robot.consumer_problems refuses the MJCF for it)."""
+    if inertial is None or not inertial.mass > 0:
+        return inertial
+    tensor = inertial.tensor()
+    ready = inertia_policy.mujoco_ready(tensor)
+    if ready is None or ready is tensor:
+        return inertial
+    return Inertial.from_tensor(inertial.mass, inertial.com, ready)
 
 
 def inertial_to_json(inertial: Inertial | None):

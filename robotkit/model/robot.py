@@ -18,7 +18,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from robotkit.geometry import rpy_matrix
+from robotkit.geometry import matrix_rpy, rpy_matrix
+from robotkit.model.inertia_policy import MIN_MOMENT, mujoco_ready
 from robotkit.model.selfcollision import Matrix, Settings
 
 Vec3 = tuple[float, float, float]
@@ -341,6 +342,17 @@ class Robot:
             todo = below
         return None
 
+    def anchor_pose(self) -> Pose:
+        """The pose of :meth:`anchor` in the massless root's frame: every fixed joint between
+        them (the PhantomX arm's ``base_link`` -> ``arm_base_link`` -> first servo)."""
+        parent_joint = {j.child: j for j in self.joints}
+        T, name = np.eye(4), self.anchor()
+        while name != self.root:
+            j = parent_joint[name]
+            T = j.origin.matrix() @ T
+            name = j.parent
+        return Pose(tuple(float(v) for v in T[:3, 3]), matrix_rpy(T[:3, :3]))
+
     def body_mass(self, name: str) -> float:
         """Mass of ``name`` and of everything welded to it by fixed joints below it: what a
         simulator moves as one body."""
@@ -385,6 +397,14 @@ class Robot:
             out.append((root, f"{what}: Gazebo's URDF conversion drops it and everything below it (an empty model); "
                         f"name the root 'world' to fix the robot to the world, or give links.{root} an inertial",
                         ("urdf", "sdf")))
+        for link in self.links:
+            if link.inertial is not None and link.inertial.mass > 0 and \
+                    mujoco_ready(link.inertial.tensor()) is None:
+                moments = ", ".join(f"{v:.6g}" for v in np.linalg.eigvalsh(link.inertial.tensor()))
+                out.append((link.name, f"link '{link.name}': MuJoCo refuses its inertia (principal moments {moments} "
+                            f"kg m^2; it needs each at least {MIN_MOMENT:g} and the two smaller summing to the "
+                            f"largest); give links.{link.name} an inertia it accepts (inertial.policy: repair "
+                            "raises the moments)", ("mjcf",)))
         depth, deepest = self.depth()
         if depth > MJCF_MAX_DEPTH:
             out.append((deepest, f"link '{deepest}' sits {depth} links deep: MuJoCo's XML reader stops at "

@@ -3,7 +3,7 @@ Gazebo (libsdformat's URDF conversion, and model.sdf), Drake, Pinocchio, PyBulle
 
 Each program is real (installed by scripts/test.sh); under CI a missing one fails.  The
 oracle is the robot's own URDF: per-link and total mass to 1e-9 relative, every link frame at
-random joint configurations to 1e-9 (PyBullet computes in single precision: 1e-6)."""
+random joint configurations to 1e-9 (PyBullet computes in single precision: 1e-5)."""
 
 from __future__ import annotations
 

@@ -165,10 +165,12 @@ def test_editing_one_links_density_reruns_that_inertial_and_the_urdf(project):
                                    "    visual: {mesh: meshes/turret_bot/rotor.stl, material: blue}\n"
                                    "    inertial: {density: 2700}"))
     again = build([recipe], out)
-    # the outputs that contain inertials rerun; model.config, package.xml, the scene and the meshes do not
-    # and the drives' checks (turret_bot's gains are given: controllers.yaml does not rerun)
+    # the outputs that contain inertials rerun, and the scene (its floor makes room for a robot fixed to
+    # the world below z = 0: it reads the robot); model.config, package.xml and the meshes do not, and
+    # the drives' checks (turret_bot's gains are given: controllers.yaml does not rerun)
     assert sorted(again.ran) == ["turret_bot:drives", "turret_bot:inertial:rotor", "turret_bot:mjcf",
-                                 "turret_bot:report", "turret_bot:sdf", "turret_bot:urdf", "turret_bot:xacro"]
+                                 "turret_bot:mjcf-scene", "turret_bot:report", "turret_bot:sdf", "turret_bot:urdf",
+                                 "turret_bot:xacro"]
     mass = urdf_inertials(out / "turret_bot" / "urdf" / "turret_bot.urdf")["rotor"][0]
     assert mass == pytest.approx(2.1141772435614743 / 1250 * 2700, rel=1e-12)
 
@@ -187,7 +189,8 @@ def test_changing_one_mesh_file_reruns_only_what_depends_on_it(project):
         # the self-collision matrix is sampled again, and is the same (the slider collides as its
         # boxes and cylinder): the SRDF does not rerun
         "turret_bot:drives", "turret_bot:urdf", "turret_bot:sdf", "turret_bot:self-collision",
-        "turret_bot:mjcf", "turret_bot:report", "turret_bot:xacro", "turret_bot:rviz"])  # rviz: the robot's extent
+        "turret_bot:mjcf", "turret_bot:report", "turret_bot:xacro", "turret_bot:rviz",  # rviz: the robot's extent
+        "turret_bot:mjcf-scene"])  # the scene: the robot's lowest point (a floor below a world-rooted robot)
 
 
 @pytest.mark.slow

@@ -622,8 +622,10 @@ def test_changing_an_argument_reruns_only_what_reads_it(tmp_path):
     first = build([recipe], tmp_path / "out")
     assert not build([recipe], tmp_path / "out").ran
     again = build([recipe], tmp_path / "out", args={"arm_mass": "2"})
-    # the arm's inertial and the outputs that hold inertials; no mesh work, no metadata file
-    assert sorted(again.ran) == ["r:inertial:arm", "r:mjcf", "r:report", "r:sdf", "r:urdf", "r:xacro"]
+    # the arm's inertial, the outputs that hold inertials and the scene (it reads the robot: its floor makes
+    # room for a robot fixed to the world below z = 0); no mesh work, no metadata file
+    assert sorted(again.ran) == ["r:inertial:arm", "r:mjcf", "r:mjcf-scene", "r:report", "r:sdf", "r:urdf",
+                                 "r:xacro"]
     assert len(first.ran) > len(again.ran)
     assert read_urdf(tmp_path / "out/r/urdf/r.urdf").links["arm"].mass == 2.0
     assert not build([recipe], tmp_path / "out", args={"arm_mass": "2"}).ran

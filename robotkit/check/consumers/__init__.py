@@ -24,7 +24,7 @@ import numpy as np
 
 from robotkit import urdfxml
 from robotkit.check.findings import Finding
-from robotkit.check.kinematics import lump, read_urdf, real_mass
+from robotkit.check.kinematics import lump, read_urdf, real_mass, turn
 from robotkit.check.lints import resolve_uri
 from robotkit.mesh.export import obj_bytes
 from robotkit.mesh.io import load_mesh
@@ -63,6 +63,7 @@ class View:
     masses: dict[str, float]  # link (as the program splits the robot) -> kg
     poses: Callable[[dict[str, float]], dict[str, np.ndarray]] | None = None  # joint values -> link frames
     lumped: bool = False  # the program merges links joined by fixed joints
+    kept: frozenset[str] = frozenset()  # but these fixed joints (the URDF's <preserveFixedJoint>)
     pose_tol: float = REL_TOL  # relative: what the program's arithmetic can hold
     notes: list[str] = field(default_factory=list)
 
@@ -145,7 +146,7 @@ def configurations(reference, count: int, seed: int = 0) -> list[dict[str, float
 
 def compare(reference, view: View, configs: list[dict[str, float]], tol: float = REL_TOL) -> list[str]:
     """Differences between the description (``reference``, a KModel) and a program's view."""
-    ref = lump(reference) if view.lumped else reference
+    ref = lump(reference, view.kept) if view.lumped else reference
     expected = {n: real_mass(link.mass) for n, link in ref.links.items() if n != "world"}
     total = sum(expected.values())
     scale = max(total, 1e-12)
@@ -177,9 +178,13 @@ def compare(reference, view: View, configs: list[dict[str, float]], tol: float =
             A, B = Rw @ want[name], Rg @ got[name]
             size = max(1.0, float(np.abs(A[:3, 3]).max()))
             ptol = max(tol, view.pose_tol)
-            if not (np.abs(A[:3, 3] - B[:3, 3]).max() <= ptol * size and np.abs(A[:3, :3] - B[:3, :3]).max() <= ptol):
+            if np.abs(A[:3, 3] - B[:3, 3]).max() > ptol * size:
                 diffs.append(f"link '{name}' is at {np.round(B[:3, 3], 9).tolist()}, the description puts it at "
                              f"{np.round(A[:3, 3], 9).tolist()} (joint values {q})")
+                return diffs
+            if np.abs(A[:3, :3] - B[:3, :3]).max() > ptol:
+                diffs.append(f"link '{name}' is turned by {turn(A, B):.3g} rad from the orientation the description "
+                             f"gives it (joint values {q})")
                 return diffs
     return diffs
 

@@ -8,7 +8,8 @@ import shutil
 import subprocess
 
 from robotkit.check.consumers import Missing, Refused, View
-from robotkit.check.kinematics import read_sdf_text
+from robotkit import urdfxml
+from robotkit.check.kinematics import LIBSDFORMAT_PRECISION, extension_parts, kept_fixed, read_sdf_text
 
 
 def _parsed(path) -> str:
@@ -24,9 +25,9 @@ def _parsed(path) -> str:
     return proc.stdout  # read_sdf_text copes with its undeclared namespace prefixes
 
 
-def _view(text: str, source: str, lumped: bool) -> View:
+def _view(text: str, source: str, lumped: bool, leave_out=(set(), set()), kept=frozenset()) -> View:
     try:
-        model = read_sdf_text(text, source)
+        model = read_sdf_text(text, source, leave_out)
     except ValueError as exc:  # libsdformat wrote a model it cannot load (a URDF planar joint drops)
         raise Refused(f"libsdformat's reading is not a model it can load: {str(exc).removeprefix(source + ': ')}") \
             from None
@@ -35,11 +36,14 @@ def _view(text: str, source: str, lumped: bool) -> View:
         # model.sdf renames a joint named like a link (robotkit.emit.sdf.joint_names)
         return model.fk({n if n in model.joints else f"{n}_joint": v for n, v in q.items()})
 
-    return View({n: link.mass for n, link in model.links.items() if n != "world"}, poses, lumped=lumped)
+    return View({n: link.mass for n, link in model.links.items() if n != "world"}, poses, lumped=lumped,
+                pose_tol=LIBSDFORMAT_PRECISION, kept=kept)
 
 
 def from_urdf(build) -> View:
-    return _view(_parsed(build.urdf), f"URDF {build.urdf} (libsdformat)", lumped=True)
+    # the links and joints of the URDF's own <gazebo> blocks are Gazebo's additions, not the robot's
+    return _view(_parsed(build.urdf), f"URDF {build.urdf} (libsdformat)", lumped=True,
+                 leave_out=extension_parts(build.urdf), kept=kept_fixed(urdfxml.parse_file(build.urdf).getroot()))
 
 
 def from_sdf(build) -> View:

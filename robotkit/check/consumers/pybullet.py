@@ -12,7 +12,10 @@ from robotkit.check.consumers import Missing, Refused, View, listed, with_mesh_p
 
 
 MAX_LINKS = 128
-PRECISION = 1e-6  # PyBullet's wheels compute kinematics in single precision
+PRECISION = 1e-5
+"""PyBullet's wheels compute kinematics in single precision: a six-joint chain at joint values up to
+7 rad loses 5.5e-7 of its reach in float32 (measured, numpy), PyBullet's frames through each link's
+inertial frame more (ABB IRB 140's link_5 1.02e-6 off at 1.01 m): ten times the chain's."""
 
 
 
