@@ -214,7 +214,8 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
     workers = _fork_pool()  # forked first, from one thread
     own = workers.submit(_own_consumers, build)
     started = start_motion(mjcf, urdf, {name: robot_dir})  # its simulators run beside the other stages
-    programs_ = [["ign", "sdf", "-p", str(p)] for p in (urdf, sdf)] if shutil.which("ign") else []
+    programs_ = ([["ign", "sdf", "-k", str(sdf)]] + [["ign", "sdf", "-p", str(p)] for p in (urdf, sdf)]
+                 if shutil.which("ign") else [])
     with programs.started(programs_), ThreadPoolExecutor(max_workers=2) as threads:
         validators = {"check_urdf": threads.submit(_timed, validate_urdf, urdf),
                       "ign sdf -k": threads.submit(_timed, validate_sdf, sdf)}
