@@ -115,7 +115,7 @@ def test_a_chain_deeper_than_mujoco_reads_builds_without_its_mjcf(tmp_path):
     (tmp_path / "deep.yaml").write_text(chain(500))
     proc = run_cli("build", "deep.yaml", "--out", "out", "--no-report", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
-    assert proc.stderr.splitlines() == [
+    assert [line for line in proc.stderr.splitlines() if "not written" in line] == [
         "deep.yaml:1: warning: deep: not written, a limit of the format: MJCF: link 'l499' sits 500 links deep and "
         "MuJoCo's XML reader stops at 496 nested bodies (a body per link); left out: deep/mjcf/deep.xml, "
         "deep/mjcf/scene.xml (list it under outputs: to make this an error)"]
