@@ -212,14 +212,31 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
     build = Build(name, robot_dir, urdf, sdf, mjcf, base)
     consumers_started = time.perf_counter()
     workers = _fork_pool()  # forked first, from one thread
-    own = workers.submit(_own_consumers, build)
-    started = start_motion(mjcf, urdf, {name: robot_dir})  # its simulators run beside the other stages
-    programs_ = ([["ign", "sdf", "-k", str(sdf)]] + [["ign", "sdf", "-p", str(p)] for p in (urdf, sdf)]
-                 if shutil.which("ign") else [])
-    with programs.started(programs_), ThreadPoolExecutor(max_workers=2) as threads:
-        validators = {"check_urdf": threads.submit(_timed, validate_urdf, urdf),
+    try:
+        own = workers.submit(_own_consumers, build)
+        started = start_motion(mjcf, urdf, {name: robot_dir})  # its simulators run beside the other stages
+        findings, gazebo = _main_stages(build, clock, declared_mass)
+        findings += _merged_consumers(gazebo, own, subject)
+    finally:
+        workers.shutdown(wait=False, cancel_futures=True)
+    clock.add("consumers", time.perf_counter() - consumers_started)
+    findings += clock.timed("simulation", lambda: _stage("simulation", subject, lambda: _simulate(scene, subject)))
+    findings += clock.timed("self-collision", lambda: _stage("self-collision", subject,
+                                                             lambda: interference(robot_dir)))
+    return findings + unreported_missing(findings, finish_motion(started, subject, name, motion, clock))
+
+
+def _main_stages(build: Build, clock: Clock, declared_mass: float | None) -> tuple[list[Finding], list[Finding]]:
+    """The lints, the validators, the equivalence and Gazebo's view, with libsdformat's runs
+    and check_urdf started first beside them: (their findings, Gazebo's findings)."""
+    subject, sdf, mjcf = f"robot '{build.name}'", build.sdf, build.mjcf
+    scene = robot_layout(build.dir).scene
+    sdformat = ([["ign", "sdf", "-k", str(sdf)]] + [["ign", "sdf", "-p", str(p)] for p in (build.urdf, sdf)]
+                if shutil.which("ign") else [])
+    with programs.started(sdformat), ThreadPoolExecutor(max_workers=2) as threads:
+        validators = {"check_urdf": threads.submit(_timed, validate_urdf, build.urdf),
                       "ign sdf -k": threads.submit(_timed, validate_sdf, sdf)}
-        findings = clock.timed("lints", lambda: _lints(urdf, {name: str(robot_dir)}, declared_mass))
+        findings = clock.timed("lints", lambda: _lints(build.urdf, {build.name: str(build.dir)}, declared_mass))
         for stage, future in validators.items():  # in the order the stages are listed
             found, seconds = _stage_outcome(stage, subject, future)
             findings += found
@@ -228,17 +245,11 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
 
         def equivalent() -> list[Finding]:
             return [Finding("error", "equivalence", subject, f"{what}: {d}")
-                    for what, diffs in equivalence(robot_dir).items() for d in diffs]
+                    for what, diffs in equivalence(build.dir).items() for d in diffs]
 
         findings += clock.timed("equivalence", lambda: _stage("equivalence", subject, equivalent))
-        gazebo, gazebo_seconds = _timed(lambda: _stage("consumers", subject,
-                                                       lambda: consumer_findings(build, GAZEBO)[0]))
-    findings += _merged_consumers(gazebo, own, subject, workers)
-    clock.add("consumers", time.perf_counter() - consumers_started)
-    findings += clock.timed("simulation", lambda: _stage("simulation", subject, lambda: _simulate(scene, subject)))
-    findings += clock.timed("self-collision", lambda: _stage("self-collision", subject,
-                                                             lambda: interference(robot_dir)))
-    return findings + unreported_missing(findings, finish_motion(started, subject, name, motion, clock))
+        gazebo = _stage("consumers", subject, lambda: consumer_findings(build, GAZEBO)[0])
+    return findings, gazebo
 
 
 GAZEBO = [c for c in CONSUMERS if c.startswith("Gazebo")]
@@ -249,10 +260,9 @@ def _lints(urdf: Path, package_paths: dict[str, str], declared_mass: float | Non
     return notes + lint(links, joints, declared_mass)
 
 
-def _merged_consumers(gazebo: list[Finding], own: Future, subject: str, workers) -> list[Finding]:
+def _merged_consumers(gazebo: list[Finding], own: Future, subject: str) -> list[Finding]:
     """Gazebo's findings, then the worker's, each once (both say when the description cannot be read)."""
     found, _ = _stage_outcome("consumers", subject, own)
-    workers.shutdown()
     return list(dict.fromkeys(gazebo + found))
 
 
