@@ -9,13 +9,17 @@ which, and building a recipe first, is ``robotkit.commands.check``'s job.
 from __future__ import annotations
 
 import re
+import shutil
 import tempfile
+import time
+from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor
 import xml.etree.ElementTree as ET
 from dataclasses import replace
 from pathlib import Path
 
 from robotkit import urdfxml
-from robotkit.check.consumers import Build, consumer_findings
+from robotkit.check import programs
+from robotkit.check.consumers import CONSUMERS, Build, consumer_findings
 from robotkit.check.equivalence import equivalence
 from robotkit.check.selfcollision import interference, mjcf_interference
 from robotkit.check.findings import Finding
@@ -27,8 +31,6 @@ from robotkit.check.simulation import smoke_test
 from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
 from robotkit.emit.layout import robot_layout
 from robotkit.errors import Problem, RobotkitError
-from robotkit.importer.package_xml import with_own_package
-from robotkit.importer.xacro_expand import check_package_paths, expand
 
 
 URDF_CONSUMERS = ["Gazebo (URDF)", "Drake (URDF)", "Pinocchio (URDF)", "PyBullet (URDF)"]
@@ -47,6 +49,8 @@ def check_urdf_file(path: Path, package_paths: dict[str, str]) -> list[Finding]:
     """Findings on a URDF, each located at its link's or joint's line.  A broken tree (a
     cycle, a second parent, a missing link) is found here first: the validators and
     consumers are not given it (check_urdf prints a cycle forever, simulators crash)."""
+    from robotkit.importer.package_xml import with_own_package  # the importer (pydantic): not for a build folder
+
     package_paths = with_own_package(path.absolute(), package_paths)
     try:
         links, joints, notes = read_urdf_facts(path, package_paths)
@@ -71,6 +75,9 @@ def check_xacro_file(path: Path, package_paths: dict[str, str], args: dict[str, 
     """A xacro file expanded in the import's sandbox (``$(find)`` through ``package_paths``,
     ``args`` as xacro arguments), then checked as the URDF it expands to; findings name the
     xacro file."""
+    from robotkit.importer.package_xml import with_own_package
+    from robotkit.importer.xacro_expand import check_package_paths, expand
+
     packages = with_own_package(path.absolute(), check_package_paths(package_paths))
     text = expand(path, packages, args).text
 
@@ -134,40 +141,136 @@ def urdf_tree(path: Path) -> tuple[dict[str, int], list[Finding]]:
     return lines, found
 
 
-def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion: dict | None = None) -> list[Finding]:
+class Clock:
+    """Each stage's wall time in seconds, added into ``timings`` (stage -> seconds; None: not kept)."""
+
+    def __init__(self, timings: dict[str, float] | None):
+        self.timings = timings
+
+    def add(self, stage: str, seconds: float) -> None:
+        if self.timings is not None:
+            self.timings[stage] = self.timings.get(stage, 0.0) + seconds
+
+    def timed(self, stage: str, run):
+        """``run()``, its time added to ``stage``."""
+        t = time.perf_counter()
+        try:
+            return run()
+        finally:
+            self.add(stage, time.perf_counter() - t)
+
+
+def _timed(run, *args) -> tuple[object, float]:
+    """(``run(*args)``, its wall time): a stage run in a thread or a worker process."""
+    t = time.perf_counter()
+    return run(*args), time.perf_counter() - t
+
+
+def _stage_outcome(name: str, subject: str, future: Future) -> tuple[list[Finding], float]:
+    try:
+        return future.result()
+    except Exception as exc:  # as _stage reports it (a worker process that died, a program that crashed)
+        return [Finding("error", name, subject, f"the {name} stage could not run: {type(exc).__name__}: {exc}")], 0.0
+
+
+def _own_consumers(build: Build) -> tuple[list[Finding], float]:
+    """The consumers that read the robot in Python (Drake, Pinocchio, PyBullet, MuJoCo), in a
+    worker process: their imports and readings beside the main process's stages."""
+    return _timed(lambda: _stage("consumers", f"robot '{build.name}'",
+                                 lambda: consumer_findings(build, IN_WORKER)[0]))
+
+
+IN_WORKER = [c for c in CONSUMERS if not c.startswith("Gazebo")]
+"""The consumers read in a worker process; Gazebo's (``ign sdf -p``, run once for the equivalence
+stage too: robotkit.check.programs) in the main one."""
+
+
+def _fork_pool():
+    """A one-worker process pool, forked where the system can (the worker inherits the imports)."""
+    import multiprocessing
+
+    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    return ProcessPoolExecutor(max_workers=1, mp_context=context)
+
+
+def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion: dict | None = None,
+                    timings: dict[str, float] | None = None) -> list[Finding]:
     """Every stage on a build folder: lints, validators, equivalence of the formats, what each
     consuming program sees, the MuJoCo scene's own simulation and, when the MJCF has actuators,
     the step responses of its drives (``motion``: gets the robot's motion results by name).
-    Every stage always runs."""
+    Every stage always runs; the ones that do not depend on each other at once (the motion
+    stage's simulators and the Python consumers in worker processes, the validator programs and
+    ``ign sdf -p`` in threads).  ``timings``: gets each stage's wall time (seconds, by stage)."""
     layout = robot_layout(robot_dir)
     name, urdf, sdf, mjcf, scene = layout.name, layout.urdf, layout.sdf, layout.mjcf, layout.scene
     for p in (urdf, sdf, mjcf, scene):
         if not p.is_file():
             raise RobotkitError(Problem(f"not a robotkit build folder: {p.relative_to(robot_dir)} is missing",
                                         file=str(robot_dir)))
-    subject = f"robot '{name}'"
-    started = start_motion(mjcf, urdf, {name: robot_dir})  # its simulators run beside the other stages
-    links, joints, notes = read_urdf_facts(urdf, {name: str(robot_dir)})
-    findings = notes + lint(links, joints, declared_mass)
-    findings += validate_urdf(urdf) + validate_sdf(sdf) + validate_mjcf(mjcf) + validate_mjcf(scene)
-
-    def equivalent() -> list[Finding]:
-        return [Finding("error", "equivalence", subject, f"{what}: {d}")
-                for what, diffs in equivalence(robot_dir).items() for d in diffs]
-
+    clock, subject = Clock(timings), f"robot '{name}'"
     base = "free" if "<freejoint" in mjcf.read_text(encoding="utf-8") else "fixed"
     build = Build(name, robot_dir, urdf, sdf, mjcf, base)
-    findings += _stage("equivalence", subject, equivalent)
-    findings += _stage("consumers", subject, lambda: consumer_findings(build)[0])
-    def simulate() -> list[Finding]:
-        notes: list[str] = []
-        problems = smoke_test(scene, notes=notes)
-        return ([Finding("error", "simulation", subject, p, "MuJoCo scene mjcf/scene.xml") for p in problems]
-                + [Finding("warning", "simulation", subject, n, "MuJoCo scene mjcf/scene.xml") for n in notes])
+    consumers_started = time.perf_counter()
+    workers = _fork_pool()  # forked first, from one thread
+    try:
+        own = workers.submit(_own_consumers, build)
+        started = start_motion(mjcf, urdf, {name: robot_dir})  # its simulators run beside the other stages
+        findings, gazebo = _main_stages(build, clock, declared_mass)
+        findings += _merged_consumers(gazebo, own, subject)
+    finally:
+        workers.shutdown(wait=False, cancel_futures=True)
+    clock.add("consumers", time.perf_counter() - consumers_started)
+    findings += clock.timed("simulation", lambda: _stage("simulation", subject, lambda: _simulate(scene, subject)))
+    findings += clock.timed("self-collision", lambda: _stage("self-collision", subject,
+                                                             lambda: interference(robot_dir)))
+    return findings + unreported_missing(findings, finish_motion(started, subject, name, motion, clock))
 
-    findings += _stage("simulation", subject, simulate)
-    findings += _stage("self-collision", subject, lambda: interference(robot_dir))
-    return findings + unreported_missing(findings, finish_motion(started, subject, name, motion))
+
+def _main_stages(build: Build, clock: Clock, declared_mass: float | None) -> tuple[list[Finding], list[Finding]]:
+    """The lints, the validators, the equivalence and Gazebo's view, with libsdformat's runs
+    and check_urdf started first beside them: (their findings, Gazebo's findings)."""
+    subject, sdf, mjcf = f"robot '{build.name}'", build.sdf, build.mjcf
+    scene = robot_layout(build.dir).scene
+    sdformat = ([["ign", "sdf", "-k", str(sdf)]] + [["ign", "sdf", "-p", str(p)] for p in (build.urdf, sdf)]
+                if shutil.which("ign") else [])
+    with programs.started(sdformat), ThreadPoolExecutor(max_workers=2) as threads:
+        validators = {"check_urdf": threads.submit(_timed, validate_urdf, build.urdf),
+                      "ign sdf -k": threads.submit(_timed, validate_sdf, sdf)}
+        findings = clock.timed("lints", lambda: _lints(build.urdf, {build.name: str(build.dir)}, declared_mass))
+        for stage, future in validators.items():  # in the order the stages are listed
+            found, seconds = _stage_outcome(stage, subject, future)
+            findings += found
+            clock.add(stage, seconds)
+        findings += clock.timed("mujoco", lambda: validate_mjcf(mjcf) + validate_mjcf(scene))
+
+        def equivalent() -> list[Finding]:
+            return [Finding("error", "equivalence", subject, f"{what}: {d}")
+                    for what, diffs in equivalence(build.dir).items() for d in diffs]
+
+        findings += clock.timed("equivalence", lambda: _stage("equivalence", subject, equivalent))
+        gazebo = _stage("consumers", subject, lambda: consumer_findings(build, GAZEBO)[0])
+    return findings, gazebo
+
+
+GAZEBO = [c for c in CONSUMERS if c.startswith("Gazebo")]
+
+
+def _lints(urdf: Path, package_paths: dict[str, str], declared_mass: float | None) -> list[Finding]:
+    links, joints, notes = read_urdf_facts(urdf, package_paths)
+    return notes + lint(links, joints, declared_mass)
+
+
+def _merged_consumers(gazebo: list[Finding], own: Future, subject: str) -> list[Finding]:
+    """Gazebo's findings, then the worker's, each once (both say when the description cannot be read)."""
+    found, _ = _stage_outcome("consumers", subject, own)
+    return list(dict.fromkeys(gazebo + found))
+
+
+def _simulate(scene: Path, subject: str) -> list[Finding]:
+    notes: list[str] = []
+    problems = smoke_test(scene, notes=notes)
+    return ([Finding("error", "simulation", subject, p, "MuJoCo scene mjcf/scene.xml") for p in problems]
+            + [Finding("warning", "simulation", subject, n, "MuJoCo scene mjcf/scene.xml") for n in notes])
 
 
 def unreported_missing(findings: list[Finding], more: list[Finding]) -> list[Finding]:
@@ -186,7 +289,7 @@ def start_motion(mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path]) -
 
 
 def finish_motion(started: MotionRun | Exception | None, subject: str, name: str,
-                  motion: dict | None) -> list[Finding]:
+                  motion: dict | None, clock: Clock | None = None) -> list[Finding]:
     if started is None:
         return []
 
@@ -194,6 +297,8 @@ def finish_motion(started: MotionRun | Exception | None, subject: str, name: str
         if isinstance(started, Exception):
             raise started
         found, results = started.finish()
+        if clock is not None:  # from the stage's start: its simulators ran beside the other stages
+            clock.add("motion", float(results.get("wall", 0.0)))
         if motion is not None:
             motion[name] = results
         return found

@@ -16,13 +16,13 @@ from __future__ import annotations
 import copy
 import math
 import re
-import subprocess
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from robotkit import mj, urdfxml
+from robotkit.check import programs
 
 WORLD = "world"
 NEGLIGIBLE = 1e-200  # kg: robotkit's URDF writes massless links as 1e-300 kg (see emit/urdf.py)
@@ -385,7 +385,7 @@ def read_sdf(path) -> KModel:
 
 def read_urdf_via_libsdformat(path) -> KModel:
     """libsdformat's own reading of the URDF (`ign sdf -p`), as SDF."""
-    proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
+    proc = programs.libsdformat(path)
     if proc.returncode != 0 or "<sdf" not in proc.stdout:
         raise RuntimeError(f"ign sdf -p {path} failed: {proc.stderr.strip() or proc.stdout.strip()}")
     return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)", extension_parts(path))

@@ -13,20 +13,25 @@ from robotkit.errors import display_path
 
 def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error",
            cases: list[tuple[str, str]] | None = None, motion: dict | None = None,
-           elapsed: float | None = None) -> str:
+           elapsed: float | None = None, timings: dict[str, float] | None = None) -> str:
     """``fail_on`` (``--fail-on``): the lowest severity that fails the check; every format says
     which findings fail it (JUnit failures, GitHub ``::error``, JSON ``failed``, the text's last line).
     ``cases``: every (check, subject) that ran (:func:`robotkit.commands.check.cases`): JUnit lists the
     ones without findings as passing test cases, the text and JSON each stage with its verdict.
     ``motion``: the motion stage's results by robot (JSON: under ``motion``; text: one line per
-    joint).  ``elapsed``: the check's wall time in seconds (the text's last line)."""
+    joint).  ``elapsed``: the check's wall time in seconds (the text's last line; JSON: ``seconds``).
+    ``timings``: each stage's wall time in seconds (JSON: the stage's ``seconds``; stages run at
+    once, so they add up to more than ``elapsed``)."""
     if fmt == "json":
         out = {"source": source, "errors": sum(f.severity == "error" for f in findings),
                "warnings": sum(f.severity == "warning" for f in findings), "fail_on": fail_on,
                "failed": sum(f.fails(fail_on) for f in findings),
                "stages": [{"stage": s.name, "verdict": s.verdict, "subjects": s.subjects}
+                          | ({"seconds": round(timings[s.name], 3)} if s.name in (timings or {}) else {})
                           for s in stages(findings, cases or [])],
                "findings": [asdict(f) for f in findings]}
+        if elapsed is not None:
+            out["seconds"] = round(elapsed, 3)
         if motion:
             out["motion"] = motion
         return json.dumps(out, indent=1) + "\n"

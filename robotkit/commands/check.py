@@ -11,7 +11,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from robotkit.check import check_build_dir, check_model_file, check_urdf_file, check_xacro_file, xacro_robot
+from robotkit.check import Clock, check_build_dir, check_model_file, check_urdf_file, check_xacro_file, xacro_robot
 from robotkit.check.findings import Finding, input_findings
 from robotkit.check.locate import element_lines, locate
 from robotkit.check.render import job_summary, render
@@ -19,9 +19,14 @@ from robotkit.commands.build import cores
 from robotkit.commands.inputs import classify, package_paths
 from robotkit.emit.layout import RobotLayout, robot_layout
 from robotkit.errors import RobotkitError
-from robotkit.pipeline.buildwarn import parse
-from robotkit.pipeline.runner import build
-from robotkit.recipe.load import load_recipes
+
+
+def load_recipes(path, args: dict[str, str] | None = None, variant: str | None = None):
+    """robotkit.recipe.load.load_recipes, imported when a recipe is checked: the recipe schema
+    (pydantic) and the build are no part of a build folder's check."""
+    from robotkit.recipe.load import load_recipes as load
+
+    return load(path, args, variant)
 
 
 def run(args) -> int:
@@ -41,14 +46,14 @@ def run(args) -> int:
 def _check_paths(args, packages: dict[str, str]) -> int:
     """Every PATH in turn; bad input (exit 2) is reported in the chosen format too, so a CI
     report never comes out empty, and its lines go to stderr as always."""
-    findings, status, ran, motion = [], 0, [], {}
+    findings, status, ran, motion, timings = [], 0, [], {}, {}
     start = time.perf_counter()
     for path in args.paths:
         try:  # a recipe is built as `robotkit build` builds it; its picture report for GitHub's summary,
             # or kept when an earlier build wrote one (None), never drawn anew only for a check
             report = False if args.no_report or args.temp_out else (True if args.format == "github" else None)
             findings += check(path, args.out, packages, args=dict(args.arg), report=report, motion=motion,
-                              variant=args.variant, ros=args.ros, jobs=args.jobs or cores())
+                              variant=args.variant, ros=args.ros, jobs=args.jobs or cores(), timings=timings)
             ran += cases(path, args.out, dict(args.arg), args.variant)
         except RobotkitError as exc:
             for line in exc.lines():
@@ -56,15 +61,17 @@ def _check_paths(args, packages: dict[str, str]) -> int:
             findings += input_findings(exc.problems, path)
             status = max(status, exc.exit_status)
     ran += [("motion", f"robot '{name}'") for name in motion]  # the robots whose drives were stepped
-    _write_findings(args, findings, status, ran, motion, time.perf_counter() - start)
+    _write_findings(args, findings, status, ran, motion, time.perf_counter() - start, timings)
     return status or (1 if any(f.fails(args.fail_on) for f in findings) else 0)
 
 
 def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[str, str]],
-                    motion: dict | None = None, elapsed: float | None = None) -> None:
+                    motion: dict | None = None, elapsed: float | None = None,
+                    timings: dict[str, float] | None = None) -> None:
     source = " ".join(args.paths)
     if args.format != "text" or not status:
-        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran, motion=motion, elapsed=elapsed))
+        sys.stdout.write(render(findings, args.format, source, args.fail_on, ran, motion=motion, elapsed=elapsed,
+                                timings=timings))
     elif any(f.check != "input" for f in findings):  # the paths that could be checked
         sys.stdout.write(render([f for f in findings if f.check != "input"], "text", source, args.fail_on, ran,
                                 motion=motion, elapsed=elapsed))
@@ -79,16 +86,19 @@ def _write_findings(args, findings: list[Finding], status: int, ran: list[tuple[
 
 def check(path: str, out_dir: str = "build", package_paths: dict[str, str] | None = None,
           args: dict[str, str] | None = None, report: bool | None = False, motion: dict | None = None,
-          variant: str | None = None, ros: str | None = None, jobs: int = 1) -> list[Finding]:
+          variant: str | None = None, ros: str | None = None, jobs: int = 1,
+          timings: dict[str, float] | None = None) -> list[Finding]:
     """The findings on PATH.  ``report``: a recipe's build also writes its picture report (as
     ``robotkit build`` does); None: when the build folder has one already.  ``motion``: gets each robot's motion results by name.  ``variant``,
-    ``ros`` and ``jobs``: a recipe's build (``--variant``, ``--ros``, ``-j``)."""
+    ``ros`` and ``jobs``: a recipe's build (``--variant``, ``--ros``, ``-j``).  ``timings``: gets each
+    stage's wall time (seconds by stage: a build folder's stages and a recipe's build)."""
     what = classify(path)
     package_paths = package_paths or {}
     if what.kind == "build":  # a build folder's findings point at its URDF
-        return [f for d in what.robots for f in locate(check_build_dir(d.root, motion=motion), d.urdf)]
+        return [f for d in what.robots
+                for f in locate(check_build_dir(d.root, motion=motion, timings=timings), d.urdf)]
     if what.kind == "recipe":
-        return check_recipe(what.path, out_dir, args, report, motion, variant, ros, jobs)
+        return check_recipe(what.path, out_dir, args, report, motion, variant, ros, jobs, timings)
     if what.kind == "urdf":
         return check_urdf_file(what.path, package_paths)
     if what.kind == "xacro":
@@ -109,13 +119,18 @@ def _has_report(path: Path, out_dir: str, args: dict[str, str] | None, variant: 
 
 def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, report: bool | None = False,
                  motion: dict | None = None, variant: str | None = None, ros: str | None = None,
-                 jobs: int = 1) -> list[Finding]:
+                 jobs: int = 1, timings: dict[str, float] | None = None) -> list[Finding]:
     """Build the recipe, then check each of its robots (one per variant, or ``variant``), the
     build's warnings and the findings placed on the recipe's lines."""
+    from robotkit.pipeline.buildwarn import parse
+    from robotkit.pipeline.runner import build
+
     located = []
     if report is None:
         report = _has_report(path, out_dir, args, variant)
-    result = build([path], out_dir, jobs=jobs, args=args, report=report, ros=ros, variant=variant)
+    clock = Clock(timings)
+    result = clock.timed("build", lambda: build([path], out_dir, jobs=jobs, args=args, report=report, ros=ros,
+                                                variant=variant))
     warnings = [parse(w) for w in result.warning_lines]  # (file, line, key, text)
     for i, loaded in enumerate(load_recipes(path, args, variant)):  # one per variant
         name = loaded.recipe.robot
@@ -123,15 +138,16 @@ def check_recipe(path: Path, out_dir: str, args: dict[str, str] | None = None, r
         # a warning naming another variant's robot belongs to that one; the rest to the first
         mine = [w for w in warnings if w[3].startswith(f"{name}:")
                 or (i == 0 and not any(w[3].startswith(f"{o}:") for o in others))]
-        located += _check_variant(loaded, mine, out_dir, motion)
+        located += _check_variant(loaded, mine, out_dir, motion, timings)
     return located
 
 
-def _check_variant(loaded, warnings: list[tuple], out_dir: str, motion: dict | None = None) -> list[Finding]:
+def _check_variant(loaded, warnings: list[tuple], out_dir: str, motion: dict | None = None,
+                   timings: dict[str, float] | None = None) -> list[Finding]:
     name = loaded.recipe.robot
     build_findings = [Finding("warning", "build", key or f"robot '{name}'", text, file=file, line=line)
                       for file, line, key, text in warnings]
-    findings = check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass, motion)
+    findings = check_build_dir(Path(out_dir) / name, loaded.recipe.measured_mass, motion, timings)
     marks = loaded.marks
     located = []
     for f in findings:

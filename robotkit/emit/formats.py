@@ -56,6 +56,10 @@ class Format:
     folder holds no file naming a missing one."""
     when: Callable[[Robot], bool] | None = None
     """Written only for the robots this accepts (default: every robot)."""
+    limit: Callable[[Robot], str | None] | None = None
+    """The format's own limit: why it cannot hold this robot (None: it can).  Not the recipe's
+    fault: the build leaves the format out, with every format that needs it, and says so in one
+    warning, unless the recipe lists it under ``outputs`` (then its task refuses the robot)."""
     points: Callable[[Robot], list[str]] | None = None
     """The mesh files below ``meshes/`` whose vertices ``render`` needs (keyword ``points``: file ->
     vertices); the build reads them after writing them."""
@@ -66,3 +70,45 @@ class Format:
 
     def wanted(self, robot: Robot) -> bool:
         return self.when is None or self.when(robot)
+
+
+def unknown_outputs(outputs: list[str], formats: Mapping[str, Format]) -> list[str]:
+    """The names of ``outputs`` (a recipe's ``outputs:``) that are not formats of ``formats``."""
+    return [n for n in outputs if n not in formats]
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """The formats a robot's build writes (:func:`outputs_of`)."""
+
+    written: tuple[str, ...]
+    """In the registry's order."""
+    lost: Mapping[str, str] = field(default_factory=dict)
+    """Format -> why it cannot hold the robot (its own limit), left out."""
+    with_lost: tuple[str, ...] = ()
+    """The formats left out because they need a lost one."""
+
+    def __contains__(self, name: str) -> bool:
+        return name in self.written
+
+
+def outputs_of(robot: Robot, formats: Mapping[str, Format], outputs: list[str] | None = None) -> Outputs:
+    """The formats of ``formats`` the build writes for ``robot``: the ones it wants, or the
+    recipe's ``outputs`` with every format they need; without ``outputs``, a format at its own
+    limit (:attr:`Format.limit`) is lost, with every format that needs it."""
+    wanted = [n for n, f in formats.items() if f.wanted(robot)]
+    if outputs is not None:
+        chosen, todo = set(), list(outputs)
+        while todo:
+            name = todo.pop()
+            if name in formats and name not in chosen:
+                chosen.add(name)
+                todo += list(formats[name].needs)
+        return Outputs(tuple(n for n in wanted if n in chosen))
+    lost = {n: why for n in wanted if formats[n].limit is not None and (why := formats[n].limit(robot))}
+    gone, changed = set(lost), True
+    while changed:
+        more = {n for n in wanted if n not in gone and any(m in gone for m in formats[n].needs)}
+        gone |= more
+        changed = bool(more)
+    return Outputs(tuple(n for n in wanted if n not in gone), lost, tuple(n for n in wanted if n in gone - set(lost)))

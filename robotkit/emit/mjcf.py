@@ -23,7 +23,7 @@ from robotkit.emit.meshfiles import collision_file, conversions, visual_file
 from robotkit.emit.sdf import extras_losses
 from robotkit.emit.sensors import losses as sensor_losses
 from robotkit.emit.sensors import mjcf_context
-from robotkit.model.robot import Geom, Robot
+from robotkit.model.robot import MJCF_MAX_DEPTH, Geom, Robot
 
 WORLD = "world"
 MJCF_MESH_EXT = (".stl", ".obj")
@@ -419,8 +419,19 @@ def render_scene(robot: Robot, points: dict[str, np.ndarray] | None = None) -> s
     return render("mjcf/scene.xml.j2", robot=robot, floor=floor_height(robot, points))
 
 
+def too_deep(robot: Robot) -> str | None:
+    """Why MuJoCo cannot load the robot's MJCF whatever the recipe says (a body per link,
+    nested): a chain deeper than its XML reader goes.  None when it can."""
+    depth, deepest = robot.depth()
+    if depth <= MJCF_MAX_DEPTH:
+        return None
+    return (f"link '{deepest}' sits {depth} links deep and MuJoCo's XML reader stops at {MJCF_MAX_DEPTH} "
+            "nested bodies (a body per link)")
+
+
 FORMATS = [
-    Format("mjcf", render_mjcf, layout.MJCF, ("mjcf/robot.xml.j2",), consumed=True, points=collision_meshes),
+    Format("mjcf", render_mjcf, layout.MJCF, ("mjcf/robot.xml.j2",), consumed=True, points=collision_meshes,
+           limit=too_deep),
     Format("mjcf-scene", render_scene, layout.SCENE, ("mjcf/scene.xml.j2",), needs=("mjcf",),
            points=collision_meshes),
 ]

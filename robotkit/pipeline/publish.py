@@ -123,3 +123,13 @@ def _publish_unit(staged: Path, final: Path, files: list[str], scratch: Path) ->
         os.rename(final, old)
     os.rename(new, final)
     shutil.rmtree(old, ignore_errors=True)
+
+
+def loss_warning(robot: str, lost: dict[str, str], files: list[str]) -> str:
+    """The one warning on the formats a robot's build left out as beyond their own limits
+    (``lost``: format -> why) with ``files``, every file left out (below the output folder):
+    not a failure, since no recipe of this robot could have them; listing the format under
+    ``outputs:`` makes it one."""
+    why = "; ".join(f"{name.upper()}: {reason}" for name, reason in lost.items())
+    return (f"{robot}: not written, a limit of the format: {why}; left out: {', '.join(files)} "
+            f"(list it under outputs: to make this an error)")

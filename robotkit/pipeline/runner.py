@@ -22,12 +22,15 @@ from doit.exceptions import TaskFailed, UnmetDependency
 from doit.task import dict_to_task
 
 from robotkit.emit.env import template_dirs
+from robotkit.emit.formats import Outputs, outputs_of, unknown_outputs
+from robotkit.emit.layout import output_path
+from robotkit.emit.registry import FORMATS
 from robotkit.errors import Problem, RobotkitError
 from robotkit.model.load import load_robots, mesh_locations
 from robotkit.pipeline import stamp
-from robotkit.pipeline.buildwarn import build_warnings, no_pictures
+from robotkit.pipeline.buildwarn import build_warnings, no_pictures, warning_line
 from robotkit.pipeline.progress import Progress
-from robotkit.pipeline.publish import STATE, publish, stage_dir, staged_files
+from robotkit.pipeline.publish import STATE, loss_warning, publish, stage_dir, staged_files
 from robotkit.pipeline.tasks import robot_tasks
 
 
@@ -161,8 +164,9 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     out = Path(out_dir).absolute()
     robots = load_robots(recipes, ros, args, moveit=moveit, variant=variant)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
+    chosen = chosen_outputs(robots)  # an unknown format under outputs: is bad input, before anything is written
     tasks = [t for loaded, robot in robots for t in robot_tasks(robot, out, mesh_locations(loaded, robot),
-                                                                 report=report)]
+                                                                 report=report, outputs=chosen[robot.name])]
     (out / STATE).mkdir(parents=True, exist_ok=True)
     recorder = _Recorder(result, echo, progress)
     inputs = _input_stats(robots, tasks)  # before running: an edit during the build is a change
@@ -174,7 +178,7 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         raise _failure(result, {robot.name: str(loaded.file) for loaded, robot in robots})
     if rc not in (0,) and not result.errors and not result.failed:
         result.errors.append(("doit", f"doit exited with status {rc}"))
-    warnings = build_warnings(robots, out)  # (text, file:line: key: warning: text) pairs
+    warnings = losses(robots, chosen, report) + build_warnings(robots, out)  # (text, file:line: key: warning: text)
     result.warnings, result.warning_lines = [t for t, _ in warnings], [line for _, line in warnings]
     # a report drawn without pictures is retried by the next build (MuJoCo may draw by then): no stamp
     retry = any(no_pictures(name, out) for name in result.robots)
@@ -186,6 +190,32 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
         except OSError:
             pass  # no stamp: the next build runs doit's checks
     return result
+
+
+def chosen_outputs(robots) -> dict[str, Outputs]:
+    """Each robot's formats (robotkit.emit.formats.outputs_of its recipe's ``outputs:``)."""
+    problems = [loaded.marks.problem(("outputs",), f"'{name}' is not an output format (one of: {', '.join(FORMATS)})")
+                for loaded, _ in robots for name in unknown_outputs(loaded.recipe.outputs or [], FORMATS)]
+    if problems:
+        raise RobotkitError(problems)
+    return {robot.name: outputs_of(robot, FORMATS, loaded.recipe.outputs) for loaded, robot in robots}
+
+
+def losses(robots, chosen: dict[str, Outputs], report: bool) -> list[tuple[str, str]]:
+    """The warning of each robot that lost a format to the format's own limit, placed on its recipe's
+    ``robot:`` line: the formats, why, and every file left out with them."""
+    out = []
+    for loaded, robot in robots:
+        mine = chosen[robot.name]
+        if not mine.lost:
+            continue
+        files = [f"{robot.name}/{output_path(FORMATS[n].path, robot.name, robot.ros)}"
+                 for n in (*mine.lost, *mine.with_lost)]
+        files += [f"{robot.name}/report/report.html"] if report and "mjcf" not in mine else []
+        text = loss_warning(robot.name, dict(mine.lost), files)
+        file, line = loaded.marks.locate(("robot",))
+        out.append((text, warning_line(text, {"file": file or str(loaded.file), "line": line})))
+    return out
 
 
 def run_doit(tasks: list[dict], out: Path, recorder: "_Recorder", jobs: int = 1) -> int:

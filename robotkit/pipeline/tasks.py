@@ -29,7 +29,7 @@ from doit.tools import config_changed
 from robotkit.emit import layout
 from robotkit.emit.registry import FORMATS
 from robotkit.emit.env import template_dirs
-from robotkit.emit.formats import Format
+from robotkit.emit.formats import Format, Outputs, outputs_of
 from robotkit.emit.meshfiles import conversions
 from robotkit.emit.ros import has_moveit
 from robotkit.geometry import rpy_quat
@@ -101,12 +101,14 @@ class Place:
 
 
 def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None,
-                report: bool = False) -> list[dict]:
+                report: bool = False, outputs: Outputs | None = None) -> list[dict]:
     """The task dicts that build ``robot`` into ``out_dir/<robot>/``.
 
     ``where`` maps a mesh key, and ``link:<name>``, to the recipe location naming it (for messages);
-    ``report`` adds the picture report (``report/report.html``).
+    ``report`` adds the picture report (``report/report.html``, drawn from the MJCF: not without it);
+    ``outputs``: the formats written (default: :func:`robotkit.emit.formats.outputs_of` the robot).
     """
+    outputs = outputs or outputs_of(robot, FORMATS)
     place = Place.of(robot, out_dir, where)
     meshes = mesh_tasks(place)
     # collision pieces before the other mesh work: CoACD is the longest, and doit -j N hands
@@ -114,10 +116,10 @@ def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = N
     collisions = collision_tasks(place)
     files = visual_tasks(place) + copy_tasks(place) + convert_tasks(place)  # the mesh files below meshes/
     textures = texture_tasks(place)
-    outputs = output_tasks(place, [t["targets"][0] for t in files])
+    written = output_tasks(place, [t["targets"][0] for t in files], outputs)
     tasks = meshes + collisions + files + textures + inertial_tasks(place) + drive_tasks(place)
-    tasks += self_collision_tasks(place, [t["targets"][0] for t in files]) + outputs
-    if report:
+    tasks += self_collision_tasks(place, [t["targets"][0] for t in files]) + written
+    if report and "mjcf" in outputs:
         tasks.append(report_task(place, collisions + files + textures, meshes))
     return tasks + world_tasks(robot, out_dir)
 
@@ -367,11 +369,12 @@ def readings(place: Place) -> dict[str, Reading]:
     }
 
 
-def output_tasks(place: Place, written: list[str]) -> list[dict]:
-    """``<robot>:<format>``: one output file per registered format the robot wants; ``written``:
-    the mesh files below ``meshes/`` (a format that measures them waits for them)."""
+def output_tasks(place: Place, written: list[str], outputs: Outputs | None = None) -> list[dict]:
+    """``<robot>:<format>``: one output file per registered format the robot wants (of ``outputs``);
+    ``written``: the mesh files below ``meshes/`` (a format that measures them waits for them)."""
     reads = readings(place)
-    return [output_task(place, fmt, reads[fmt.reads], written) for fmt in FORMATS.values() if fmt.wanted(place.robot)]
+    outputs = outputs or outputs_of(place.robot, FORMATS)
+    return [output_task(place, FORMATS[name], reads[FORMATS[name].reads], written) for name in outputs.written]
 
 
 def output_task(place: Place, fmt: Format, reading: Reading, written: list[str]) -> dict:
@@ -500,7 +503,8 @@ def all_tasks(recipe_files, out_dir, args: dict[str, str] | None = None, ignore_
     build`` publishes after doit ran, robotkit.pipeline.runner)."""
     tasks = []
     for loaded, robot in load_robots(recipe_files, None, args, ignore_unknown_args):
-        mine = robot_tasks(robot, out_dir, mesh_locations(loaded, robot), report=report)
+        mine = robot_tasks(robot, out_dir, mesh_locations(loaded, robot), report=report,
+                           outputs=outputs_of(robot, FORMATS, loaded.recipe.outputs))
         tasks.extend(mine)
         tasks.append(publish_task(robot.name, out_dir, mine))
     return tasks

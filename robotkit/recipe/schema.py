@@ -807,6 +807,8 @@ class Recipe(Strict):
     """Default policy for meshes that are not closed volumes after safe repair."""
     meshes: MeshDefaults = MeshDefaults()
     """Mesh processing defaults: repair, visual decimation, collision strategy."""
+    outputs: list[str] | None = None
+    """The output formats the build must write, by name (``urdf``, ``sdf``, ``mjcf``, ``mjcf-scene``, ``srdf``, ``rviz``...: the names ``robotkit build -v`` gives its tasks), each with the formats it names or needs. Default: every format. Without the list, a format that cannot hold the robot by a limit of its own (MuJoCo's XML reader nests at most 496 bodies: a chain deeper than that has no MJCF) is left out with what depends on it (the MuJoCo scene, the picture report), with one warning, and the build succeeds; a format listed here that cannot be written fails the build (exit 1)."""
     measured_mass: PositiveMass | None = None
     """The robot's total mass as weighed, in kg; `robotkit check` compares it with the sum of the links' masses."""
     self_collide: bool | None = None

@@ -190,7 +190,8 @@ def test_a_robot_a_consumer_refuses_fails_the_build_naming_the_link(tmp_path):
 def test_a_chain_of_1000_links(tmp_path):
     """URDF and SDF of a 1000-link chain load in Gazebo and Drake with the right masses and
     frames; the programs that cannot hold it say why (measured limits), and the MJCF, which
-    MuJoCo's XML reader could not load (496 nested bodies at most), is not written."""
+    MuJoCo's XML reader could not load (496 nested bodies at most), is not written: a stated loss,
+    the build succeeds."""
     consumers_installed()
     n = 1000
     lines = ["robot: chain", "links:"]
@@ -202,13 +203,11 @@ def test_a_chain_of_1000_links(tmp_path):
     recipe = tmp_path / "chain.yaml"
     recipe.write_text("\n".join(lines) + "\n")
     proc = run_cli("build", recipe, "--out", tmp_path / "out", cwd=tmp_path)
-    assert proc.returncode == 1
-    problems = [line for line in proc.stderr.splitlines() if not line.startswith(("warning", "  "))]  # timings
-    assert problems == [
-        "chain.yaml:1002: links.l999: link 'l999' sits 1000 links deep: MuJoCo's XML reader stops at 496 nested "
-        "bodies, so it could not load the MJCF (a body per link); make the chain shorter",
-        "chain.yaml: chain: left out (refused by a consumer, or naming a file that is): chain/mjcf/chain.xml, "
-        "chain/mjcf/scene.xml, chain/report/report.html"]
+    assert proc.returncode == 0, proc.stderr  # a limit of the format, not of the robot (issue 33)
+    assert [line for line in proc.stderr.splitlines() if "not written" in line] == [
+        "chain.yaml:1: warning: chain: not written, a limit of the format: MJCF: link 'l999' sits 1000 links deep "
+        "and MuJoCo's XML reader stops at 496 nested bodies (a body per link); left out: chain/mjcf/chain.xml, "
+        "chain/mjcf/scene.xml, chain/report/report.html (list it under outputs: to make this an error)"]
     b = build_of(tmp_path / "out", "chain")
     assert b.urdf.is_file() and b.sdf.is_file() and not b.mjcf.exists() and not b.dir.joinpath("mjcf").exists()
     findings, summary = consumer_findings(b, ["Gazebo (URDF)", "Gazebo (model.sdf)", "Drake (URDF)",

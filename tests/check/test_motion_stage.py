@@ -90,6 +90,12 @@ def test_json_has_the_motion_results(ur5):
     motion = json.loads(proc.stdout)["motion"]["ur5"]
     assert set(motion["simulators"]) == {"mujoco", "pybullet", "drake"} and motion["wall"] > 0
     assert motion["joints"]["elbow_joint"]["poses"]["home"]["simulators"]["drake"]["rise_time"] > 0
+    # each stage timed (issue 33): they run at once, so the longest is at most the check's own time
+    data = json.loads(proc.stdout)
+    stages = {s["stage"]: s["seconds"] for s in data["stages"]}
+    assert list(stages) == ["check_urdf", "ign sdf -k", "mujoco", "lints", "equivalence", "consumers",
+                            "simulation", "self-collision", "motion"]
+    assert all(s > 0 for s in stages.values()) and max(stages.values()) <= data["seconds"]
 
 
 def test_kinova_gen3_before_its_fix_fails_on_joint_7():

@@ -303,3 +303,15 @@ def test_junit_has_no_passing_build_case_beside_the_build_s_warnings():
                                ([], [("robotkit.build", "robot 'r'"), ("robotkit.check_urdf", "r.urdf")])):
         suite = ET.fromstring(render(findings, "junit", "r.yaml", cases=cases)).find("testsuite")
         assert [(c.get("classname"), c.get("name")) for c in suite] == expected
+
+
+def test_json_gives_each_timed_stage_its_seconds():
+    from robotkit.check.findings import Finding
+    from robotkit.check.render import render
+
+    findings = [Finding("warning", "mass", "link 'a'", "light")]
+    cases = [("check_urdf", "r.urdf"), ("mass", "link 'a'")]
+    data = json.loads(render(findings, "json", "r", cases=cases, elapsed=2.5, timings={"lints": 1.23456}))
+    assert data["stages"] == [{"stage": "check_urdf", "verdict": "ok", "subjects": 1},
+                              {"stage": "lints", "verdict": "1 warning", "subjects": 1, "seconds": 1.235}]
+    assert data["seconds"] == 2.5

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import re
 import shutil
-import subprocess
 
+from robotkit.check import programs
 from robotkit.check.consumers import Missing, Refused, View
 from robotkit import urdfxml
 from robotkit.check.kinematics import LIBSDFORMAT_PRECISION, extension_parts, kept_fixed, read_sdf_text
@@ -15,7 +15,7 @@ from robotkit.check.kinematics import LIBSDFORMAT_PRECISION, extension_parts, ke
 def _parsed(path) -> str:
     if shutil.which("ign") is None:
         raise Missing("`ign` is not installed (apt install ignition-tools libsdformat-dev)")
-    proc = subprocess.run(["ign", "sdf", "-p", str(path)], capture_output=True, text=True)
+    proc = programs.libsdformat(path)  # run once for the check (the equivalence stage reads the URDF so too)
     errors = [line for line in (proc.stdout + proc.stderr).splitlines()
               if "Error" in line and "libignition-tools-backward" not in line]
     if proc.returncode != 0 or "<sdf" not in proc.stdout:
