@@ -17,6 +17,7 @@ import numpy as np
 
 from robotkit.importer.mjcf.frames import clean, origin, quat_matrix
 from robotkit.importer.names import valid_frame_name
+from robotkit.model.inertia_policy import MIN_MOMENT
 
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 WORLD = "world"
@@ -142,7 +143,8 @@ def _note(src, tree: Tree, name: str, t: int, j: int, anchor) -> None:
 
 
 def _point(mass: float) -> dict:
-    i = max(mass * 1e-6, 1e-14)  # MuJoCo's floor is 1e-15
+    # ten times the least moment the build writes into an MJCF (inertia_policy.MIN_MOMENT)
+    i = max(mass * 1e-6, 10 * MIN_MOMENT)
     return {"ixx": i, "iyy": i, "izz": i}
 
 
