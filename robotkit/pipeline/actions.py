@@ -424,6 +424,26 @@ def _keyed(value, out: str):
     return value
 
 
+def gl_backend() -> str:
+    """MuJoCo's GL backend (``$MUJOCO_GL``, robotkit's default osmesa) and whether its library
+    loads here: a report drawn with pictures is not reused where none could be drawn."""
+    import ctypes
+    import ctypes.util
+
+    backend = os.environ.get("MUJOCO_GL") or "osmesa"
+    library = {"osmesa": ("OSMesa", "8"), "egl": ("EGL", "1")}.get(backend)
+    if library is None:
+        return backend
+    name, version = library
+    for find in (lambda: f"lib{name}.so.{version}", lambda: ctypes.util.find_library(name) or f"lib{name}.so"):
+        try:  # the usual name, else a search
+            ctypes.CDLL(find())
+            return backend
+        except OSError:
+            continue
+    return f"{backend} without lib{name}"
+
+
 _DIGESTS: dict = {}  # (id, out) -> (object, digest): a robot shared by many tasks is hashed once per process
 
 
@@ -446,13 +466,14 @@ def cached_task(op: str, out: str, deps: list[str], outputs: dict, action: str, 
     ``args`` (paths below ``out`` relative to it) and the content of every file in ``deps``.
     ``outputs``: ``files`` (written by the action), ``tree`` (a folder written whole),
     ``pieces`` ((record, meshes folder): the collision pieces the record lists), ``unless`` (a
-    picture record: a report drawn without pictures is not stored).  A failed action stores
+    picture record: a report drawn without pictures is not stored), ``gl`` (the key holds
+    :func:`gl_backend`).  A failed action stores
     nothing.  Hits and misses write the same bytes: a rebuild from the cache is byte-identical."""
     out, deps = os.path.abspath(out), sorted(set(deps))  # file_dep built from a set comes in any order
     run = globals()[action]
     try:
         params = {"op": op, "version": RESULTS_VERSION, "code": code_digest(),
-                  "libraries": library_versions(RESULT_LIBRARIES), "gl": os.environ.get("MUJOCO_GL"),
+                  "libraries": library_versions(RESULT_LIBRARIES), "gl": gl_backend() if outputs.get("gl") else None,
                   "args": [_arg_key(a, out) for a in args], "deps": [_keyed(d, out) for d in deps]}
         inputs = [Path(d).read_bytes() for d in deps]
         cache = Cache(versions={})

@@ -442,7 +442,7 @@ def report_task(place: Place, drawn: list[dict], meshes: list[dict]) -> dict:
         "uptodate": [config_changed({"version": PICTURE_VERSION}), (actions.pictures_drawn, [record])],
         "task_dep": [t["name"] for t in meshes],
         "clean": True,
-    }, place, {"files": [record], "tree": str(built.pictures), "unless": record})
+    }, place, {"files": [record], "tree": str(built.pictures), "unless": record, "gl": True})
 
 
 def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:
