@@ -29,14 +29,11 @@ from robotkit.mesh.cache import Cache, Files, canonical_json, library_versions, 
 from robotkit.mesh.export import obj_bytes, stl_bytes
 from robotkit.mesh.inertia import hull_points, mesh_mass_properties
 from robotkit.mesh.io import load_mesh, read_vertices, volume_mesh
-from robotkit.model import gains, selfcollision
 from robotkit.model.robot import Inertial
 from robotkit.model.resolve import (compute_inertial, finalize, finalize_link_inertial, inertial_from_json,
                                     inertial_to_json)
-from robotkit.picture import report_build_dir
 from robotkit.pipeline.distributed import run as run_distributed  # on a Dask cluster when one is configured
 from robotkit.pipeline.publish import publish, staged_files
-from robotkit.world import build_world
 
 RESULTS_VERSION = 1  # of the task results cached by content (cached_task)
 RESULT_LIBRARIES = ("mujoco", "jinja2", "pillow", "numpy", "trimesh")  # beside the mesh cache's own
@@ -137,6 +134,8 @@ def _read_inertials(inertial_paths: dict[str, str]) -> dict:
 @_user_errors_fail
 def tune_drives(robot, inertial_paths: dict[str, str], target: str):
     """The actuators' gains and checks (robotkit.model.gains) from the links' inertials."""
+    from robotkit.model import gains  # here and below: off the import of every task process
+
     inertials = _read_inertials(inertial_paths)
     links = tuple(replace(link, inertial=inertials[link.name] if link.name in inertials
                           else compute_inertial(link, {})) for link in robot.links)
@@ -146,6 +145,8 @@ def tune_drives(robot, inertial_paths: dict[str, str], target: str):
 def with_drives(robot, path: str | None, matrix: str | None = None):
     """``robot`` with the tuner's gains of the record at ``path`` and the self-collision matrix of
     the record at ``matrix`` (None: as it is)."""
+    from robotkit.model import gains, selfcollision
+
     if matrix:
         with open(matrix, encoding="utf-8") as f:
             record = json.load(f)
@@ -164,6 +165,7 @@ def self_collision(robot, fact_paths: dict[str, str], meshes: str, target: str):
     only: every link gets the same placeholder, so a density edit does not resample), the mesh
     files it reads, the settings."""
     from robotkit.emit.mjcf import collision_meshes, render_mjcf
+    from robotkit.model import selfcollision
 
     placeholder = {link.name: Inertial(1.0, (0.0, 0.0, 0.0), (1e-3, 0.0, 0.0, 1e-3, 0.0, 1e-3)) for link in robot.links}
     full = replace(finalize(robot, read_facts(fact_paths), placeholder), self_collide=False, collision_matrix=None,
@@ -241,6 +243,8 @@ def _same_file(a: str, b: str) -> bool:
 @_user_errors_fail
 def world(map_yaml: str, out_dir: str, name: str, height: float, unknown_as_wall: bool, robot: dict | None = None):
     """One world from an occupancy map (robotkit.world), optionally with the robot placed in it."""
+    from robotkit.world import build_world
+
     build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall, robot=robot)
 
 
@@ -371,6 +375,8 @@ def publish_outputs(out_dir: str, robot: str, tasks: list[dict]):
 def picture_report(robot_dir: str, out_dir: str, record: str):
     """report.html and its pictures (robotkit.picture imports MuJoCo in the task).  Where MuJoCo
     cannot draw, the page is written without pictures and ``record`` says why (the build warns)."""
+    from robotkit.picture import report_build_dir
+
     shutil.rmtree(out_dir, ignore_errors=True)  # the staged report folder: no picture of an earlier build stays
     urdf = Path(os.path.relpath(robot_layout(robot_dir).urdf, out_dir)).as_posix()  # ../urdf/<robot>.urdf
     try:

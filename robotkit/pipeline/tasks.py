@@ -37,8 +37,6 @@ from robotkit.mesh.io import companions
 from robotkit.model.load import load_robots, mesh_locations
 from robotkit.model.robot import Robot
 from robotkit.paths import file_stem, out_join
-from robotkit.picture import VERSION as PICTURE_VERSION
-from robotkit.picture.page import TEMPLATE as PICTURE_TEMPLATE
 from robotkit.pipeline import actions
 from robotkit.pipeline.publish import STATE, stage_dir  # STATE: below the output folder, doit's database and JSON
 from robotkit.recipe.yamlsafe import MAX_YAML_BYTES, yaml_limits
@@ -430,6 +428,9 @@ def report_task(place: Place, drawn: list[dict], meshes: list[dict]) -> dict:
     report.json and every mesh file MuJoCo reads (the targets of ``drawn``: the meshes the MJCF
     draws and the collision pieces' records), after the ``meshes`` tasks (rendering imports stay
     in the action)."""
+    from robotkit.picture import VERSION as PICTURE_VERSION  # the check package: only with the report
+    from robotkit.picture.page import TEMPLATE as PICTURE_TEMPLATE
+
     built, record = layout.RobotLayout(place.root), place.record("pictures", "")
     inputs = [str(built.urdf), str(built.mjcf), str(built.report_json)]
     inputs += [target for t in drawn for target in t["targets"]]
