@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from robotkit.mesh.cache import Cache, CacheCorrupt, Files
+from robotkit.mesh.cache import Cache, Files
 from robotkit.pipeline.runner import build
 
 REPO = Path(__file__).resolve().parents[2]
@@ -58,12 +58,13 @@ def test_files_entry_round_trip_and_verification(tmp_path):
     payload = next(tmp_path.glob("v1/*/*.bin"))
     payload.write_bytes(payload.read_bytes()[:-1] + b"x")  # same size, other bytes: a corrupt entry
     assert cache.get(key) is None and not payload.exists()
-    with pytest.raises(CacheCorrupt):
-        Cache._decode(key, json.dumps({"format": 1, "key": key, "kind": "files", "meshes": [
-            {"file": "../escape", "size": 0}], "payload": {"file": f"{key}.x.bin", "size": 0,
-                                                           "sha256": "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"}
-        }).encode(), lambda file: b"")
-
+    # a manifest naming a file outside the output folder is refused, never written
+    empty = "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"
+    (cache.folder(key) / f"{key}.e3b0c44298fc1c14.bin").write_bytes(b"")
+    cache.manifest_path(key).write_text(json.dumps({
+        "format": 1, "key": key, "kind": "files", "meshes": [{"file": "../escape", "size": 0}],
+        "payload": {"file": f"{key}.e3b0c44298fc1c14.bin", "size": 0, "sha256": empty}}))
+    assert cache.get(key) is None and not cache.manifest_path(key).exists()
 
 def test_a_fresh_folder_is_built_from_the_cache_byte_for_byte(project):
     """The second build into another folder takes its report from the cache (an entry changed
