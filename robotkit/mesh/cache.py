@@ -38,7 +38,8 @@ waits, then hits).  Where ``fcntl`` is missing (Windows) both compute, and
 the atomic writes still keep the entry whole.
 
 Values are a ``trimesh.Trimesh``, a list of them, or a ``(mesh or list,
-info dict)`` tuple.  A miss returns the value rebuilt from the stored arrays
+info dict)`` tuple; or :class:`Files` (named byte strings: a task's output files, stored
+back to back in the payload, their names and sizes in the manifest).  A miss returns the value rebuilt from the stored arrays
 (``process=False``), so a miss and a later hit return identical arrays.
 Meshes are stored as geometry only (no visual data).
 """
@@ -46,6 +47,7 @@ Meshes are stored as geometry only (no visual data).
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import json
 import os
@@ -78,18 +80,24 @@ def default_root() -> Path:
     return base / "robotkit"
 
 
-def library_versions() -> dict:
-    """Installed versions of the libraries that shape cached results, plus robotkit's."""
+def library_versions(names: tuple[str, ...] = LIBRARIES) -> dict:
+    """Installed versions of the libraries that shape cached results, plus robotkit's (looked
+    up once per process: the installed packages do not change under a running build)."""
+    return dict(_versions(tuple(names)))
+
+
+@functools.lru_cache(maxsize=None)
+def _versions(names: tuple[str, ...]) -> tuple:
     from importlib import metadata
 
     out = {}
-    for name in LIBRARIES:
+    for name in names:
         try:
             out[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
             out[name] = "not installed"
     out["robotkit"] = robotkit.__version__
-    return out
+    return tuple(out.items())
 
 
 def mesh_digest(mesh) -> str:
@@ -129,6 +137,10 @@ def plain(value):
 
 _SHARED: set = set()
 """(shared cache URL, key) of the entries this process knows the shared copy holds."""
+
+
+class Files(dict):
+    """A cached value made of files: relative path (str) -> content (bytes)."""
 
 
 class CacheCorrupt(Exception):
@@ -286,6 +298,11 @@ class Cache:
 
     def put(self, key: str, value, *, op: str = "", params: dict | None = None):
         """Store ``value`` under ``key``; return it rebuilt from the stored arrays."""
+        if isinstance(value, Files):
+            names = sorted(value)
+            payload = b"".join(bytes(value[n]) for n in names)
+            shapes = [{"file": n, "size": len(value[n])} for n in names]
+            return self._store(key, "files", shapes, payload, None, op, params)
         meshes, kind, info = _unpack(value)
         blobs, shapes = [], []
         for m in meshes:
@@ -295,14 +312,16 @@ class Cache:
             F = np.ascontiguousarray(F.astype(ftype))
             blobs += [V.tobytes(), F.tobytes()]
             shapes.append({"vertices": int(V.shape[0]), "faces": int(F.shape[0]), "faces_dtype": ftype})
-        payload = b"".join(blobs)
+        return self._store(key, kind, shapes, b"".join(blobs), info, op, params)
+
+    def _store(self, key: str, kind: str, shapes: list, payload: bytes, info, op: str, params: dict | None):
         digest = hashlib.sha256(payload).hexdigest()
         manifest = {
             "format": CACHE_FORMAT, "key": key, "op": op, "params": plain(params or {}),
             "versions": self.versions, "kind": kind, "meshes": shapes, "info": plain(info),
             "payload": {"file": f"{key}.{digest[:16]}.bin", "size": len(payload), "sha256": digest},
         }
-        rebuilt = _build(kind, _parse(payload, shapes), manifest["info"])
+        rebuilt = _value(kind, payload, shapes, manifest["info"])
         manifest_bytes = (json.dumps(manifest, sort_keys=True, indent=1) + "\n").encode()
         try:
             folder = self.folder(key)
@@ -357,7 +376,7 @@ class Cache:
             data = read_payload(pay["file"])
             if len(data) != pay["size"] or hashlib.sha256(data).hexdigest() != pay["sha256"]:
                 raise CacheCorrupt("payload size or checksum mismatch")
-            return _build(manifest["kind"], _parse(data, manifest["meshes"]), manifest.get("info"))
+            return _value(manifest["kind"], data, manifest["meshes"], manifest.get("info"))
         except CacheCorrupt:
             raise
         except (OSError, ValueError, KeyError, TypeError, AttributeError, UnicodeDecodeError) as exc:
@@ -402,6 +421,22 @@ def _input_digest(item) -> str:
     if hasattr(item, "vertices") and hasattr(item, "faces"):
         return "mesh:" + mesh_digest(item)
     raise TypeError(f"cache inputs must be bytes, str or meshes, not {type(item).__name__}")
+
+
+def _value(kind: str, payload: bytes, shapes: list, info):
+    """An entry's value from its payload and the shapes its manifest lists."""
+    if kind != "files":
+        return _build(kind, _parse(payload, shapes), info)
+    out, at = Files(), 0
+    for s in shapes:
+        name, size = s["file"], int(s["size"])
+        if not isinstance(name, str) or name.startswith("/") or ".." in name.split("/") or not 0 <= size <= len(payload) - at:
+            raise CacheCorrupt("bad file in a files entry")
+        out[name] = payload[at:at + size]
+        at += size
+    if at != len(payload):
+        raise CacheCorrupt("payload longer than its manifest")
+    return out
 
 
 def _unpack(value):

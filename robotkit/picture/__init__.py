@@ -24,7 +24,7 @@ from robotkit.picture import page
 from robotkit.picture.plots import step_plots
 
 PAGE = PurePosixPath(REPORT_HTML).name  # report.html, in whichever folder the report is written
-VERSION = 1  # bump when the pictures or the page change for the same build
+VERSION = 2  # 2: joint strips without multisampling; bump when the pictures or the page change for the same build
 
 
 def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: float | None = None,

@@ -8,8 +8,10 @@ build turns those into exit status 2.
 
 from __future__ import annotations
 
+import dataclasses
 import filecmp
 import functools
+import hashlib
 import json
 import os
 import shutil
@@ -23,19 +25,18 @@ from robotkit.emit.registry import FORMATS
 from robotkit.emit.layout import robot_layout
 from robotkit.errors import ConsumerError, Problem, RendererUnavailable, RobotkitError, display_path
 from robotkit.ioutil import write_if_changed
-from robotkit.mesh.cache import Cache, plain
+from robotkit.mesh.cache import Cache, Files, canonical_json, library_versions, plain
 from robotkit.mesh.export import obj_bytes, stl_bytes
 from robotkit.mesh.inertia import hull_points, mesh_mass_properties
 from robotkit.mesh.io import load_mesh, read_vertices, volume_mesh
-from robotkit.model import gains, selfcollision
 from robotkit.model.robot import Inertial
 from robotkit.model.resolve import (compute_inertial, finalize, finalize_link_inertial, inertial_from_json,
                                     inertial_to_json)
-from robotkit.picture import report_build_dir
 from robotkit.pipeline.distributed import run as run_distributed  # on a Dask cluster when one is configured
 from robotkit.pipeline.publish import publish, staged_files
-from robotkit.world import build_world
 
+RESULTS_VERSION = 1  # of the task results cached by content (cached_task)
+RESULT_LIBRARIES = ("mujoco", "jinja2", "pillow", "numpy", "trimesh")  # beside the mesh cache's own
 FACTS_VERSION = 4  # 3: sources relative to the recipe (no absolute or working-folder paths); 4: hull points
 DRIVES_VERSION = 1
 SELF_COLLISION_VERSION = 1
@@ -133,6 +134,8 @@ def _read_inertials(inertial_paths: dict[str, str]) -> dict:
 @_user_errors_fail
 def tune_drives(robot, inertial_paths: dict[str, str], target: str):
     """The actuators' gains and checks (robotkit.model.gains) from the links' inertials."""
+    from robotkit.model import gains  # here and below: off the import of every task process
+
     inertials = _read_inertials(inertial_paths)
     links = tuple(replace(link, inertial=inertials[link.name] if link.name in inertials
                           else compute_inertial(link, {})) for link in robot.links)
@@ -142,6 +145,8 @@ def tune_drives(robot, inertial_paths: dict[str, str], target: str):
 def with_drives(robot, path: str | None, matrix: str | None = None):
     """``robot`` with the tuner's gains of the record at ``path`` and the self-collision matrix of
     the record at ``matrix`` (None: as it is)."""
+    from robotkit.model import gains, selfcollision
+
     if matrix:
         with open(matrix, encoding="utf-8") as f:
             record = json.load(f)
@@ -160,6 +165,7 @@ def self_collision(robot, fact_paths: dict[str, str], meshes: str, target: str):
     only: every link gets the same placeholder, so a density edit does not resample), the mesh
     files it reads, the settings."""
     from robotkit.emit.mjcf import collision_meshes, render_mjcf
+    from robotkit.model import selfcollision
 
     placeholder = {link.name: Inertial(1.0, (0.0, 0.0, 0.0), (1e-3, 0.0, 0.0, 1e-3, 0.0, 1e-3)) for link in robot.links}
     full = replace(finalize(robot, read_facts(fact_paths), placeholder), self_collide=False, collision_matrix=None,
@@ -237,6 +243,8 @@ def _same_file(a: str, b: str) -> bool:
 @_user_errors_fail
 def world(map_yaml: str, out_dir: str, name: str, height: float, unknown_as_wall: bool, robot: dict | None = None):
     """One world from an occupancy map (robotkit.world), optionally with the robot placed in it."""
+    from robotkit.world import build_world
+
     build_world(map_yaml, out_dir, name=name, height=height, unknown_as_wall=unknown_as_wall, robot=robot)
 
 
@@ -367,6 +375,8 @@ def publish_outputs(out_dir: str, robot: str, tasks: list[dict]):
 def picture_report(robot_dir: str, out_dir: str, record: str):
     """report.html and its pictures (robotkit.picture imports MuJoCo in the task).  Where MuJoCo
     cannot draw, the page is written without pictures and ``record`` says why (the build warns)."""
+    from robotkit.picture import report_build_dir
+
     shutil.rmtree(out_dir, ignore_errors=True)  # the staged report folder: no picture of an earlier build stays
     urdf = Path(os.path.relpath(robot_layout(robot_dir).urdf, out_dir)).as_posix()  # ../urdf/<robot>.urdf
     try:
@@ -387,3 +397,153 @@ def pictures_drawn(record: str) -> bool:
             return not json.load(f).get("no_pictures")
     except (OSError, ValueError, AttributeError):
         return True
+
+
+# --- task results cached by content -----------------------------------------------------------
+
+@functools.lru_cache(maxsize=None)
+def code_digest() -> str:
+    """sha256 of robotkit's own files (code, presets, templates shipped in the package): a result
+    cached by an earlier robotkit is never reused by another."""
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts):
+        h.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def _keyed(value, out: str):
+    """``value`` as plain JSON for a cache key: paths below the output folder ``out`` relative to
+    it (a fresh output folder hits), dataclasses as dicts, sets sorted."""
+    if isinstance(value, os.PathLike):
+        value = os.fspath(value)
+    if isinstance(value, str):
+        return "<out>" + value[len(out):] if value == out or value.startswith(out + os.sep) else value
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _keyed(getattr(value, f.name), out) for f in dataclasses.fields(value)}
+    if isinstance(value, dict):
+        return {str(k): _keyed(v, out) for k, v in value.items()}
+    if isinstance(value, (set, frozenset)):
+        return sorted((_keyed(v, out) for v in value), key=repr)
+    if isinstance(value, (list, tuple)):
+        return [_keyed(v, out) for v in value]
+    return value
+
+
+def gl_backend() -> str:
+    """MuJoCo's GL backend (``$MUJOCO_GL``, robotkit's default osmesa) and whether its library
+    loads here: a report drawn with pictures is not reused where none could be drawn."""
+    import ctypes
+    import ctypes.util
+
+    backend = os.environ.get("MUJOCO_GL") or "osmesa"
+    library = {"osmesa": ("OSMesa", "8"), "egl": ("EGL", "1")}.get(backend)
+    if library is None:
+        return backend
+    name, version = library
+    for find in (lambda: f"lib{name}.so.{version}", lambda: ctypes.util.find_library(name) or f"lib{name}.so"):
+        try:  # the usual name, else a search
+            ctypes.CDLL(find())
+            return backend
+        except OSError:
+            continue
+    return f"{backend} without lib{name}"
+
+
+_DIGESTS: dict = {}  # (id, out) -> (object, digest): a robot shared by many tasks is hashed once per process
+
+
+def _arg_key(value, out: str):
+    """One action argument for a cache key: a dataclass (a robot, a link) by the digest of its
+    plain JSON, computed once per object and process; anything else as :func:`_keyed`."""
+    if not dataclasses.is_dataclass(value) or isinstance(value, type):
+        return _keyed(value, out)
+    hit = _DIGESTS.get((id(value), out))
+    if hit is None or hit[0] is not value:
+        digest = hashlib.sha256(canonical_json(_keyed(value, out)).encode()).hexdigest()
+        hit = _DIGESTS[(id(value), out)] = (value, digest)
+    return {type(value).__name__: hit[1]}
+
+
+def cached_task(op: str, out: str, deps: list[str], outputs: dict, action: str, args: list):
+    """Run the action ``action`` (a name in this module) on ``args`` unless its output files are
+    in the cache (robotkit.mesh.cache.Cache, kind Files): the key is ``op``, robotkit's code
+    (so the versions in the tasks' ``config_changed`` too), the libraries' versions, $MUJOCO_GL,
+    ``args`` (paths below ``out`` relative to it) and the content of every file in ``deps``.
+    ``outputs``: ``files`` (written by the action), ``tree`` (a folder written whole),
+    ``pieces`` ((record, meshes folder): the collision pieces the record lists), ``unless`` (a
+    picture record: a report drawn without pictures is not stored), ``gl`` (the key holds
+    :func:`gl_backend`).  A failed action stores
+    nothing.  Hits and misses write the same bytes: a rebuild from the cache is byte-identical."""
+    out, deps = os.path.abspath(out), sorted(set(deps))  # file_dep built from a set comes in any order
+    run = globals()[action]
+    try:
+        params = {"op": op, "version": RESULTS_VERSION, "code": code_digest(),
+                  "libraries": library_versions(RESULT_LIBRARIES), "gl": gl_backend() if outputs.get("gl") else None,
+                  "args": [_arg_key(a, out) for a in args], "deps": [_keyed(d, out) for d in deps]}
+        inputs = [Path(d).read_bytes() for d in deps]
+        cache = Cache(versions={})
+        key = cache.key(f"task/{op}", params, inputs)
+    except (OSError, TypeError, ValueError):  # a dependency missing, or args that are no key: just run it
+        return run(*args)
+    files = cache.get(key)
+    if isinstance(files, Files) and _restore(files, out, outputs):
+        return None
+    failed = run(*args)
+    if failed is not None:
+        return failed
+    files = _collect(out, outputs, Files)
+    if files is not None:
+        cache.put(key, files, op=f"task/{op}", params={"op": op})
+    return None
+
+
+def _output_paths(outputs: dict) -> list[str] | None:
+    """Every file an action wrote (absolute), or None when its result is not to be cached."""
+    paths = list(outputs.get("files", []))
+    unless = outputs.get("unless")  # a record whose "no_pictures" says the result is provisional
+    if unless and not pictures_drawn(unless):
+        return None
+    tree = outputs.get("tree")
+    if tree:
+        for root, _dirs, names in os.walk(tree):
+            paths += [os.path.join(root, n) for n in names]
+    if outputs.get("pieces"):
+        record, meshes = outputs["pieces"]
+        try:
+            with open(record, encoding="utf-8") as f:
+                pieces = json.load(f).get("pieces", [])
+        except (OSError, ValueError, AttributeError):
+            return None
+        paths += [os.path.join(meshes, p["file"]) for p in pieces if isinstance(p, dict) and p.get("file")]
+    return paths
+
+
+def _collect(out: str, outputs: dict, files_type):
+    """The files an action wrote, relative to ``out`` (None: nothing to store)."""
+    paths = _output_paths(outputs)
+    if paths is None:
+        return None
+    files = files_type()
+    for path in paths:
+        rel = os.path.relpath(path, out)
+        if rel.startswith(".."):
+            return None
+        try:
+            files[Path(rel).as_posix()] = Path(path).read_bytes()
+        except OSError:
+            return None
+    return files
+
+
+def _restore(files: dict, out: str, outputs: dict) -> bool:
+    """Write a cached result's files below ``out``; False (nothing written) when it lacks one
+    the task promises."""
+    rel = {Path(os.path.relpath(p, out)).as_posix() for p in outputs.get("files", [])}
+    if not rel <= set(files):
+        return False
+    if outputs.get("tree"):
+        shutil.rmtree(outputs["tree"], ignore_errors=True)  # no file of an earlier result stays
+    for name, data in sorted(files.items()):
+        write_if_changed(os.path.join(out, *name.split("/")), data)
+    return True

@@ -37,8 +37,6 @@ from robotkit.mesh.io import companions
 from robotkit.model.load import load_robots, mesh_locations
 from robotkit.model.robot import Robot
 from robotkit.paths import file_stem, out_join
-from robotkit.picture import VERSION as PICTURE_VERSION
-from robotkit.picture.page import TEMPLATE as PICTURE_TEMPLATE
 from robotkit.pipeline import actions
 from robotkit.pipeline.publish import STATE, stage_dir  # STATE: below the output folder, doit's database and JSON
 from robotkit.recipe.yamlsafe import MAX_YAML_BYTES, yaml_limits
@@ -60,6 +58,11 @@ class Place:
         out_dir = Path(out_dir).absolute()
         return cls(robot, out_join(stage_dir(out_dir), robot.name, key="robot"), out_dir / STATE / robot.name,
                    where or {})
+
+    @property
+    def out_dir(self) -> Path:
+        """The output folder (``state`` is ``OUT/.robotkit/<robot>``)."""
+        return self.state.parent.parent
 
     def record(self, kind: str, key: str) -> str:
         return str(self.state / layout.RECORDS[kind].format(key=key))
@@ -100,6 +103,18 @@ class Place:
                 if link.inertial_spec.mode in ("density", "mass", "estimate")}
 
 
+def cached(task: dict, place: Place, outputs: dict | None = None) -> dict:
+    """``task`` with its action run through :func:`robotkit.pipeline.actions.cached_task`: its
+    output files come from the cache when its inputs (the action's arguments, robotkit's code,
+    the content of its ``file_dep``: what its ``config_changed`` values derive from) were built
+    before, in any output folder.  ``outputs``: what the action writes (default: its targets)."""
+    (fn, args), = task["actions"]
+    task["actions"] = [(actions.cached_task, [task["name"].split(":", 1)[1].split(":")[0], str(place.out_dir),
+                                              list(task["file_dep"]), outputs or {"files": list(task["targets"])},
+                                              fn.__name__, list(args)])]
+    return task
+
+
 def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None,
                 report: bool = False, outputs: Outputs | None = None) -> list[dict]:
     """The task dicts that build ``robot`` into ``out_dir/<robot>/``.
@@ -129,7 +144,7 @@ def mesh_tasks(place: Place) -> list[dict]:
     robot, tasks = place.robot, []
     for key, mesh in robot.meshes().items():
         target = place.record("mesh", key)
-        tasks.append({
+        tasks.append(cached({
             "name": f"{robot.name}:mesh:{key}",
             "doc": f"mass properties of {os.path.basename(mesh.source)}",
             "actions": [(actions.mesh_facts, [mesh.source, list(mesh.scale), mesh.open_mesh,
@@ -139,7 +154,7 @@ def mesh_tasks(place: Place) -> list[dict]:
             "uptodate": [config_changed({"scale": list(mesh.scale), "policy": mesh.open_mesh,
                                          "version": actions.FACTS_VERSION})],
             "clean": True,
-        })
+        }, place))
     return tasks
 
 
@@ -150,7 +165,7 @@ def collision_tasks(place: Place) -> list[dict]:
         m = shape.mesh
         target = place.record("collision", key)
         stem = os.path.splitext(m.file_name)[0]
-        tasks.append({
+        tasks.append(cached({
             "name": f"{robot.name}:collision:{key[len('proxy-'):]}",
             "doc": f"{shape.strategy.kind} collision of {os.path.basename(m.source)}",
             "actions": [(actions.collision_proxy, [m.source, list(m.scale), shape.strategy.params(), stem,
@@ -161,7 +176,7 @@ def collision_tasks(place: Place) -> list[dict]:
             "uptodate": [config_changed({"scale": list(m.scale), "strategy": shape.strategy.params(),
                                          "version": actions.FACTS_VERSION})],
             "clean": True,
-        })
+        }, place, {"files": [target], "pieces": (target, place.out(layout.MESHES))}))
     return tasks
 
 
@@ -181,7 +196,7 @@ def visual_tasks(place: Place) -> list[dict]:
     for rel, mesh in sorted(processed.items()):
         target = place.mesh(rel)
         visual_report = place.record("visual", mesh.key)
-        tasks.append({
+        tasks.append(cached({
             "name": f"{robot.name}:visual:{mesh.file_name}",
             "doc": f"processed visual mesh {mesh.file_name}",
             "actions": [(actions.process_visual, [mesh.source, list(mesh.scale), list(mesh.decimate), mesh.repair,
@@ -191,7 +206,7 @@ def visual_tasks(place: Place) -> list[dict]:
             "uptodate": [config_changed({"scale": list(mesh.scale), "decimate": list(mesh.decimate),
                                          "repair": mesh.repair, "version": actions.FACTS_VERSION})],
             "clean": True,
-        })
+        }, place))
     return tasks
 
 
@@ -248,7 +263,7 @@ def convert_tasks(place: Place) -> list[dict]:
     for rel, (source, scale) in conversions(robot).items():
         target = place.mesh(rel)
         checked = [facts[k] for k, m in robot.meshes().items() if m.source == source]
-        tasks.append({
+        tasks.append(cached({
             "name": f"{robot.name}:convert:{rel}",
             "actions": [(actions.convert_mesh, [source, target, list(scale)])],
             "file_dep": [source, *checked],
@@ -256,7 +271,7 @@ def convert_tasks(place: Place) -> list[dict]:
             "uptodate": [config_changed({"version": actions.FACTS_VERSION, "scale": list(scale)})],
             "clean": True,
             "doc": f"{layout.MESHES}/{rel}",
-        })
+        }, place))
     return tasks
 
 
@@ -269,7 +284,7 @@ def inertial_tasks(place: Place) -> list[dict]:
         keys = sorted({g.shape.mesh.key for g in link.source_geoms() if g.shape.mesh is not None})
         deps = {k: facts[k] for k in keys}
         target = place.inertials[link.name]
-        tasks.append({
+        tasks.append(cached({
             "name": f"{robot.name}:inertial:{link.name}",
             "doc": f"inertial of link {link.name}",
             "actions": [(actions.link_inertial, [link, deps, target])],
@@ -277,7 +292,7 @@ def inertial_tasks(place: Place) -> list[dict]:
             "targets": [target],
             "uptodate": [config_changed({"link": asdict(link), "version": actions.FACTS_VERSION})],
             "clean": True,
-        })
+        }, place))
     return tasks
 
 
@@ -288,7 +303,7 @@ def drive_tasks(place: Place) -> list[dict]:
     if place.drives is None:
         return []
     structure = {k: v for k, v in robot.to_dict().items() if k not in ("worlds", "sensors", "metadata")}
-    return [{
+    return [cached({
         "name": f"{robot.name}:drives",
         "doc": "actuator gains and checks",
         "actions": [(actions.tune_drives, [robot, place.inertials, place.drives])],
@@ -296,7 +311,7 @@ def drive_tasks(place: Place) -> list[dict]:
         "targets": [place.drives],
         "uptodate": [config_changed({"robot": structure, "version": actions.DRIVES_VERSION})],
         "clean": True,
-    }]
+    }, place)]
 
 
 def self_collision_tasks(place: Place, written: list[str]) -> list[dict]:
@@ -309,7 +324,7 @@ def self_collision_tasks(place: Place, written: list[str]) -> list[dict]:
     geometry = {k: v for k, v in robot.to_dict().items() if k in ("name", "joints", "base", "poses", "self_collision")}
     geometry["links"] = [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
                          for link in robot.to_dict()["links"]]
-    return [{
+    return [cached({
         "name": f"{robot.name}:self-collision",
         "doc": "self-collision matrix",
         "actions": [(actions.self_collision, [robot, facts, place.out(layout.MESHES), target])],
@@ -319,7 +334,7 @@ def self_collision_tasks(place: Place, written: list[str]) -> list[dict]:
         "uptodate": [config_changed({"robot": geometry, "version": actions.SELF_COLLISION_VERSION})],
         "task_dep": [f"{robot.name}:mesh:{k}" for k in place.facts],
         "clean": True,
-    }]
+    }, place)]
 
 
 class Reading(NamedTuple):
@@ -383,7 +398,7 @@ def output_task(place: Place, fmt: Format, reading: Reading, written: list[str])
     how = {"raw": reading.raw, "facts": reading.with_facts, "drives": reading.drives, "matrix": reading.matrix,
            "meshes": place.out(layout.MESHES) if fmt.points is not None else None}
     options = {**fmt.options, **{k: True for k, v in how.items() if v}}  # hashed with the robot's values
-    return {
+    return cached({
         "name": f"{robot.name}:{fmt.name}",
         "doc": layout.output_path(fmt.path, robot.name, robot.ros),
         "actions": [(actions.emit, [fmt.name, reading.robot, reading.facts, reading.inertials, target, how,
@@ -396,7 +411,7 @@ def output_task(place: Place, fmt: Format, reading: Reading, written: list[str])
         "task_dep": [f"{robot.name}:mesh:{k}" for k in place.facts]
         + [f"{robot.name}:{n}" for n in fmt.needs if FORMATS[n].wanted(robot)],
         "clean": True,
-    }
+    }, place)
 
 
 def template_files(names) -> list[str]:
@@ -416,10 +431,13 @@ def report_task(place: Place, drawn: list[dict], meshes: list[dict]) -> dict:
     report.json and every mesh file MuJoCo reads (the targets of ``drawn``: the meshes the MJCF
     draws and the collision pieces' records), after the ``meshes`` tasks (rendering imports stay
     in the action)."""
+    from robotkit.picture import VERSION as PICTURE_VERSION  # the check package: only with the report
+    from robotkit.picture.page import TEMPLATE as PICTURE_TEMPLATE
+
     built, record = layout.RobotLayout(place.root), place.record("pictures", "")
     inputs = [str(built.urdf), str(built.mjcf), str(built.report_json)]
     inputs += [target for t in drawn for target in t["targets"]]
-    return {
+    return cached({
         "name": f"{place.robot.name}:report-html",
         "doc": layout.REPORT_HTML,
         "actions": [(actions.picture_report, [str(place.root), str(built.pictures), record])],
@@ -428,7 +446,7 @@ def report_task(place: Place, drawn: list[dict], meshes: list[dict]) -> dict:
         "uptodate": [config_changed({"version": PICTURE_VERSION}), (actions.pictures_drawn, [record])],
         "task_dep": [t["name"] for t in meshes],
         "clean": True,
-    }
+    }, place, {"files": [record], "tree": str(built.pictures), "unless": record, "gl": True})
 
 
 def world_tasks(robot: Robot, out_dir: str | os.PathLike) -> list[dict]:

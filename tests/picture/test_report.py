@@ -14,6 +14,7 @@ from markupsafe import escape
 from PIL import Image
 
 from conftest import GOLDEN, RECIPES, assert_golden, run_cli, write_recipe
+from robotkit.picture.render import STRIP_SIZE
 from robotkit.pipeline.runner import build
 
 CHROMIUM_ARGS = ["--no-sandbox", "--headless", "--disable-gpu", "--disable-background-networking",
@@ -194,8 +195,8 @@ def test_flipped_axis_shows_in_the_limit_pictures(arms):
     """q -> -q: the flipped joint at its lower limit is the healthy one at its upper limit."""
     def panels(name):
         strip = pixels(arms / name / "report" / "joint-shoulder.png")
-        w = 320  # lower, zero, +0.6 rad, upper
-        assert strip.shape == (240 + 28, 4 * w, 3)  # the labels on a band above the pictures
+        w, h = STRIP_SIZE  # lower, zero, +0.6 rad, upper
+        assert strip.shape == (h + 28, 4 * w, 3)  # the labels on a band above the pictures
         return [strip[28:, i * w:(i + 1) * w] for i in (0, 1, 3)]
 
     def differ(a, b):  # share of pixels that differ
@@ -252,7 +253,8 @@ def test_joints_without_limits_or_whole_turns_are_drawn_at_labelled_samples(tmp_
 
     for joint in ("spin", "turn"):  # four poses, no two alike
         strip = pixels(report / f"joint-{joint}.png")[28:]
-        panels = [strip[:, i * 320:(i + 1) * 320] for i in range(4)]
+        w = STRIP_SIZE[0]
+        panels = [strip[:, i * w:(i + 1) * w] for i in range(4)]
         assert min(differ(a, b) for i, a in enumerate(panels) for b in panels[i + 1:]) > 0.002, joint
 
 

@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from conftest import RECIPES
+from robotkit.ioutil import environ
 
 MISSING = '''\
 import ctypes
@@ -98,3 +99,22 @@ def test_report_of_an_mjcf_says_which_library_the_backend_lacks(tmp_path, gl, li
     done = run_without_osmesa(tmp_path, "report", "box.xml", library=library, gl=gl)
     assert (done.returncode, done.stdout, done.stderr) == (2, "", why + "\n")
     assert not (tmp_path / "box-report").exists()
+
+
+@pytest.mark.slow
+def test_a_cached_report_with_pictures_is_not_reused_where_none_can_be_drawn(tmp_path):
+    """The report is cached by content (robotkit.pipeline.actions.cached_task); a machine that
+    cannot draw does not take the pictures another build drew into the same cache: it writes
+    the page without them and warns, as without a cache."""
+    shutil.copytree(RECIPES, tmp_path / "recipes", ignore=shutil.ignore_patterns("*.yaml"))
+    shutil.copy(RECIPES / "turret_bot.yaml", tmp_path / "recipes")
+    env = {**os.environ, "ROBOTKIT_CACHE": str(tmp_path / "cache")}
+    drawn = subprocess.run([sys.executable, "-m", "robotkit", "build", "recipes/turret_bot.yaml", "--out", "drawn"],
+                           capture_output=True, text=True, cwd=tmp_path, env=env)
+    assert drawn.returncode == 0, drawn.stderr
+    assert list((tmp_path / "drawn" / "turret_bot" / "report").glob("*.png"))
+    with environ({"ROBOTKIT_CACHE": str(tmp_path / "cache")}):  # run_without_osmesa passes this process's
+        built = run_without_osmesa(tmp_path, "build", "recipes/turret_bot.yaml", "--out", "out")
+    assert built.returncode == 0, built.stderr
+    assert f"recipes/turret_bot.yaml:6: robot: warning: turret_bot: report/report.html: {WHY}" in built.stderr
+    assert not list((tmp_path / "out" / "turret_bot" / "report").glob("*.png"))
