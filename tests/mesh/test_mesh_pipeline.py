@@ -366,11 +366,14 @@ def test_meshlib_runs_on_the_calling_thread_alone():
 def test_meshlib_fast_stage_where_the_first_pass_gives_up(monkeypatch):
     """Without the first pass, MeshLib goes to 3 times the target keeping vertices where they
     are, then to the target with its optimal positions: the target is reached, a closed mesh
-    stays closed, and the distance stays near MeshLib's own (measured: 0.8-1.2 of it)."""
+    stays closed, and the distance stays near MeshLib's own (measured: 0.8-1.2 of it); here
+    tested with the quality check (issue 33) off."""
     import robotkit.mesh.decimate as decimate_module
     from robotkit.mesh.io import load_mesh
 
     monkeypatch.setattr(decimate_module, "PREPASS_GIVE_UP", 0.0)  # give up after any defect
+    monkeypatch.setattr(decimate_module, "FAST_STAGE", 3.0)
+    monkeypatch.setattr(decimate_module, "GUARANTEE_FACTOR", float("inf"))
     tire = load_mesh(str(REPO / "recipes/meshes/turtlebot3/left_tire.stl"))
     out, report = decimate(tire, target_faces=2167, samples=2000)
     assert report["prepass"] is None and report["prepass_rounds"] == 1 and report["fast_stage"] == 3.0
