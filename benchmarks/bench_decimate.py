@@ -266,7 +266,7 @@ def main() -> int:
           f"samples each way; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"{'mesh':44} {'faces':>7} {'target':>6} C | " + " | ".join(f"{t[:10]:>27}" for t in tools))
     for path in visual_meshes():
-        if args.only not in path:
+        if not any(part in path for part in args.only.split(",")):  # comma-separated substrings
             continue
         from robotkit.mesh.io import load_mesh
 

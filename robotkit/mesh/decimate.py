@@ -32,6 +32,15 @@ holes: a mesh that lacks triangles of its tessellation (the KUKA iiwa's
 the target the holes of three edges are filled (:func:`_fill_missing_triangles`)
 and the decimation runs again.
 
+The shortcuts (the first pass, the fast stage) are checked (issue 33, :func:`_guarantee`):
+the input's vertices (about ``CHECK_POINTS`` of them) are measured against the result, exactly,
+and where the input is further from it than ``GUARANTEE_FACTOR`` times the error MeshLib's last
+stage reports, MeshLib decimates the input alone and its result is kept; the report's
+``check`` and ``fallback`` say so.  On CAD meshes the first pass had dropped thin parts (the
+Kinova Gen3's links at a tenth of their faces: 7-8 times MeshLib's distance).  The check is a
+heuristic, not a proof: MeshLib alone's distance is not known without running it (see
+docs/performance.md, *Issue 33*).
+
 MeshLib builds a half-edge mesh: faces it cannot place (repeated or degenerate
 faces) are dropped on the way in, and the result is counted from what it
 returns.  It works in float32, so the mesh is moved to its bounding-box centre
