@@ -23,8 +23,11 @@ work) count in another tool's CPU time:
 Prints the load average before and after, one row per mesh (faces, wall ms, Hausdorff) and
 a summary: targets reached, closed meshes kept closed, robotkit's Hausdorff over plain
 meshlib's, every tool's wall and CPU time over robotkit's (median and over the sum of
-times).  ``python benchmarks/bench_decimate.py [--keep 0.1] [--repeat 3]
-[--samples 5000] [--json out.json] [--only SUBSTRING]``.  Needs ``pip install pymeshlab
+times), how often robotkit's quality check sent it to MeshLib alone (issue 33), and robotkit's
+Hausdorff over pymeshlab's.  ``python benchmarks/bench_decimate.py [--keep 0.1 | --faces 3000]
+[--repeat 3] [--samples 5000] [--json out.json] [--only SUBSTRING,SUBSTRING]
+[--pymeshlab-python PY]`` (``PY``: an interpreter with pymeshlab, where this one has none).
+The meshes of ``tests/data/meshes`` (the Panda's link0 and link4) are included.  Needs ``pip install pymeshlab
 meshoptimizer fast-simplification`` (benchmark only).
 """
 
