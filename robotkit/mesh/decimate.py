@@ -32,6 +32,15 @@ holes: a mesh that lacks triangles of its tessellation (the KUKA iiwa's
 the target the holes of three edges are filled (:func:`_fill_missing_triangles`)
 and the decimation runs again.
 
+The shortcuts (the first pass, the fast stage) are checked (issue 33, :func:`_guarantee`):
+the input's vertices (about ``CHECK_POINTS`` of them) are measured against the result, exactly,
+and where the input is further from it than ``GUARANTEE_FACTOR`` times the error MeshLib's last
+stage reports, MeshLib decimates the input alone and its result is kept; the report's
+``check`` and ``fallback`` say so.  On CAD meshes the first pass had dropped thin parts (the
+Kinova Gen3's links at a tenth of their faces: 7-8 times MeshLib's distance).  The check is a
+heuristic, not a proof: MeshLib alone's distance is not known without running it (see
+docs/performance.md, *Issue 33*).
+
 MeshLib builds a half-edge mesh: faces it cannot place (repeated or degenerate
 faces) are dropped on the way in, and the result is counted from what it
 returns.  It works in float32, so the mesh is moved to its bounding-box centre
@@ -83,6 +92,10 @@ PREPASS_RINGS = 1
 PREPASS_LIMIT = 0.7  # ... when that removes at least 30 % of the faces
 PREPASS_GIVE_UP = 0.05  # no more runs when more faces than this fraction of the target are defective
 FAST_STAGE = 3.0  # without the first pass, MeshLib goes to this many times the target without moving vertices
+GUARANTEE_FACTOR = 0.75  # a shortcut's result is replaced by MeshLib alone's where the input is further from it
+# than this many times the error MeshLib's last stage reports (see :func:`_guarantee`)
+CHECK_POINTS = 1000  # faces of the input whose vertices are measured against the result (an even stride)
+FACE_TOLERANCE = 0.02  # a result is on target within this fraction of it
 PREPASS_ERROR = 1e-2  # meshoptimizer's error bound, relative to the mesh's extent
 
 
@@ -99,7 +112,8 @@ def _version(name: str) -> str:
 def library() -> dict:
     """The decimation libraries and their versions, for cache keys and reports."""
     return {"library": LIBRARY, "library_version": _version(LIBRARY),
-            "prepass_library": PREPASS_LIBRARY, "prepass_library_version": _version(PREPASS_LIBRARY)}
+            "prepass_library": PREPASS_LIBRARY, "prepass_library_version": _version(PREPASS_LIBRARY),
+            "guarantee": f"meshlib-alone-above-{GUARANTEE_FACTOR}-error"}
 
 
 def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, *,
@@ -122,7 +136,9 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     ``volume_change`` (relative, ``after/before - 1``; None unless both are
     closed volumes), ``is_volume_before``, ``is_volume_after``, and
     ``distance``: :func:`surface_distance` between the two surfaces (None when
-    ``samples`` is 0).
+    ``samples`` is 0).  ``check`` and ``fallback``: the quality check of a shortcut's result,
+    and whether MeshLib alone ran because it failed (:func:`_guarantee`; ``check`` is None
+    when MeshLib alone was the path taken at once).
     """
     n = int(len(mesh.faces))
     if (target_faces is None) == (ratio is None):
@@ -147,7 +163,7 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     lo, hi = (V.min(axis=0), V.max(axis=0)) if len(V) else (np.zeros(3), np.zeros(3))
     centre = 0.5 * (lo + hi)
     vol_in = _closed_volume(V, F, census, centre)
-    details = {**_NO_PREPASS, "fast_stage": None, "holes_filled": 0}
+    details = {**_NO_PREPASS, "fast_stage": None, "holes_filled": 0, "check": None, "fallback": False}
     if target >= n:
         out = trimesh.Trimesh(V.copy(), F.copy(), process=False)
     else:
@@ -158,7 +174,9 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
             F = F[~degenerate]
             census = _edge_census(F, len(V))
         closed = vol_in is not None or census == CLOSED  # CLOSED and no volume: inside out
-        v, f, details = _decimate_core((V - centre) * k, F, target, closed, defective=census[0])
+        Vn = (V - centre) * k
+        v, f, details = _decimate_core(Vn, F, target, closed, defective=census[0])
+        v, f, details = _guarantee(Vn, F, v, f, details, target, closed, k)
         out = trimesh.Trimesh(v / k + centre, f, process=False)  # MeshLib packs: every vertex is used
     F_out = np.asarray(out.faces, dtype=np.int64)
     V_out = np.asarray(out.vertices, dtype=np.float64)
@@ -176,8 +194,68 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     return out, report
 
 
+def _guarantee(Vn: np.ndarray, F: np.ndarray, v: np.ndarray, f: np.ndarray, details: dict, target: int,
+               closed: bool, k: float) -> tuple[np.ndarray, np.ndarray, dict]:
+    """The quality check of a shortcut's result (``v``, ``f``: :func:`_decimate_core`'s, from the
+    normalised input ``Vn``, ``F``), and MeshLib alone where it fails: (vertices, faces, details
+    with ``check`` and ``fallback``), still normalised; ``k`` is the normalising scale.
+
+    The shortcuts (meshoptimizer's first pass, MeshLib's fast stage) are 2-4 times faster than
+    MeshLib alone but can take out detail MeshLib keeps (measured for issue 33: the Kinova Gen3's
+    links at 10 % of their faces came out at 7-8 times MeshLib's distance: meshoptimizer drops
+    thin parts within its error bound, and MeshLib's last stage, which only sees the pass's
+    result, cannot know).  So the result of a shortcut is measured against the input
+    (:func:`_lost_detail`: how far about ``CHECK_POINTS`` of the input's vertices are
+    from the result, exact), and compared with the largest error MeshLib's last stage reports
+    (``errorIntroduced``, a quadric error over the collapsed faces' planes).  Above
+    ``GUARANTEE_FACTOR`` times it (or an infinite error: a forced collapse), MeshLib alone runs
+    on the input and its result is kept, unless it misses the target by more than
+    ``FACE_TOLERANCE`` where the shortcut did not.  ``check``: ``distance``, ``error`` and
+    ``bound`` (metres) and ``kept`` (``shortcut`` or ``meshlib-alone``); None when no shortcut
+    was taken.  ``fallback``: whether MeshLib alone ran.
+    """
+    error = details.pop("error", None)
+    details = {**details, "fallback": False, "check": None}
+    if details["prepass"] is None and details["fast_stage"] is None:
+        return v, f, details  # MeshLib alone already
+    dist = _lost_detail(Vn, F, v, f)
+    bound = GUARANTEE_FACTOR * float(error) if error is not None else float("inf")
+    check = {"distance": dist / k, "error": float(error) / k if error is not None else None, "bound": bound / k,
+             "kept": "shortcut"}
+    if dist <= bound and error is not None and np.isfinite(error):  # an infinite error: a forced collapse
+        return v, f, {**details, "check": check}
+    va, fa, alone = _decimate_core(Vn, F, target, closed, shortcuts=False)
+    alone.pop("error", None)
+    if abs(len(fa) - target) > FACE_TOLERANCE * target >= abs(len(f) - target):  # only the shortcut on target
+        return v, f, {**details, "fallback": True, "check": check}
+    return va, fa, {**details, **alone, "fallback": True, "check": {**check, "kept": "meshlib-alone"}}
+
+
+def _lost_detail(Vn: np.ndarray, F: np.ndarray, v: np.ndarray, f: np.ndarray) -> float:
+    """The largest distance from a vertex of the input (``Vn``, ``F``; the vertices of every
+    ``len(F) / CHECK_POINTS``-th face, about ``CHECK_POINTS`` of them) to the result's surface
+    (``v``, ``f``), exact, by MeshLib's ``findMaxDistanceSqOneWay`` (an AABB tree of the result):
+    where the result lost a part of the input, the input's vertices there are far from it.
+
+    Measured on the UR5's visual meshes: 9-11 ms of CPU on a loaded machine for results of
+    1,300-3,000 faces, where the other direction (the result's vertices to the input, which
+    needs a tree of the input) cost as much as the decimation, and an upper bound from the faces
+    of the nearest centroids (scipy) was 3-10 times too large on CAD meshes, whose long thin
+    triangles have far centroids."""
+    import meshlib.mrmeshnumpy as mn
+    import meshlib.mrmeshpy as mm
+
+    _meshlib_single_threaded()
+    sub = np.asarray(F)[::max(1, len(F) // CHECK_POINTS)]
+    used, local = np.unique(sub, return_inverse=True)
+    probe = mn.meshFromFacesVerts(np.ascontiguousarray(local.reshape(-1, 3), dtype=np.int32),
+                                  np.ascontiguousarray(Vn[used], dtype=np.float32))
+    result = mn.meshFromFacesVerts(np.ascontiguousarray(f, dtype=np.int32), np.ascontiguousarray(v, dtype=np.float32))
+    return float(np.sqrt(mm.findMaxDistanceSqOneWay(mm.MeshPart(result), mm.MeshPart(probe))))
+
+
 def _decimate_core(V: np.ndarray, F: np.ndarray, target: int, closed: bool,
-                   defective: bool = True) -> tuple[np.ndarray, np.ndarray, dict]:
+                   defective: bool = True, shortcuts: bool = True) -> tuple[np.ndarray, np.ndarray, dict]:
     """Decimate (V, F), already normalised, to ``target`` faces: (float64 vertices, int64 faces, details).
 
     A meshoptimizer pass first (:func:`_prepass`; ``defective``: whether the input may have
@@ -187,13 +265,16 @@ def _decimate_core(V: np.ndarray, F: np.ndarray, target: int, closed: bool,
     same again on the input with those filled.  Details: ``prepass`` (the factor of the target
     the first pass went to, or None), ``prepass_rounds`` and ``prepass_locked`` (see
     :func:`_prepass`), ``fast_stage`` (the factor MeshLib's fast stage went to, or None) and
-    ``holes_filled``.
+    ``holes_filled``, ``error`` (the largest error MeshLib's last stage reports, in the
+    normalised units).  ``shortcuts`` false: MeshLib alone, neither the first pass nor the fast stage.
     """
     def run(Vf, F, defective):
-        first, details = _prepass(Vf, F, target, closed, defective)
-        fast = FAST_STAGE if details["prepass"] is None and FAST_STAGE * target < len(F) else None
-        v, f = _meshlib_decimate(Vf, first, target, fast_stage=fast)
-        return v, f, {**details, "fast_stage": fast}
+        first, details = _prepass(Vf, F, target, closed, defective) if shortcuts else (F, dict(_NO_PREPASS))
+        fast = (FAST_STAGE if shortcuts and FAST_STAGE and details["prepass"] is None
+                and FAST_STAGE * target < len(F) else None)
+        result: dict = {}
+        v, f = _meshlib_decimate(Vf, first, target, fast_stage=fast, result=result)
+        return v, f, {**details, "fast_stage": fast, "error": result["error"]}
 
     Vf = np.ascontiguousarray(V, dtype=np.float32)
     F = np.asarray(F)
@@ -448,9 +529,11 @@ def _meshlib_single_threaded() -> int:
 _TBB_LIMITS: list = []
 
 
-def _meshlib_decimate(V: np.ndarray, F: np.ndarray, target: int,
-                      fast_stage: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _meshlib_decimate(V: np.ndarray, F: np.ndarray, target: int, fast_stage: float | None = None,
+                      result: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
     """MeshLib's quadric decimation of (V, F) to ``target`` faces: (float64 vertices, int64 faces).
+    ``result``, a dict, receives ``error``: the largest error of the last stage's collapses as
+    MeshLib reports it (``errorIntroduced``, in the units of V; inf where it forced a collapse).
 
     With ``fast_stage``, MeshLib first goes to that many times the target without optimising
     vertex positions (each collapse keeps one of its two vertices, as meshoptimizer's do: half
@@ -479,7 +562,9 @@ def _meshlib_decimate(V: np.ndarray, F: np.ndarray, target: int,
     settings.maxDeletedFaces = max(int(m.topology.numValidFaces()) - int(target), 0)
     settings.packMesh = True
     settings.subdivideParts = 1  # one sequential pass: as good, no faster in parallel on loaded cores
-    mm.decimateMesh(m, settings)
+    done = mm.decimateMesh(m, settings)
+    if result is not None:
+        result["error"] = float(done.errorIntroduced)
     v = np.asarray(mn.getNumpyVerts(m), dtype=np.float64).reshape(-1, 3)
     f = np.asarray(mn.getNumpyFaces(m.topology), dtype=np.int64).reshape(-1, 3)
     return v, f

@@ -286,11 +286,15 @@ REAL_VISUALS = sorted(str(p.relative_to(REPO)) for p in (REPO / "recipes" / "mes
 
 @pytest.mark.slow
 @pytest.mark.parametrize("keep", [0.1, 0.3])
-def test_decimate_reaches_the_target_and_keeps_closed_meshes_closed_on_real_meshes(keep):
+def test_decimate_reaches_the_target_and_keeps_closed_meshes_closed_on_real_meshes(keep, monkeypatch):
     """Every visual mesh of the examples (CAD tessellations: long thin triangles, several bodies):
     the face count is within 2 % of the target, and a closed mesh stays closed.  The turret_bot's
-    meshes (28-92 faces, targets under 30 faces where 2 % is less than one face) are left out."""
+    meshes (28-92 faces, targets under 30 faces where 2 % is less than one face) are left out.
+    The shortcuts' results are kept (the quality check of issue 33 off), so the paths show."""
+    import robotkit.mesh.decimate as decimate_module
     from robotkit.mesh.io import load_mesh
+
+    monkeypatch.setattr(decimate_module, "GUARANTEE_FACTOR", float("inf"))
 
     meshes = [(rel, load_mesh(str(REPO / rel))) for rel in REAL_VISUALS]
     meshes = [(rel, m) for rel, m in meshes if len(m.faces) >= 1000]
@@ -366,11 +370,14 @@ def test_meshlib_runs_on_the_calling_thread_alone():
 def test_meshlib_fast_stage_where_the_first_pass_gives_up(monkeypatch):
     """Without the first pass, MeshLib goes to 3 times the target keeping vertices where they
     are, then to the target with its optimal positions: the target is reached, a closed mesh
-    stays closed, and the distance stays near MeshLib's own (measured: 0.8-1.2 of it)."""
+    stays closed, and the distance stays near MeshLib's own (measured: 0.8-1.2 of it); here
+    tested with the quality check (issue 33) off."""
     import robotkit.mesh.decimate as decimate_module
     from robotkit.mesh.io import load_mesh
 
     monkeypatch.setattr(decimate_module, "PREPASS_GIVE_UP", 0.0)  # give up after any defect
+    monkeypatch.setattr(decimate_module, "FAST_STAGE", 3.0)
+    monkeypatch.setattr(decimate_module, "GUARANTEE_FACTOR", float("inf"))
     tire = load_mesh(str(REPO / "recipes/meshes/turtlebot3/left_tire.stl"))
     out, report = decimate(tire, target_faces=2167, samples=2000)
     assert report["prepass"] is None and report["prepass_rounds"] == 1 and report["fast_stage"] == 3.0
