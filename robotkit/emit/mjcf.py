@@ -108,7 +108,11 @@ def _assets(robot: Robot) -> dict:
                 n += 1
                 name = f"{base}_{n}"
             used_names.add(name)
-            assets[key] = {"name": name, "file": key[0], "scale": key[1] if any(v != 1 for v in key[1]) else None}
+            # a visual mesh is copied as it is (open, misoriented or flat, as modellers draw them) and its
+            # geom carries no mass: its inertia as a thin shell, which MuJoCo computes for any surface
+            # (as a solid it refuses the mesh: "mesh volume is too small")
+            assets[key] = {"name": name, "file": key[0], "scale": key[1] if any(v != 1 for v in key[1]) else None,
+                           "shell": role == "visual"}
     return assets
 
 

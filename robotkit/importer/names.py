@@ -69,3 +69,37 @@ def without_leading_slash(children: list) -> dict[str, tuple[str, str]]:
             if sub is not el and isinstance(sub.tag, str) and (sub.text or "").strip() in renamed and not len(sub):
                 sub.text = renamed[sub.text.strip()][1]
     return renamed
+
+
+JOINT_REFERENCES = (("joint", "mimic"), ("transmission", "joint"), ("ros2_control", "joint"))
+"""(top-level element, its child): where a URDF names a joint (attribute ``name`` or ``joint``)."""
+
+
+def joints_apart_from_links(children: list) -> dict[str, str]:
+    """Joints named like a link (SO-ARM100's joint 'gripper' on its link 'gripper') get ``_joint``
+    appended (then a number), as model.sdf names them (robotkit.emit.sdf.joint_names): links and
+    joints share one namespace in SDF, and libsdformat, reading the URDF for Gazebo, refuses the
+    pair.  Renamed in the elements ``children`` of <robot> (edited in place) and where mimics,
+    transmissions and ros2_control name the joint; a gazebo block naming it is left to the link.
+    Returns old name -> new."""
+    links = {el.get("name") for el in children if el.tag == "link"}
+    taken = links | {el.get("name") for el in children if el.tag == "joint"}
+    renamed: dict[str, str] = {}
+    for el in children:
+        name = el.get("name")
+        if el.tag != "joint" or name not in links or name in renamed:
+            continue
+        new, n = f"{name}_joint", 2
+        while new in taken:
+            new, n = f"{name}_joint{n}", n + 1
+        taken.add(new)
+        renamed[name] = new
+    for el in children:
+        if el.tag == "joint" and el.get("name") in renamed:
+            el.set("name", renamed[el.get("name")])
+        for tag, child in JOINT_REFERENCES:
+            for ref in el.findall(child) if el.tag == tag else ():
+                attr = "joint" if child == "mimic" else "name"
+                if ref.get(attr) in renamed:
+                    ref.set(attr, renamed[ref.get(attr)])
+    return renamed

@@ -31,13 +31,13 @@ from pathlib import Path
 import numpy as np
 
 from robotkit import urdfxml
-from robotkit.emit.sdf import names_apart
 from robotkit.emit.urdf import MASSLESS
 from robotkit.errors import Problem, RobotkitError, short_number
 from robotkit.importer.inertials import chosen_inertial, give_moving_links_mass, no_inertial_form, read_inertial
 from robotkit.importer import units as mesh_units
 from robotkit.importer.meshes import MeshResolver, MeshUse
-from robotkit.importer.names import material_name, name_hint, valid_frame_name, valid_name, without_leading_slash
+from robotkit.importer.names import (joints_apart_from_links, material_name, name_hint, valid_frame_name, valid_name,
+                                     without_leading_slash)
 from robotkit.importer.parsing import (Problems, fmt_list, shown, local_name, origin_dict, read_float, read_floats,
                                        read_origin)
 from robotkit.importer.recipe_writer import fmt
@@ -123,10 +123,16 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
                  Converted(recipe={}), recompute_inertials, density, inertia_policy, lines, dict(overrides or {}))
     robot_name = _robot_name(root.get("name") or source.name.split(".")[0], r.warnings)
     renamed = without_leading_slash(children)
+    apart = joints_apart_from_links(children)
     materials = _Materials(children, r.problems, r.warnings)
     links = _links(children, materials, r)
     joints = _joints(children, links.links, r)
     _note_renamed(renamed, r)
+    for old, new in apart.items():
+        if new in joints:
+            _note(new, f"named '{old}' in the original, like a link: links and joints share one namespace in SDF, "
+                       "where libsdformat (Gazebo) reads the URDF, so it is renamed here and where mimics and "
+                       "transmissions name it", r)
     extras = _extras(children, root, links, joints, materials.materials, r)
     _zero_limits(children, joints, r)
     r.problems.raise_if_any()
@@ -563,10 +569,6 @@ def _joints(children: list, links: dict[str, dict], r: _Reading) -> dict[str, di
         note = joint.pop("__note", None)
         if note:
             r.out.joint_notes[name] = note
-    for name, sdf_name in names_apart(links, joints).items():
-        if sdf_name != name:  # ROS accepts it; an SDF model has one namespace for links and joints
-            _note(name, f"named like a link in the original: SDF, where links and joints share names, calls it "
-                        f"'{sdf_name}'", r)
     _drop_dangling_mimics(joints, r)
     return joints
 

@@ -194,7 +194,10 @@ def _with_stated_joint_changes(text: str, notes: dict[str, str]) -> str:
     from scipy.spatial.transform import Rotation
 
     root = ET.fromstring(text)
+    renamed = {re.match(r"named '([^']+)' in the original, like a link", note)[1]: name
+               for name, note in notes.items() if re.match(r"named '([^']+)' in the original, like a link", note)}
     for el in root.iter("joint"):
+        el.set("name", renamed.get(el.get("name"), el.get("name")))
         note = notes.get(el.get("name"), "")
         if note.startswith("mimicked fixed joint"):
             el.remove(el.find("mimic"))
@@ -234,8 +237,9 @@ def test_an_edited_copy_imports_builds_and_loads(tmp_path):
                             "equal limits and let it slide freely",
         "lbr_iiwa_joint_7": "mimicked fixed joint 'tool_joint' in the original: a fixed joint has no position to "
                             "follow, so the mimic is dropped and the joint moves on its own",
-        "lbr_iiwa_link_5": "named like a link in the original: SDF, where links and joints share names, calls it "
-                           "'lbr_iiwa_link_5_joint'"}
+        "lbr_iiwa_link_5_joint": "named 'lbr_iiwa_link_5' in the original, like a link: links and joints share one "
+                                 "namespace in SDF, where libsdformat (Gazebo) reads the URDF, so it is renamed here "
+                                 "and where mimics and transmissions name it"}
     assert '<joint name="lbr_iiwa_link_5_joint" type="revolute">' in (robot_dir / "model.sdf").read_text()
     assert result.repairs["lbr_iiwa_link_5"] == (
         "the original's principal moments 0.01, 0.01, 0.05 violate the triangle inequality: repaired (principal "

@@ -98,8 +98,18 @@ ZERO_LIMITS = _robot("wheels", _cube("base_link", 2.0, 0.1) + _cube("caster", 0.
                          </transmission>
                          """), "  "))
 
+# SO-ARM100 (example-robot-data): its joint 'gripper' moves the jaw on the link 'gripper'
+GRIPPER = _robot("so100", _cube("base", 1.0) + _cube("gripper", 0.2) + _cube("jaw", 0.05) + _cube("jaw2", 0.05)
+                 + _joint("wrist_roll", "base", "gripper") + _joint("gripper", "gripper", "jaw")
+                 + _joint("jaw_mirror", "gripper", "jaw2", more='<mimic joint="gripper"/>')
+                 + '  <gazebo reference="gripper"><mu1>0.9</mu1></gazebo>\n'
+                 '  <transmission name="gripper_trans"><type>transmission_interface/SimpleTransmission</type>'
+                 '<joint name="gripper"><hardwareInterface>hardware_interface/PositionJointInterface'
+                 '</hardwareInterface></joint><actuator name="motor6"><mechanicalReduction>1</mechanicalReduction>'
+                 '</actuator></transmission>\n')
+
 ROBOTS = {"slash": SLASH, "mimic": MIMIC, "unlimited": UNLIMITED, "placeholders": PLACEHOLDERS,
-          "zero_limits": ZERO_LIMITS}
+          "zero_limits": ZERO_LIMITS, "gripper": GRIPPER}
 
 
 @pytest.fixture(autouse=True)
@@ -341,3 +351,20 @@ def test_a_mass_too_light_but_not_meshlabs_is_kept_and_reported(tmp_path):
     assert [w for w in result.warnings if "link '" in w] == [
         "light.urdf:3: link 'body': the original's mass 27 kg over its geometry's 4.096 m^3 implies 6.59 kg/m^3, "
         "below 10 (the density or mass is far too low): kept (check reports it)"]
+
+
+def test_a_joint_named_like_a_link_is_renamed_with_its_references(tmp_path):
+    """libsdformat, reading the URDF for Gazebo, refuses a joint and a link of one name ("Joint with
+    non-unique name [gripper]"): the joint gets the name model.sdf gives it, in the URDF too."""
+    result, text, recipe = _import(tmp_path, "gripper")
+    note = ("named 'gripper' in the original, like a link: links and joints share one namespace in SDF, where "
+            "libsdformat (Gazebo) reads the URDF, so it is renamed here and where mimics and transmissions name it")
+    assert [w for w in result.warnings if "in the original, like a link" in w] == [f"joint 'gripper_joint': {note}"]
+    assert _comment_above(text, "gripper_joint") == note
+    assert list(recipe["joints"]) == ["wrist_roll", "gripper_joint", "jaw_mirror"]
+    assert recipe["joints"]["gripper_joint"]["parent"] == "gripper"
+    assert recipe["joints"]["wrist_roll"]["child"] == "gripper"
+    assert recipe["joints"]["jaw_mirror"]["mimic"] == {"joint": "gripper_joint"}
+    extras = "".join(recipe["urdf_extras"])
+    assert '<gazebo reference="gripper">' in extras  # the link's
+    assert '<joint name="gripper_joint">' in extras
