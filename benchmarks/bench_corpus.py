@@ -37,7 +37,7 @@ def figures(results: list[dict]) -> list[str]:
                 reached[stage] += 1
     clean = sum(r["clean"] for r in results)
     own = sum(bool(r["own"]) for r in results)
-    lines = [f"| robots | imported | built | checked | clean (no error) | with an error of robotkit's own |",
+    lines = ["| robots | imported | built | checked | clean (no error) | with an error of robotkit's own |",
              "|---|---|---|---|---|---|",
              f"| {n} | {reached['imported']} | {reached['built']} | {reached['checked']} | {clean} | {own} |", "",
              "| rule (check errors) | robots | errors |", "|---|---|---|"]
@@ -55,12 +55,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("-j", type=int, default=len(os.sched_getaffinity(0)))
     parser.add_argument("--out", type=Path, default=None)
-    parser.add_argument("--only", nargs="*", default=None)
+    parser.add_argument("--only", nargs="*", default=None, help="these robots, in this order")
+    parser.add_argument("--first", nargs="*", default=[], help="run these robots first, in this order")
+    parser.add_argument("--resume", action="store_true", help="skip the robots OUT/results.jsonl already holds")
     a = parser.parse_args()
     out = a.out or Path(tempfile.mkdtemp(prefix="corpus-"))
     out.mkdir(parents=True, exist_ok=True)
     corpus = robots()
-    names = [n for n in corpus if a.only is None or n in a.only]
+    names = [n for n in a.only if n in corpus] if a.only is not None else list(corpus)
+    names = [n for n in a.first if n in names] + [n for n in names if n not in a.first]
+    if a.resume and (out / "results.jsonl").is_file():
+        done = {json.loads(line)["robot"] for line in open(out / "results.jsonl", encoding="utf-8")}
+        names = [n for n in names if n not in done]
     print(f"{len(names)} robots into {out}, {a.j} at once", flush=True)
     t = time.perf_counter()
     results = []

@@ -1,0 +1,108 @@
+"""Public robots (tests/corpus/robots.tsv: the PyPI packages rtb-data and example-robot-data)
+through `robotkit import`, `build` and `check`, as a user runs them, one process per stage.
+
+A fixed sample per run (SAMPLE: one robot of each shape issue 32 found trouble with); all of
+them with ROBOTKIT_CORPUS_ALL=1, or in benchmarks/bench_corpus.py, which prints the figures of
+docs/performance.md.  The sample's robots run in parallel (as many as the cores this process may
+use), each once per session (under pytest-xdist, once per worker that has tests of it).
+
+- No error of robotkit's own making: no traceback, no disagreement between the URDF, SDF and
+  MJCF it wrote, no consumer, MuJoCo or libsdformat refusal of them, no simulation error.
+- Every robot imports, builds and is checked, or the refusal names the file.
+- Every error check finds in the build is a defect of the original that the import reported
+  (it names the same link).
+
+What fails on main today is listed in KNOWN (strict: a fix makes the test fail until its line
+goes), with the issue's words.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from concurrent.futures import ThreadPoolExecutor
+
+import pytest
+
+from tests.corpus.corpus import OWN_CHECKS, robots, run, table_names
+from tests.validators import IN_CI
+
+pytestmark = [pytest.mark.slow, pytest.mark.consumers]
+
+SAMPLE = {  # robot: the shape it stands for
+    "interbotix_px100": "link names with a leading slash (tf-prefix style), xacro",
+    "talos_reduced": "humanoid; <mimic> on fixed joints",
+    "iris": "drone: floating base, rotor limits of +-1e16 meaning unlimited",
+    "lynxmotion_al5d": "small arm whose poses hold 1e-19 values (tolerance against zero)",
+    "qut_panda_arm_hand": "xacro arm and hand: mimic finger, chain of fixed joints (link8, hand)",
+    "ridgeback": "mobile base (xacro), massless sensor frames on fixed joints",
+    "solo12": "quadruped, floating base",
+    "allegro_right_hand": "hand: many small links",
+    "kuka_kr210l150": "industrial arm (xacro macros), fixed flange/tool0 chain",
+    "ur5_robot": "arm on a world link, placeholder inertias, transmissions",
+}
+
+# what main does today (issue 32); each line goes when the fix lands (strict xfail)
+KNOWN: dict[tuple[str, str], str] = {}
+
+ALL = os.environ.get("ROBOTKIT_CORPUS_ALL", "") not in ("", "0")
+NAMES = table_names() if ALL else sorted(SAMPLE)
+
+
+def _known(test: str, name: str):
+    why = KNOWN.get((test, name))
+    return pytest.param(name, marks=pytest.mark.xfail(reason=why, strict=True)) if why else name
+
+
+def params(test: str) -> list:
+    return [_known(test, n) for n in NAMES]
+
+
+@pytest.fixture(scope="session")
+def corpus(request, tmp_path_factory) -> dict:
+    """The robots this session's tests use, each imported, built and checked once, in parallel."""
+    available = robots()
+    wanted = sorted({item.callspec.params["name"] for item in request.session.items
+                     if item.path.parent.name == "corpus" and hasattr(item, "callspec")
+                     and "name" in item.callspec.params})
+    missing = [n for n in wanted if n not in available or not available[n].entry.is_file()]
+    if missing:
+        msg = (f"the robot corpus is not installed ({len(missing)} robots missing, e.g. {missing[0]}): "
+               "scripts/setup.sh --test installs rtb-data and example-robot-data, or set ROBOTKIT_CORPUS to "
+               "a folder the wheels are unzipped into")
+        pytest.fail(msg) if IN_CI else pytest.skip(msg)
+    root = tmp_path_factory.mktemp("corpus")
+    with ThreadPoolExecutor(len(os.sched_getaffinity(0))) as pool:
+        runs = dict(zip(wanted, pool.map(lambda n: run(available[n], root / n), wanted)))
+    return runs
+
+
+@pytest.mark.parametrize("name", params("own"))
+def test_no_error_of_robotkit_own_making(corpus, name):
+    assert corpus[name].own_errors() == []
+
+
+@pytest.mark.parametrize("name", params("reached"))
+def test_imports_builds_and_is_checked(corpus, name):
+    result = corpus[name]
+    assert result.reached == "checked", result.stages[-1].lines()
+
+
+@pytest.mark.parametrize("name", params("refusal"))
+def test_a_refusal_names_the_file(corpus, name):
+    result = corpus[name]
+    if result.reached == "checked":
+        return
+    for line in result.stages[-1].lines():
+        assert re.match(r"\S+\.(urdf|xacro|yaml|stl|dae|obj|STL|DAE)(:\d+)?: ", line), line
+
+
+@pytest.mark.parametrize("name", params("reported"))
+def test_every_check_error_is_a_defect_the_import_reported(corpus, name):
+    result = corpus[name]
+    if result.reached != "checked":
+        pytest.skip(f"{name} is {result.reached}")
+    said = result.stages[0].stderr
+    unreported = [f"{f['check']}: {f['subject']}: {f['message']}" for f in result.errors()
+                  if f["check"] not in OWN_CHECKS and f["subject"].split(" ", 1)[-1] not in said]
+    assert unreported == []
