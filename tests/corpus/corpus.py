@@ -146,7 +146,7 @@ class Run:
                 out.append(f"{s.name}: exit {s.returncode}: {' | '.join(s.lines())}")
         if self.stages[-1].name == "build" and self.stages[-1].returncode == 1:
             out += [f"build: {ln}" for ln in self.stages[-1].lines() if _own_build_refusal(ln)]
-        out += [f"check: {f['check']}: {f['subject']}: {f['message']}" for f in self.errors() if f["check"] in OWN_CHECKS]
+        out += [f"check: {f['check']}: {f['subject']}: {f['message']}" for f in self.errors() if own_finding(f)]
         return out
 
     def clean(self) -> bool:
@@ -159,6 +159,12 @@ class Run:
                 "errors": sorted({f["check"] for f in self.errors()}),
                 "error_counts": _count(f["check"] for f in self.errors()),
                 "own": self.own_errors()}
+
+
+def own_finding(finding: dict) -> bool:
+    """Whether a check finding is robotkit's own: a rule of OWN_CHECKS, or a stage that could
+    not run on the build."""
+    return finding["check"] in OWN_CHECKS or "stage could not run" in finding["message"]
 
 
 def _count(items) -> dict[str, int]:
