@@ -23,32 +23,43 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from tests.corpus.corpus import robots, run  # noqa: E402
+from tests.corpus.corpus import own_finding, robots, run  # noqa: E402
 
 
 def figures(results: list[dict]) -> list[str]:
-    """The Markdown table of pass figures per stage and the errors per rule."""
-    n = len(results)
-    reached = {"imported": 0, "built": 0, "checked": 0}
+    """The Markdown tables: robots per stage reached, and the check's errors per rule (whose: robotkit's
+    own, or the original's defect)."""
     order = ["imported", "built", "checked"]
-    for r in results:
-        if r["reached"] in order:
-            for stage in order[: order.index(r["reached"]) + 1]:
-                reached[stage] += 1
+    reached = {stage: sum(r["reached"] in order[order.index(stage):] for r in results) for stage in order}
     clean = sum(r["clean"] for r in results)
     own = sum(bool(r["own"]) for r in results)
-    lines = ["| robots | imported | built | checked | clean (no error) | with an error of robotkit's own |",
-             "|---|---|---|---|---|---|",
-             f"| {n} | {reached['imported']} | {reached['built']} | {reached['checked']} | {clean} | {own} |", "",
-             "| rule (check errors) | robots | errors |", "|---|---|---|"]
+    share = f"{100 * clean / reached['built']:.0f} %" if reached["built"] else "-"
+    lines = ["| robots | imported | built | checked | clean (no error) | clean / built | with an error of robotkit's own |",
+             "|---|---|---|---|---|---|---|",
+             f"| {len(results)} | {reached['imported']} | {reached['built']} | {reached['checked']} | {clean} | {share} "
+             f"| {own} |", "", "| rule (check errors) | whose | robots | errors |", "|---|---|---|---|"]
     rules: dict[str, list[int]] = {}
+    owners: dict[str, str] = {}
     for r in results:
         for rule, count in r["error_counts"].items():
             rules.setdefault(rule, [0, 0])
             rules[rule][0] += 1
             rules[rule][1] += count
-    lines += [f"| {rule} | {a} | {b} |" for rule, (a, b) in sorted(rules.items(), key=lambda kv: -kv[1][0])]
+            if any(o.startswith(f"check: {rule}:") for o in r["own"]):
+                owners[rule] = "robotkit"
+    lines += [f"| {rule} | {owners.get(rule, 'original')} | {a} | {b} |"
+              for rule, (a, b) in sorted(rules.items(), key=lambda kv: (-kv[1][0], kv[0]))]
     return lines
+
+
+def reclassify(summary: dict, out: Path) -> dict:
+    """``summary`` with its check errors classified by today's own_finding (from OUT/<robot>/check.json)."""
+    report = out / summary["robot"] / "check.json"
+    if report.is_file():
+        errors = [f for f in json.loads(report.read_text(encoding="utf-8"))["findings"] if f["severity"] == "error"]
+        summary["own"] = [o for o in summary["own"] if not o.startswith("check: ")]
+        summary["own"] += [f"check: {f['check']}: {f['subject']}: {f['message']}" for f in errors if own_finding(f)]
+    return summary
 
 
 def main() -> None:
@@ -58,9 +69,17 @@ def main() -> None:
     parser.add_argument("--only", nargs="*", default=None, help="these robots, in this order")
     parser.add_argument("--first", nargs="*", default=[], help="run these robots first, in this order")
     parser.add_argument("--resume", action="store_true", help="skip the robots OUT/results.jsonl already holds")
+    parser.add_argument("--figures", action="store_true",
+                        help="only print the figures of OUT/results.jsonl (each robot's last result)")
     a = parser.parse_args()
     out = a.out or Path(tempfile.mkdtemp(prefix="corpus-"))
     out.mkdir(parents=True, exist_ok=True)
+    if a.figures:
+        last = {}
+        for line in open(out / "results.jsonl", encoding="utf-8"):
+            last[json.loads(line)["robot"]] = reclassify(json.loads(line), out)
+        print("\n".join(figures(list(last.values()))))
+        return
     corpus = robots()
     names = [n for n in a.only if n in corpus] if a.only is not None else list(corpus)
     names = [n for n in a.first if n in names] + [n for n in names if n not in a.first]
