@@ -167,6 +167,18 @@ def own_finding(finding: dict) -> bool:
     return finding["check"] in OWN_CHECKS or "stage could not run" in finding["message"]
 
 
+TOPIC = {"inertia-box": "inerti", "inertia": "inerti", "implied-density": "densit", "total-mass": "mass"}
+
+
+def reported(finding: dict, said: str) -> bool:
+    """Whether a line of the import's messages names the finding's subject and its topic (for
+    joint-limits: which limit, "effort limit 0 ..." -> effort)."""
+    name = finding["subject"].split(" ", 1)[-1]
+    rule = finding["check"]
+    topic = finding["message"].split()[0] if rule == "joint-limits" else TOPIC.get(rule, rule.split("-")[0])
+    return any(name in line and topic.lower() in line.lower() for line in said.splitlines())
+
+
 def _count(items) -> dict[str, int]:
     out: dict[str, int] = {}
     for i in items:
