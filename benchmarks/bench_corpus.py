@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import sys
 import tempfile
 import time
@@ -49,7 +50,31 @@ def figures(results: list[dict]) -> list[str]:
                 owners[rule] = "robotkit"
     lines += [f"| {rule} | {owners.get(rule, 'original')} | {a} | {b} |"
               for rule, (a, b) in sorted(rules.items(), key=lambda kv: (-kv[1][0], kv[0]))]
+    refusals: dict[tuple[str, str], list[str]] = {}
+    for r in results:
+        if r["reached"].startswith("refused"):
+            refusals.setdefault((r["reached"], cause(r["refusal"])), []).append(r["robot"])
+    lines += ["", "| refused | cause | robots |", "|---|---|---|"]
+    lines += [f"| {stage.removeprefix('refused by ')} | {why} | {len(names)}: {', '.join(sorted(names))} |"
+              for (stage, why), names in sorted(refusals.items(), key=lambda kv: -len(kv[1]))]
     return lines
+
+
+CAUSES = [("not a valid recipe name", "link names with a leading slash"),
+          ("cannot mimic", "<mimic> on a fixed joint"),
+          (re.compile(r"limit\.(lower|upper): Input should be"), "limits beyond +-10000 (meaning unlimited)"),
+          (re.compile(r":\d+: xacro: "), "xacro expansion"),
+          ("give --package-path", "a package the table does not give"),
+          ("Traceback", "traceback")]
+
+
+def cause(lines: list[str]) -> str:
+    """The refusal's cause, in a few words (the first line's message when none of CAUSES)."""
+    text = "\n".join(lines)
+    for pattern, why in CAUSES:
+        if (pattern.search(text) if isinstance(pattern, re.Pattern) else pattern in text):
+            return why
+    return re.sub(r"^\S+: ", "", lines[0] if lines else "(no message)")[:100]
 
 
 def reclassify(summary: dict, out: Path) -> dict:
