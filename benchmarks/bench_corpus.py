@@ -65,7 +65,7 @@ CAUSES = [("not a valid recipe name", "link names with a leading slash"),
           (re.compile(r"limit\.(lower|upper): Input should be"), "limits beyond +-10000 (meaning unlimited)"),
           (re.compile(r":\d+: xacro: "), "xacro expansion"),
           ("give --package-path", "a package the table does not give"),
-          ("Traceback", "traceback")]
+          ("Traceback", "traceback"), ("timed out after", "timed out (900 s per stage)")]
 
 
 def cause(lines: list[str]) -> str:
@@ -102,7 +102,10 @@ def main() -> None:
     if a.figures:
         last = {}
         for line in open(out / "results.jsonl", encoding="utf-8"):
-            last[json.loads(line)["robot"]] = reclassify(json.loads(line), out)
+            summary = reclassify(json.loads(line), out)
+            if summary["reached"].startswith("refused") and not summary["refusal"]:  # before refusal() said why
+                summary["refusal"] = [o for o in summary["own"] if "timed out" in o]
+            last[summary["robot"]] = summary
         print("\n".join(figures(list(last.values()))))
         return
     corpus = robots()

@@ -149,13 +149,22 @@ class Run:
         out += [f"check: {f['check']}: {f['subject']}: {f['message']}" for f in self.errors() if own_finding(f)]
         return out
 
+    def refusal(self) -> list[str]:
+        """The last stage's message lines, when it refused (or timed out)."""
+        last = self.stages[-1]
+        if self.reached == "checked" or (last.returncode == 0 and not last.traceback):
+            return []
+        if last.returncode is None:
+            return [f"{last.name}: timed out after {last.seconds:.0f} s"]
+        return last.lines() or [f"{last.name}: exit {last.returncode} without a message"]
+
     def clean(self) -> bool:
         return self.reached == "checked" and not self.errors()
 
     def summary(self) -> dict:
         return {"robot": self.robot, "reached": self.reached, "clean": self.clean(),
                 "seconds": {s.name: round(s.seconds, 1) for s in self.stages},
-                "refusal": [] if self.reached == "checked" or self.stages[-1].returncode == 0 else self.stages[-1].lines(),
+                "refusal": self.refusal(),
                 "errors": sorted({f["check"] for f in self.errors()}),
                 "error_counts": _count(f["check"] for f in self.errors()),
                 "own": self.own_errors()}
