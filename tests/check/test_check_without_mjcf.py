@@ -20,6 +20,7 @@ import robotkit.emit.mjcf
 import robotkit.model.robot
 from conftest import run_cli
 from robotkit.check import check_build_dir
+from robotkit.commands.check import cases, check
 from robotkit.commands.inputs import classify
 from robotkit.commands.report import write_report
 from robotkit.commands.view import resolve
@@ -98,6 +99,20 @@ def test_check_json_and_the_output_folder(lost):
     assert [s["stage"] for s in out["stages"] if "seconds" in s and s["verdict"] == "skipped"] == []  # not timed
 
 
+def test_check_of_the_recipe_warns_of_the_loss_and_skips_what_needs_the_mjcf(lost, monkeypatch):
+    monkeypatch.setenv("ROBOTKIT_CACHE", str(lost / "cache"))
+    monkeypatch.chdir(lost)
+    monkeypatch.setattr(robotkit.emit.mjcf, "MJCF_MAX_DEPTH", 3)
+    monkeypatch.setattr(robotkit.model.robot, "MJCF_MAX_DEPTH", 3)
+    findings = check("deep.yaml", "out")
+    assert [(f.severity, f.check, f.line, f.message) for f in findings] == [
+        ("warning", "build", 1, "deep: not written, a limit of the format: MJCF: link 'l4' sits 5 links deep and "
+         "MuJoCo's XML reader stops at 3 nested bodies (a body per link); left out: deep/mjcf/deep.xml, "
+         "deep/mjcf/scene.xml (list it under outputs: to make this an error)")]
+    assert [c for c in cases("deep.yaml", "out") if c[1].startswith("skipped: ")] == [
+        (stage, f"skipped: {WHY}") for stage in ("mujoco", "simulation", "self-collision", "motion")]
+
+
 def test_a_folder_without_its_mjcf_and_without_the_record_is_still_refused(lost, tmp_path):
     folder = tmp_path / "deep"
     shutil.copytree(lost / "out" / "deep", folder)
@@ -124,3 +139,42 @@ def test_view_shows_the_urdf(lost):
         kind, make = resolve(path, "build")
         [shown] = make()
         assert kind == "build" and shown.urdf == lost / "out" / "deep" / "urdf" / "deep.urdf"
+
+
+REAL = ("the MJCF was left out: link 'l599' sits 600 links deep and MuJoCo's XML reader stops at 496 nested "
+        "bodies (a body per link)")
+
+
+@pytest.fixture(scope="module")
+def deep600(tmp_path_factory) -> Path:
+    """A real 600-deep chain (MuJoCo refuses it): built once, without its MJCF."""
+    tmp = tmp_path_factory.mktemp("deep600")
+    (tmp / "deep.yaml").write_text(chain(600))
+    proc = run_cli("build", "deep.yaml", "--out", "out", "--no-report", cwd=tmp)
+    assert proc.returncode == 0, proc.stderr
+    return tmp
+
+
+@pytest.mark.slow
+def test_check_of_a_600_deep_chain_skips_what_needs_the_mjcf(deep600):
+    """Every stage but MuJoCo's runs; the only findings are the programs with limits of their own
+    (PyBullet holds at most 128 links in a body; Pinocchio's data grows with the cube of the joints)."""
+    proc = run_cli("check", "out/deep", "--format", "json", cwd=deep600)
+    out = json.loads(proc.stdout)
+    verdicts = {s["stage"]: s["verdict"] for s in out["stages"]}
+    assert {s["stage"]: s.get("why") for s in out["stages"] if s["verdict"] == "skipped"} == {
+        "mujoco": REAL, "simulation": REAL, "self-collision": REAL, "motion": REAL}
+    assert [verdicts[s] for s in ("check_urdf", "ign sdf -k", "lints", "equivalence")] == ["ok"] * 4
+    refused = {f["message"].split(" refuses the robot: ")[0] for f in out["findings"]}
+    assert all(f["check"] == "consumer" and " refuses the robot: " in f["message"] for f in out["findings"])
+    assert refused <= {"PyBullet (URDF)", "Pinocchio (URDF)"} and "MuJoCo" not in proc.stdout.replace(REAL, "")
+    assert proc.returncode == (1 if out["findings"] else 0), proc.stderr
+
+
+@pytest.mark.slow
+def test_report_of_a_600_deep_chain_has_no_pictures(deep600):
+    proc = run_cli("report", "out/deep", cwd=deep600)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("wrote out/deep/report/report.html (")
+    page = (deep600 / "out" / "deep" / "report" / "report.html").read_text(encoding="utf-8")
+    assert f"No pictures: {REAL} (the pictures are drawn in MuJoCo, from the MJCF)".replace("'", "&#39;") in page
