@@ -5,7 +5,8 @@ skipped with the reason, ``robotkit report`` writes the page without pictures an
 ``robotkit view`` shows the URDF.
 
 The fast tests lower MuJoCo's limit to 3 bodies for the build (as tests/pipeline/test_format_limit.py
-does); the check reads the folder's record, not the limit.  The slow one builds a real 600-deep chain."""
+does); the check reads the folder's record, not the limit.  The slow ones build a real 600-deep
+chain.  The tests that run a check load the consumers (marked ``consumers``)."""
 
 from __future__ import annotations
 
@@ -62,6 +63,7 @@ def test_report_json_records_the_format_left_out_and_why(lost):
     assert data["left_out"] == {"mjcf": WHY.removeprefix("the MJCF was left out: ")}
 
 
+@pytest.mark.consumers
 def test_check_runs_the_stages_without_the_mjcf_and_skips_the_others(lost):
     proc = run_cli("check", "out/deep", "--junit", "junit.xml", cwd=lost)
     assert proc.returncode == 0, proc.stdout + proc.stderr
@@ -85,6 +87,7 @@ def test_check_runs_the_stages_without_the_mjcf_and_skips_the_others(lost):
     assert suite.get("skipped") == "4" and suite.get("failures") == "0"
 
 
+@pytest.mark.consumers
 def test_check_json_and_the_output_folder(lost):
     """The output folder holding the robot is a build PATH too; the JSON names why a stage was skipped."""
     proc = run_cli("check", "out", "--format", "json", cwd=lost)
@@ -99,6 +102,7 @@ def test_check_json_and_the_output_folder(lost):
     assert [s["stage"] for s in out["stages"] if "seconds" in s and s["verdict"] == "skipped"] == []  # not timed
 
 
+@pytest.mark.consumers
 def test_check_of_the_recipe_warns_of_the_loss_and_skips_what_needs_the_mjcf(lost, monkeypatch):
     monkeypatch.setenv("ROBOTKIT_CACHE", str(lost / "cache"))
     monkeypatch.chdir(lost)
@@ -155,6 +159,7 @@ def deep600(tmp_path_factory) -> Path:
     return tmp
 
 
+@pytest.mark.consumers
 @pytest.mark.slow
 def test_check_of_a_600_deep_chain_skips_what_needs_the_mjcf(deep600):
     """Every stage but MuJoCo's runs; the only findings are the programs with limits of their own
