@@ -106,13 +106,14 @@ class Stage:
     subjects: int  # the files or subjects it ran on
     verdict: str  # ok | skipped | 1 error | 2 warnings | 1 error, 2 warnings
     why: str = ""  # why it was skipped
+    compared: str = "URDF, model.sdf, MJCF"  # the equivalence stage's formats (no MJCF when it was skipped)
 
     @property
     def label(self) -> str:
         if self.name == "lints" and self.subjects:
             return f"lints ({self.subjects} links and joints)"
         if self.name == "equivalence":
-            return f"equivalence (URDF, model.sdf, MJCF and Gazebo's URDF at {EQUIVALENCE_CONFIGS} configurations)"
+            return f"equivalence ({self.compared} and Gazebo's URDF at {EQUIVALENCE_CONFIGS} configurations)"
         if self.name in ("check_urdf", "ign sdf -k", "mujoco") and self.subjects > 1:
             return f"{self.name} ({self.subjects} files)"
         return self.name
@@ -152,7 +153,8 @@ def stages(findings: list[Finding], cases: list[tuple[str, str]]) -> list[Stage]
         # a validator whose program is missing did not run; a consumer missing is one of several
         missing = name != "consumers" and items and all("not installed" in f.message for f in items)
         out.append(Stage(name, len(subjects.get(name, ())), "skipped" if missing else verdict,
-                         "; ".join(dict.fromkeys(f.message for f in items)) if missing else ""))
+                         "; ".join(dict.fromkeys(f.message for f in items)) if missing else "",
+                         "URDF, model.sdf" if "mujoco" in skips else Stage.compared))
     return out
 
 

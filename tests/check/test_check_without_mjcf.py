@@ -74,7 +74,7 @@ def test_check_runs_the_stages_without_the_mjcf_and_skips_the_others(lost):
         "  ok       ign sdf -k",
         f"  skipped  mujoco  ({WHY})",
         "  ok       lints (9 links and joints)",
-        "  ok       equivalence (URDF, model.sdf, MJCF and Gazebo's URDF at 100 configurations)",
+        "  ok       equivalence (URDF, model.sdf and Gazebo's URDF at 100 configurations)",
         "  ok       consumers",
         f"  skipped  simulation  ({WHY})",
         f"  skipped  self-collision  ({WHY})",
