@@ -8,6 +8,7 @@ which, and building a recipe first, is ``robotkit.commands.check``'s job.
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 import tempfile
@@ -175,9 +176,11 @@ def _stage_outcome(name: str, subject: str, future: Future) -> tuple[list[Findin
 
 def _own_consumers(build: Build) -> tuple[list[Finding], float]:
     """The consumers that read the robot in Python (Drake, Pinocchio, PyBullet, MuJoCo), in a
-    worker process: their imports and readings beside the main process's stages."""
+    worker process: their imports and readings beside the main process's stages.  MuJoCo's
+    reads the MJCF: not without one."""
+    consumers = IN_WORKER if build.mjcf is not None else [c for c in IN_WORKER if c != "MuJoCo (MJCF)"]
     return _timed(lambda: _stage("consumers", f"robot '{build.name}'",
-                                 lambda: consumer_findings(build, IN_WORKER)[0]))
+                                 lambda: consumer_findings(build, consumers)[0]))
 
 
 IN_WORKER = [c for c in CONSUMERS if not c.startswith("Gazebo")]
@@ -193,37 +196,62 @@ def _fork_pool():
     return ProcessPoolExecutor(max_workers=1, mp_context=context)
 
 
+MJCF_STAGES = ("mujoco", "simulation", "self-collision", "motion")
+"""The stages that read the MJCF (its validator on it and the scene, the scene's simulation, the
+self-collision sampled in MuJoCo, the motion in MuJoCo): skipped when the build left it out."""
+
+
+def mjcf_left_out(robot_dir: Path) -> str | None:
+    """Why the build left the MJCF out of a build folder (a limit of the format: its report.json
+    says), as the stages it skips say it; None when the folder should hold it."""
+    why = robot_layout(robot_dir).left_out().get("mjcf")
+    return None if why is None else f"the MJCF was left out: {why}"
+
+
 def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion: dict | None = None,
                     timings: dict[str, float] | None = None) -> list[Finding]:
     """Every stage on a build folder: lints, validators, equivalence of the formats, what each
     consuming program sees, the MuJoCo scene's own simulation and, when the MJCF has actuators,
     the step responses of its drives (``motion``: gets the robot's motion results by name).
-    Every stage always runs; the ones that do not depend on each other at once (the motion
-    stage's simulators and the Python consumers in worker processes, the validator programs and
-    ``ign sdf -p`` in threads).  ``timings``: gets each stage's wall time (seconds, by stage)."""
+    Every stage always runs but the ones of :data:`MJCF_STAGES` (and MuJoCo's consumer) on a
+    folder whose MJCF the build left out (:func:`mjcf_left_out`); the ones that do not depend on
+    each other at once (the motion stage's simulators and the Python consumers in worker
+    processes, the validator programs and ``ign sdf -p`` in threads).  ``timings``: gets each
+    stage's wall time (seconds, by stage)."""
     layout = robot_layout(robot_dir)
     name, urdf, sdf, mjcf, scene = layout.name, layout.urdf, layout.sdf, layout.mjcf, layout.scene
-    for p in (urdf, sdf, mjcf, scene):
+    lost = mjcf_left_out(robot_dir) is not None
+    for p in (urdf, sdf) if lost else (urdf, sdf, mjcf, scene):
         if not p.is_file():
             raise RobotkitError(Problem(f"not a robotkit build folder: {p.relative_to(robot_dir)} is missing",
                                         file=str(robot_dir)))
     clock, subject = Clock(timings), f"robot '{name}'"
-    base = "free" if "<freejoint" in mjcf.read_text(encoding="utf-8") else "fixed"
-    build = Build(name, robot_dir, urdf, sdf, mjcf, base)
+    build = Build(name, robot_dir, urdf, sdf, None if lost else mjcf, _base(layout, lost))
     consumers_started = time.perf_counter()
     workers = _fork_pool()  # forked first, from one thread
     try:
         own = workers.submit(_own_consumers, build)
-        started = start_motion(mjcf, urdf, {name: robot_dir})  # its simulators run beside the other stages
+        started = None if lost else start_motion(mjcf, urdf, {name: robot_dir})  # beside the other stages
         findings, gazebo = _main_stages(build, clock, declared_mass)
         findings += _merged_consumers(gazebo, own, subject)
     finally:
         workers.shutdown(wait=False, cancel_futures=True)
     clock.add("consumers", time.perf_counter() - consumers_started)
+    if lost:
+        return findings
     findings += clock.timed("simulation", lambda: _stage("simulation", subject, lambda: _simulate(scene, subject)))
     findings += clock.timed("self-collision", lambda: _stage("self-collision", subject,
                                                              lambda: interference(robot_dir)))
     return findings + unreported_missing(findings, finish_motion(started, subject, name, motion, clock))
+
+
+def _base(layout, lost: bool) -> str:
+    """How the robot's root sits (free | fixed): the MJCF's free joint, or report.json's word on
+    it when the MJCF was left out."""
+    if not lost:
+        return "free" if "<freejoint" in layout.mjcf.read_text(encoding="utf-8") else "fixed"
+    consumers = json.loads(layout.report_json.read_text(encoding="utf-8")).get("consumers", {})
+    return "free" if consumers.get("MuJoCo (MJCF)", {}).get("base") == "free joint" else "fixed"
 
 
 def _main_stages(build: Build, clock: Clock, declared_mass: float | None) -> tuple[list[Finding], list[Finding]]:
@@ -241,7 +269,8 @@ def _main_stages(build: Build, clock: Clock, declared_mass: float | None) -> tup
             found, seconds = _stage_outcome(stage, subject, future)
             findings += found
             clock.add(stage, seconds)
-        findings += clock.timed("mujoco", lambda: validate_mjcf(mjcf) + validate_mjcf(scene))
+        if mjcf is not None:
+            findings += clock.timed("mujoco", lambda: validate_mjcf(mjcf) + validate_mjcf(scene))
 
         def equivalent() -> list[Finding]:
             return [Finding("error", "equivalence", subject, f"{what}: {d}")

@@ -12,17 +12,18 @@ from robotkit.emit.layout import robot_layout
 def equivalence(robot_dir: str | Path, tol: float = 1e-9, configs: int = EQUIVALENCE_CONFIGS,
                 notes: list[str] | None = None) -> dict[str, list[str]]:
     """Compare the URDF, SDF and MJCF of a build folder pairwise; {comparison: differences}.
+    A folder whose MJCF the build left out (a limit of the format) compares the others.
 
     ``notes`` is kept for comparisons that cannot be made (none today)."""
     layout = robot_layout(robot_dir)
     u = k.read_urdf(layout.urdf)
-    m = k.read_mjcf(layout.mjcf)
     s = k.read_sdf(layout.sdf)
     g = k.read_urdf_via_libsdformat(layout.urdf)
-    result = {
-        "URDF (MuJoCo) vs MJCF (MuJoCo)": k.compare(u, m, tol, configs, ignore=("velocity",)),
-        "URDF (MuJoCo) vs SDF": k.compare(u, s, tol, configs, ignore=("mimic",)),
-    }
+    result = {}
+    if "mjcf" not in layout.left_out():
+        result["URDF (MuJoCo) vs MJCF (MuJoCo)"] = k.compare(u, k.read_mjcf(layout.mjcf), tol, configs,
+                                                            ignore=("velocity",))
+    result["URDF (MuJoCo) vs SDF"] = k.compare(u, s, tol, configs, ignore=("mimic",))
     # Gazebo spawns a URDF through libsdformat's conversion, which lumps every fixed joint and
     # reprints each orientation (to sqrt(eps) at a pitch of +-pi/2)
     result["URDF (libsdformat) vs URDF lumped as Gazebo does"] = k.compare(

@@ -27,6 +27,7 @@ def render(findings: list[Finding], fmt: str, source: str, fail_on: str = "error
                "warnings": sum(f.severity == "warning" for f in findings), "fail_on": fail_on,
                "failed": sum(f.fails(fail_on) for f in findings),
                "stages": [{"stage": s.name, "verdict": s.verdict, "subjects": s.subjects}
+                          | ({"why": s.why} if s.why else {})
                           | ({"seconds": round(timings[s.name], 3)} if s.name in (timings or {}) else {})
                           for s in stages(findings, cases or [])],
                "findings": [asdict(f) for f in findings]}
@@ -105,38 +106,55 @@ class Stage:
     subjects: int  # the files or subjects it ran on
     verdict: str  # ok | skipped | 1 error | 2 warnings | 1 error, 2 warnings
     why: str = ""  # why it was skipped
+    compared: str = "URDF, model.sdf, MJCF"  # the equivalence stage's formats (no MJCF when it was skipped)
 
     @property
     def label(self) -> str:
         if self.name == "lints" and self.subjects:
             return f"lints ({self.subjects} links and joints)"
         if self.name == "equivalence":
-            return f"equivalence (URDF, model.sdf, MJCF and Gazebo's URDF at {EQUIVALENCE_CONFIGS} configurations)"
+            return f"equivalence ({self.compared} and Gazebo's URDF at {EQUIVALENCE_CONFIGS} configurations)"
         if self.name in ("check_urdf", "ign sdf -k", "mujoco") and self.subjects > 1:
             return f"{self.name} ({self.subjects} files)"
         return self.name
 
 
+SKIPPED = "skipped: "
+"""The subject of a case that did not run (:func:`skipped_case`)."""
+
+
+def skipped_case(check: str, why: str) -> tuple[str, str]:
+    """The case of a stage that was not run, and why (a stage that needs a file the build left out)."""
+    return check, SKIPPED + why
+
+
 def stages(findings: list[Finding], cases: list[tuple[str, str]]) -> list[Stage]:
     """Each stage that ran (a case of ``cases``, or a finding of its) with its verdict: ``ok``,
-    the count of its findings, or ``skipped`` when all it says is that its program is not installed."""
+    the count of its findings, or ``skipped`` when all it says is that its program is not installed
+    or it was not run (:func:`skipped_case`: its reason)."""
     subjects: dict[str, set[str]] = {}
     found: dict[str, list[Finding]] = {}
+    skips = {_stage_of(check): subject.removeprefix(SKIPPED) for check, subject in cases if subject.startswith(SKIPPED)}
     for check, subject in cases:
-        subjects.setdefault(_stage_of(check), set()).add(subject)
+        if not subject.startswith(SKIPPED):
+            subjects.setdefault(_stage_of(check), set()).add(subject)
     for f in findings:
         if f.check != "input":
             found.setdefault(_stage_of(f.check), []).append(f)
     out = []
-    for name in sorted(subjects.keys() | found.keys(), key=lambda s: (ORDER + (s,)).index(s)):
+    for name in sorted(subjects.keys() | found.keys() | skips.keys(), key=lambda s: (ORDER + (s,)).index(s)):
         items = found.get(name, [])
+        if name in skips and not items and name not in subjects:
+            out.append(Stage(name, 0, "skipped", skips[name]))
+            continue
         errors = sum(f.severity == "error" for f in items)
         verdict = ", ".join(([_count(errors, "error")] if errors else [])
                             + ([_count(len(items) - errors, "warning")] if len(items) > errors else [])) or "ok"
         # a validator whose program is missing did not run; a consumer missing is one of several
         missing = name != "consumers" and items and all("not installed" in f.message for f in items)
         out.append(Stage(name, len(subjects.get(name, ())), "skipped" if missing else verdict,
-                         "; ".join(dict.fromkeys(f.message for f in items)) if missing else ""))
+                         "; ".join(dict.fromkeys(f.message for f in items)) if missing else "",
+                         "URDF, model.sdf" if "mujoco" in skips else Stage.compared))
     return out
 
 
@@ -216,7 +234,8 @@ def _junit(findings: list[Finding], source: str, fail_on: str, ran: list[tuple[s
     failing = [any(x.fails(fail_on) for x in v) for v in cases.values()]
     total = len(cases) + len(passed)
     suite = ET.Element("testsuite", name=f"robotkit check {source}", tests=str(max(total, 1)),
-                       failures=str(sum(failing)), errors="0", skipped="0")
+                       failures=str(sum(failing)), errors="0",
+                       skipped=str(sum(subject.startswith(SKIPPED) for _, subject in passed)))
     if not total:
         ET.SubElement(suite, "testcase", classname="robotkit", name="all checks")
     for ((check, subject), items), fails in zip(cases.items(), failing):
@@ -229,7 +248,10 @@ def _junit(findings: list[Finding], source: str, fail_on: str, ran: list[tuple[s
         else:
             ET.SubElement(case, "system-out").text = text
     for check, subject in passed:
-        ET.SubElement(suite, "testcase", classname=f"robotkit.{check}", name=subject)
+        case = ET.SubElement(suite, "testcase", classname=f"robotkit.{check}",
+                             name=subject if not subject.startswith(SKIPPED) else check)
+        if subject.startswith(SKIPPED):
+            ET.SubElement(case, "skipped", message=subject.removeprefix(SKIPPED))
     suites = ET.Element("testsuites", tests=suite.get("tests"), failures=suite.get("failures"), errors="0")
     suites.append(suite)
     return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(suites, encoding="unicode") + "\n"

@@ -11,10 +11,11 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from robotkit.check import Clock, check_build_dir, check_model_file, check_urdf_file, check_xacro_file, xacro_robot
+from robotkit.check import (MJCF_STAGES, Clock, check_build_dir, check_model_file, check_urdf_file, check_xacro_file,
+                            mjcf_left_out, xacro_robot)
 from robotkit.check.findings import Finding, input_findings
 from robotkit.check.locate import element_lines, locate
-from robotkit.check.render import job_summary, render
+from robotkit.check.render import job_summary, render, skipped_case
 from robotkit.commands.build import cores
 from robotkit.commands.inputs import classify, package_paths
 from robotkit.emit.layout import RobotLayout, robot_layout
@@ -190,7 +191,14 @@ def _described(file: Path) -> list[tuple[str, str]]:
 
 
 def _folder_cases(d: RobotLayout) -> list[tuple[str, str]]:
+    """The cases of a build folder's check; the stages that need the MJCF skipped, with the
+    reason, when the build left it out (robotkit.check.mjcf_left_out)."""
     robot = f"robot '{d.name}'"
+    lost = mjcf_left_out(d.root)
+    if lost is not None:
+        return ([("check_urdf", str(d.urdf)), ("ign sdf -k", str(d.sdf))]
+                + [(c, robot) for c in ("equivalence", "consumer")]
+                + [skipped_case(c, lost) for c in MJCF_STAGES] + _described(d.urdf))
     files = [("check_urdf", d.urdf), ("ign sdf -k", d.sdf), ("mujoco", d.mjcf), ("mujoco", d.scene)]
     return ([(c, str(f)) for c, f in files]
             + [(c, robot) for c in ("equivalence", "consumer", "simulation", "self-collision")]

@@ -9,6 +9,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from robotkit.check import mjcf_left_out
 from robotkit.check.motion.stage import has_actuators, motion_stage
 from robotkit.commands.inputs import classify, enclosing_build, package_paths
 from robotkit.emit.layout import robot_layout
@@ -42,13 +43,13 @@ def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = No
     if what.kind == "build":
         robot = what.one_robot()
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
-                                motion=step_responses(robot))
+                                no_pictures=no_pictures(robot), motion=step_responses(robot))
     if what.kind == "recipe":
         loaded = load_recipe(p, args, variant)
         build([p], build_out, report=False, args=args, variant=variant or loaded.variant)
         robot = robot_layout(Path(build_out) / loaded.recipe.robot)
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
-                                loaded.recipe.measured_mass, motion=step_responses(robot))
+                                loaded.recipe.measured_mass, no_pictures(robot), step_responses(robot))
     if what.kind == "sdf" and (robot := enclosing_build(p)) is not None:  # a build folder's SDF is drawn
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p))
     out = Path(out_dir) if out_dir else p.parent / f"{p.stem}-report"
@@ -57,6 +58,13 @@ def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = No
             mjcf, notes = _built_mjcf(p, Path(tmp), package_paths or {})
             return report_urdf(p, out, package_paths or {}, mjcf, notes)
     return report_model_file(p, out, what.kind)
+
+
+def no_pictures(robot) -> str | None:
+    """Why a build folder's report has no pictures (they are drawn in MuJoCo, from its MJCF, which
+    the build left out at the format's own limit); None when it has them."""
+    lost = mjcf_left_out(robot.root)
+    return None if lost is None else f"No pictures: {lost} (the pictures are drawn in MuJoCo, from the MJCF)"
 
 
 def step_responses(robot) -> dict | None:

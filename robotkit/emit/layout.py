@@ -8,6 +8,7 @@ build's own records (mesh facts, collision pieces, inertials) live in ``OUT/.rob
 
 from __future__ import annotations
 
+import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -106,8 +107,18 @@ class RobotLayout:
         return self.path(MESHES)
 
     def is_build(self) -> bool:
-        """A robotkit build folder: its model.sdf and its mjcf/ folder are there."""
-        return self.sdf.is_file() and self.mjcf.parent.is_dir()
+        """A robotkit build folder: its model.sdf and its mjcf/ folder are there, or its MJCF was
+        left out at the format's own limit (:meth:`left_out`)."""
+        return self.sdf.is_file() and (self.mjcf.parent.is_dir() or "mjcf" in self.left_out())
+
+    def left_out(self) -> dict[str, str]:
+        """The formats the build left out at their own limits, and why (report.json's ``left_out``:
+        MJCF for a chain deeper than MuJoCo reads); none without a readable report.json."""
+        try:
+            lost = json.loads(self.report_json.read_text(encoding="utf-8")).get("left_out", {})
+        except (OSError, ValueError, AttributeError):
+            return {}
+        return lost if isinstance(lost, dict) else {}
 
 
 def robot_layout(root: str | os.PathLike) -> RobotLayout:

@@ -97,6 +97,9 @@ def summary(robot: Robot, facts: dict) -> dict:
            "limits": {fmt: limits for fmt, items in every.items()
                       if (limits := [str(x) for x in items if isinstance(x, Limit)])},
            "consumers": consumers(robot), "meshes": meshes, "inertials": links, "collision": collision}
+    lost = {f.name: why for f in mjcf.FORMATS if f.limit is not None and (why := f.limit(robot))}
+    if lost:  # the formats the build leaves out at their own limits (robotkit.emit.formats.Outputs.lost)
+        out["left_out"] = lost
     if robot.drive_report:  # the tuner's gains, their reasons and checks (robotkit.model.gains)
         out["actuators"] = json.loads(robot.drive_report)
     if robot.poses:

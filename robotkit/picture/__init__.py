@@ -35,7 +35,7 @@ def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: flo
     the motion stage's results, plotted."""
     layout = robot_layout(robot_dir)
     name, urdf, mjcf = layout.name, layout.urdf, layout.mjcf
-    for f in (urdf, mjcf):
+    for f in (urdf, mjcf) if no_pictures is None else (urdf,):  # no pictures, no MJCF needed
         if not f.is_file():
             raise RobotkitError(Problem(f"not a robotkit build folder: {f.relative_to(robot_dir)} is missing",
                                         file=str(robot_dir)))
