@@ -475,15 +475,10 @@ def cached_task(op: str, out: str, deps: list[str], outputs: dict, action: str, 
     picture record: a report drawn without pictures is not stored), ``gl`` (the key holds
     :func:`gl_backend`).  A failed action stores
     nothing.  Hits and misses write the same bytes: a rebuild from the cache is byte-identical."""
-    out, deps = os.path.abspath(out), sorted(set(deps))  # file_dep built from a set comes in any order
+    out = os.path.abspath(out)
     run = globals()[action]
     try:
-        params = {"op": op, "version": RESULTS_VERSION, "code": code_digest(),
-                  "libraries": library_versions(RESULT_LIBRARIES), "gl": gl_backend() if outputs.get("gl") else None,
-                  "args": [_arg_key(a, out) for a in args], "deps": [_keyed(d, out) for d in deps]}
-        inputs = [Path(d).read_bytes() for d in deps]
-        cache = Cache(versions={})
-        key = cache.key(f"task/{op}", params, inputs)
+        cache, key = _task_key(op, out, deps, outputs, args)
     except (OSError, TypeError, ValueError):  # a dependency missing, or args that are no key: just run it
         return run(*args)
     files = cache.get(key)
@@ -496,6 +491,44 @@ def cached_task(op: str, out: str, deps: list[str], outputs: dict, action: str, 
     if files is not None:
         cache.put(key, files, op=f"task/{op}", params={"op": op})
     return None
+
+
+_KEYS: dict = {}  # (op, out, id(args), its files' stats) -> (args, key): warm() asked, cached_task runs
+
+
+def _task_key(op: str, out: str, deps: list[str], outputs: dict, args: list) -> tuple[Cache, str]:
+    """The cache and the key of :func:`cached_task`'s result (OSError: a dependency is missing;
+    TypeError, ValueError: ``args`` are no key).  Computed once per task and process while its
+    files keep their size and time (:func:`in_cache`, then the task in the same process)."""
+    deps = sorted(set(deps))  # file_dep built from a set comes in any order
+    stats = tuple((d, s.st_size, s.st_mtime_ns) for d in deps for s in (os.stat(d),))
+    memo = (op, out, id(args), stats, bool(outputs.get("gl")))
+    hit = _KEYS.get(memo)
+    if hit is not None and hit[0] is args:
+        return Cache(versions={}), hit[1]
+    cache, key = _compute_key(op, out, deps, outputs, args)
+    _KEYS[memo] = (args, key)
+    return cache, key
+
+
+def _compute_key(op: str, out: str, deps: list[str], outputs: dict, args: list) -> tuple[Cache, str]:
+    params = {"op": op, "version": RESULTS_VERSION, "code": code_digest(),
+              "libraries": library_versions(RESULT_LIBRARIES), "gl": gl_backend() if outputs.get("gl") else None,
+              "args": [_arg_key(a, out) for a in args], "deps": [_keyed(d, out) for d in deps]}
+    inputs = [Path(d).read_bytes() for d in deps]
+    cache = Cache(versions={})
+    return cache, cache.key(f"task/{op}", params, inputs)
+
+
+def in_cache(op: str, out: str, deps: list[str], outputs: dict, action: str, args: list) -> bool:
+    """Whether :func:`cached_task` on these arguments would find its result in this machine's
+    cache (an entry of a shared cache not copied here yet counts as absent).  Only asks: the
+    entry is not read."""
+    try:
+        cache, key = _task_key(op, os.path.abspath(out), deps, outputs, args)
+    except (OSError, TypeError, ValueError):
+        return False
+    return cache.manifest_path(key).exists()
 
 
 def _output_paths(outputs: dict) -> list[str] | None:

@@ -16,10 +16,12 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from doit.cmd_base import TaskLoader2
-from doit.doit_cmd import DoitMain
-from doit.exceptions import TaskFailed, UnmetDependency
-from doit.task import dict_to_task
+from doit.control import TaskControl
+from doit.dependency import Dependency, JSONCodec, MD5Checker, SqliteDB
+from doit.exceptions import InvalidDodoFile, InvalidTask, TaskFailed, UnmetDependency
+from doit.globals import Globals
+from doit.runner import MRunner, Runner
+from doit.task import Stream, dict_to_task
 
 from robotkit.emit.env import template_dirs
 from robotkit.emit.formats import Outputs, outputs_of, unknown_outputs
@@ -27,7 +29,7 @@ from robotkit.emit.layout import output_path
 from robotkit.emit.registry import FORMATS
 from robotkit.errors import Problem, RobotkitError
 from robotkit.model.load import load_robots, mesh_locations
-from robotkit.pipeline import stamp
+from robotkit.pipeline import actions, stamp
 from robotkit.pipeline.buildwarn import build_warnings, no_pictures, warning_line
 from robotkit.pipeline.progress import Progress
 from robotkit.pipeline.publish import STATE, loss_warning, publish, stage_dir, staged_files
@@ -219,24 +221,49 @@ def losses(robots, chosen: dict[str, Outputs], report: bool) -> list[tuple[str, 
 
 
 def run_doit(tasks: list[dict], out: Path, recorder: "_Recorder", jobs: int = 1) -> int:
-    """Run the task dicts through doit's API (its database in ``out``); doit's exit status."""
-    class Loader(TaskLoader2):
-        def setup(self, opt_values):
-            pass
-
-        def load_doit_config(self):
-            return doit_config(out, recorder)
-
-        def load_tasks(self, cmd, pos_args):
-            return [dict_to_task(dict(t)) for t in tasks]
-
-    args = ["run"]
-    if jobs > 1:
-        args += ["-n", str(jobs), "-P", "process"]
+    """Run the task dicts with doit's runner (its database in ``out``, the settings of
+    :func:`doit_config`): in this process, or in ``jobs`` worker processes unless every task would
+    be a cache hit (:func:`warm`: then a process pool costs more than the tasks).  doit's
+    command line is not used (it looks its plugins up in every installed package's metadata).
+    doit's exit status: 0, 1 a task failed, 2 a task raised, 3 the tasks are invalid."""
+    cfg = doit_config(out)
     try:
-        return DoitMain(Loader(), config_filenames=()).run(args)
+        control = TaskControl([dict_to_task(dict(t)) for t in tasks])
+        control.process(None)  # every task
+    except (InvalidTask, InvalidDodoFile) as exc:
+        recorder.runtime_error(str(exc))
+        recorder.progress.clear()
+        return 3
+    dep_manager = Dependency(SqliteDB, cfg["dep_file"], checker_cls=MD5Checker, codec_cls=JSONCodec)
+    Globals.dep_manager = dep_manager
+    options = (dep_manager, recorder, cfg["continue"], False, Stream(cfg["verbosity"]))
+    parallel = jobs > 1 and MRunner.available() and not warm(tasks)
+    runner = MRunner(*options, jobs) if parallel else Runner(*options)
+    try:
+        return runner.run_all(control.task_dispatcher())
     finally:
         recorder.progress.clear()  # no progress line left behind, whatever happened
+
+
+def warm(tasks: list[dict]) -> bool:
+    """Whether every cached task that reads no other task's output finds its result in the cache
+    (:func:`robotkit.pipeline.actions.in_cache`): a build from the cache (a fresh output folder,
+    or another branch's), whose tasks then take milliseconds each.  The others are not asked
+    (their inputs are not written yet): they come from the same cache when these do, and a task
+    after an edit runs where it would have (in this process rather than in a worker).  Stops at
+    the first miss, so a cold build pays one lookup."""
+    targets = {str(Path(t).absolute()) for task in tasks for t in task.get("targets", [])}
+    for task in tasks:
+        for fn, args in task.get("actions", []):
+            if fn is actions.copy_file:  # a file copied: as cheap in this process
+                continue
+            if fn is not actions.cached_task:  # a world, never cached: the pool
+                return False
+            if any(str(Path(d).absolute()) in targets for d in task.get("file_dep", [])):
+                continue
+            if not actions.in_cache(*args):
+                return False
+    return True
 
 
 def _failure(result: BuildResult, recipes: dict[str, str]) -> RobotkitError:

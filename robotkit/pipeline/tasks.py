@@ -321,9 +321,10 @@ def self_collision_tasks(place: Place, written: list[str]) -> list[dict]:
     if target is None:
         return []
     facts = {**place.facts, **place.proxies}
-    geometry = {k: v for k, v in robot.to_dict().items() if k in ("name", "joints", "base", "poses", "self_collision")}
+    plain = robot.to_dict()
+    geometry = {k: v for k, v in plain.items() if k in ("name", "joints", "base", "poses", "self_collision")}
     geometry["links"] = [{k: v for k, v in link.items() if k not in ("inertial_spec", "inertial")}
-                         for link in robot.to_dict()["links"]]
+                         for link in plain["links"]]
     return [cached({
         "name": f"{robot.name}:self-collision",
         "doc": "self-collision matrix",

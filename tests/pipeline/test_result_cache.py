@@ -11,7 +11,9 @@ from pathlib import Path
 import pytest
 
 from robotkit.mesh.cache import Cache, Files
-from robotkit.pipeline.runner import build
+from robotkit.model.load import load_robots, mesh_locations
+from robotkit.pipeline.runner import build, warm
+from robotkit.pipeline.tasks import robot_tasks
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -100,3 +102,23 @@ def test_the_report_key_is_what_the_pictures_are_drawn_from(project):
     build([project / "bot.yaml"], project / "three", report=True)
     assert len(entries(project / "cache", "report-html")) == 2
     assert files(project / "one" / "bot") == files(project / "two" / "bot")
+
+
+def tasks_of(recipe: Path, out: Path) -> list[dict]:
+    return [t for loaded, robot in load_robots([recipe])
+            for t in robot_tasks(robot, out.absolute(), mesh_locations(loaded, robot))]
+
+
+def test_a_build_from_the_cache_runs_in_this_process(project):
+    """warm(): a build whose tasks all find their results in the cache runs in this process (no
+    doit process pool) even with -j 2; a cold one, or one with a changed mesh, in the pool.  The
+    files and the tasks run are the same either way."""
+    recipe = project / "bot.yaml"
+    assert not warm(tasks_of(recipe, project / "one"))  # an empty cache
+    first = build([recipe], project / "one", jobs=2)
+    assert warm(tasks_of(recipe, project / "two"))
+    second = build([recipe], project / "two", jobs=2)
+    assert sorted(second.ran) == sorted(first.ran) and not second.failed and not second.errors
+    assert files(project / "two" / "bot") == files(project / "one" / "bot")
+    shutil.copy(REPO / "recipes" / "meshes" / "turret_bot" / "rotor.stl", project / "slider.stl")
+    assert not warm(tasks_of(recipe, project / "three"))  # the mesh's facts are to compute
