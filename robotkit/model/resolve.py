@@ -579,12 +579,6 @@ def _check_tree(link_names: list[str], joints: list[Joint], marks) -> list[Probl
                                           "a link has at most one"))
         else:
             parent_of.setdefault(j.child, j.name)
-    for j in joints:
-        if j.name in known:
-            problems.append(marks.problem(("joints", j.name),
-                                          f"joint '{j.name}' is named like a link: Gazebo (libsdformat) reads a "
-                                          "URDF's links and joints as one set of names and refuses the robot; "
-                                          f"name the joint apart ('{j.name}_joint', say)"))
     roots = [n for n in link_names if n not in parent_of]
     dangling = any(j.parent not in known or j.child not in known for j in joints)
     if len(roots) > 1 and not dangling:  # a joint naming a missing link is reported already

@@ -129,8 +129,8 @@ def test_massless_links_weigh_nothing_in_every_consumer(tmp_path):
 
 
 def test_a_link_and_a_joint_with_the_same_name(tmp_path):
-    """ROS accepts it (ANYmal's LF_HAA), libsdformat refuses the URDF: the recipe is refused with its
-    line, nothing written (an import renames such a joint, stated)."""
+    """ROS accepts it (ANYmal's LF_HAA); an SDF model needs the names apart."""
+    consumers_installed()
     recipe = write_recipe(tmp_path, """
         robot: clash
         links:
@@ -145,13 +145,13 @@ def test_a_link_and_a_joint_with_the_same_name(tmp_path):
             axis: [1, 0, 0]
             limit: {lower: -0.5, upper: 0.5, effort: 5, velocity: 2}
     """)
-    proc = run_cli("build", recipe, "--out", tmp_path / "out", cwd=tmp_path)
-    assert proc.returncode == 2
-    assert proc.stderr.strip().splitlines()[-1] == (
-        f"{recipe.name}:6: joints.LF_HAA: joint 'LF_HAA' is named like a link: Gazebo (libsdformat) reads a "
-        "URDF's links and joints as one set of names and refuses the robot; name the joint apart "
-        "('LF_HAA_joint', say)")
-    assert not (tmp_path / "out" / "clash").exists()
+    result = build([recipe], tmp_path / "out")
+    assert ("clash: SDF: joint 'LF_HAA' is named 'LF_HAA_joint' in model.sdf: SDF needs link, joint and "
+            "frame names unique within a model") in result.warnings
+    b = build_of(tmp_path / "out", "clash")
+    ign_sdf_check(b.sdf)
+    findings, _ = consumer_findings(b)
+    assert [str(f) for f in findings] == []
 
 
 def test_a_robot_a_consumer_refuses_fails_the_build_naming_the_link(tmp_path):
