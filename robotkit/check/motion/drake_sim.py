@@ -170,9 +170,8 @@ def record(rec: Recorder, joints: dict, nq: int, stepped: int, states, taus, sta
     """Steps ``start`` to ``end`` from the logs into ``rec``: the state at step i's start, the net
     actuation of the stepped joint at its end.  False when the recorder saw a divergence."""
     x, u = states.data(), taus.data()
-    for i in range(start, min(end, x.shape[1], u.shape[1] - 1)):
-        q, v = x[:nq, i], x[nq:, i]
-        if not rec.record(i * rec.timestep, {n: float(q[a]) for n, (a, _) in joints.items()},
-                          {n: float(v[b]) for n, (_, b) in joints.items()}, float(u[stepped, i + 1])):
-            return False
-    return True
+    i = np.arange(start, min(end, x.shape[1], u.shape[1] - 1))
+    names = list(joints)
+    q = x[[joints[n][0] for n in names]][:, i].T
+    v = x[[nq + joints[n][1] for n in names]][:, i].T
+    return rec.record_many(i * rec.timestep, names, q, v, u[stepped, i + 1])
