@@ -235,11 +235,16 @@ def plain_mesh(path: Path) -> tuple[np.ndarray, np.ndarray] | None:
     if len(used) != len(V):
         return None
     keys = np.round(V * 1e8).astype(np.int64)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    by_key = np.lexsort(keys.T[::-1])  # stable: a group's first row is its first appearance
+    k = keys[by_key]
+    starts = np.r_[True, (k[1:] != k[:-1]).any(axis=1)]
+    inverse = np.empty(len(V), dtype=np.int64)
+    inverse[by_key] = np.cumsum(starts) - 1
+    first = by_key[starts]
     order = np.argsort(first)  # keep_order: the merged vertices in order of first appearance
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
-    return V[first[order]], rank[inverse.reshape(-1)][F]
+    return V[first[order]], rank[inverse][F]
 
 
 def _plain_obj(data: bytes):
