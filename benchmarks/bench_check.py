@@ -5,7 +5,8 @@ temporary folder (or ``--out``, kept: a second run reuses it), then checked ``--
 whole ``robotkit check FOLDER --format json`` process each.  Per stage: the median of its wall time
 in seconds as the JSON gives it (``stages[].seconds``; the stages run at once, so they add up to more
 than the total); then the median of the check's own total (``seconds``), of the process's wall
-time and of its CPU time (user + system, with its worker processes and the programs it runs).
+time and of its CPU time (user + system, with its worker processes and the programs it runs, those left running at
+its exit included: the benchmark is their subreaper).
 The load average at the start and the end says how busy the machine was.
 
 ``python benchmarks/bench_check.py [--robots ur5 turret_bot] [--repeat 5] [--out DIR]``
@@ -34,11 +35,33 @@ def children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
+def reap_orphans() -> None:
+    """Become the subreaper of this process's descendants (Linux), so that worker processes the
+    check leaves running when it exits (a pool shut down without waiting) are reparented here and
+    their CPU time is counted when :func:`wait_orphans` reaps them."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0)  # PR_SET_CHILD_SUBREAPER
+    except (OSError, AttributeError):
+        pass
+
+
+def wait_orphans() -> None:
+    while True:
+        try:
+            os.waitpid(-1, 0)
+        except ChildProcessError:
+            return
+
+
 def check_once(folder: Path) -> dict:
     cpu, t0 = children_cpu(), time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "robotkit", "check", str(folder), "--format", "json"],
                           capture_output=True, text=True)
-    wall, cpu = time.perf_counter() - t0, children_cpu() - cpu
+    wall = time.perf_counter() - t0
+    wait_orphans()
+    cpu = children_cpu() - cpu
     if proc.returncode not in (0, 1):
         raise SystemExit(f"robotkit check {folder} failed ({proc.returncode}):\n{proc.stderr}")
     data = json.loads(proc.stdout)
@@ -52,6 +75,7 @@ def main() -> int:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--out", help="build folder to keep (default: a temporary one)")
     args = ap.parse_args()
+    reap_orphans()
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the start; "
           f"medians of {args.repeat} checks, seconds")
     with tempfile.TemporaryDirectory(prefix="bench_check.") as tmp:

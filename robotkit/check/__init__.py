@@ -228,21 +228,29 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
     clock, subject = Clock(timings), f"robot '{name}'"
     build = Build(name, robot_dir, urdf, sdf, None if lost else mjcf, _base(layout, lost))
     consumers_started = time.perf_counter()
-    workers = _fork_pool()  # forked first, from one thread
+    workers, collider = _fork_pool(), _fork_pool()  # forked first, from one thread
     try:
         own = workers.submit(_own_consumers, build)
         started = None if lost else start_motion(mjcf, urdf, {name: robot_dir})  # beside the other stages
+        collisions = None if lost else collider.submit(_interference, robot_dir, subject)  # forked with MuJoCo
         findings, gazebo = _main_stages(build, clock, declared_mass)
         findings += _merged_consumers(gazebo, own, subject)
+        clock.add("consumers", time.perf_counter() - consumers_started)
+        if lost:
+            return findings
+        findings += clock.timed("simulation", lambda: _stage("simulation", subject, lambda: _simulate(scene, subject)))
+        found, seconds = _stage_outcome("self-collision", subject, collisions)
+        clock.add("self-collision", seconds)
+        findings += found
     finally:
         workers.shutdown(wait=False, cancel_futures=True)
-    clock.add("consumers", time.perf_counter() - consumers_started)
-    if lost:
-        return findings
-    findings += clock.timed("simulation", lambda: _stage("simulation", subject, lambda: _simulate(scene, subject)))
-    findings += clock.timed("self-collision", lambda: _stage("self-collision", subject,
-                                                             lambda: interference(robot_dir)))
+        collider.shutdown(wait=False, cancel_futures=True)
     return findings + unreported_missing(findings, finish_motion(started, subject, name, motion, clock))
+
+
+def _interference(robot_dir: Path, subject: str) -> tuple[list[Finding], float]:
+    """The self-collision stage, in a worker process beside the main process's stages."""
+    return _timed(lambda: _stage("self-collision", subject, lambda: interference(robot_dir)))
 
 
 def _base(layout, lost: bool) -> str:

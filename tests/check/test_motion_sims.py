@@ -222,3 +222,32 @@ def test_mujoco_holds_a_free_base(tmp_path):
                                atol=1e-12)
     falling = simulate_mujoco(free, [CRITICAL], step, hold_base=False)
     assert falling.diverged is None  # the whole robot falls: the hinge's response is not the held one
+
+
+@pytest.mark.parametrize("bad", [None, "nan", "explode"])
+def test_record_many_is_record_row_by_row(bad):
+    """Drake's runs are recorded from Drake's logs in numpy: the same trace, hold and divergence
+    as recording each control step in turn."""
+    from robotkit.check.motion.law import Recorder
+
+    drives = [Drive("a", "position", 10.0, 1.0), Drive("b", "position", 10.0, 1.0)]
+    step = Step("a", {"a": 0.1, "b": -0.2}, 0.3)
+    rng = np.random.default_rng(7)
+    t = np.arange(50) * 2e-3
+    q, qd, tau = rng.normal(size=(50, 2)), rng.normal(size=(50, 2)), rng.normal(size=50)
+    if bad == "nan":
+        q[31, 1] = np.nan
+    elif bad == "explode":
+        qd[17, 0] = -2e3
+    one, many = Recorder("drake", 2e-3, step, drives), Recorder("drake", 2e-3, step, drives)
+    for k in range(50):
+        if not one.record(float(t[k]), dict(zip("ab", q[k].tolist())), dict(zip("ab", qd[k].tolist())),
+                          float(tau[k])):
+            break
+    assert many.record_many(t[:20], ["a", "b"], q[:20], qd[:20], tau[:20]) == (bad != "explode")
+    if bad != "explode":
+        many.record_many(t[20:], ["a", "b"], q[20:], qd[20:], tau[20:])
+    a, b = one.trace(), many.trace()
+    assert (a.diverged, a.others_max_dev, len(a.t)) == (b.diverged, b.others_max_dev, len(b.t))
+    assert all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ("t", "q", "qd", "tau"))
+    assert (a.diverged is None) == (bad is None)

@@ -7,7 +7,9 @@ inertia = armature, added to the joint's diagonal mass) and effort limit = effor
 and velocity drives use Drake's implicit PD controllers (p=kp, d=kd; velocity: p=0, d=kv)
 fed the desired state; Drake clamps PD + feed-forward to the effort limit, the law's clip.
 Gravity compensation is the feed-forward on the actuation input: -CalcGravityGeneralizedForces
-at the current state, recomputed every control step.  Effort drives get actuation 0 (+ that)."""
+at the current state (Drake's InverseDynamics in gravity mode, in the diagram), recomputed every
+control step.  Effort drives get actuation 0 (+ that).  The state and the net actuation are logged
+inside Drake, so a run is a few AdvanceTo calls, not a Python call per step."""
 
 from __future__ import annotations
 
@@ -82,17 +84,78 @@ def single_dof_joints(plant, model) -> dict[str, tuple[int, int]]:
     return {j.name(): (j.position_start(), j.velocity_start()) for j in joints if j.num_positions() == 1}
 
 
+CHUNK = 100
+"""Control steps per AdvanceTo: the state is logged inside Drake, and looked at between chunks."""
+
+
 def run(plant, model, actuators: dict, drives: list[Drive], step: Step, rec: Recorder) -> None:
+    """The whole run in one diagram: the gravity compensation is Drake's InverseDynamics (gravity
+    mode) through a gain that routes each gravcomp drive's joint torque to its actuator, and the
+    state and net actuation are logged every control step, so no Python runs per step."""
     from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
 
     joints = single_dof_joints(plant, model)
-    simulator = Simulator(plant)
-    context = simulator.get_mutable_context()
+    builder = DiagramBuilder()
+    builder.AddSystem(plant)
+    gravity = gravity_feedforward(builder, plant, actuators, drives, joints)
+    state_log, tau_log = (log_every(builder, port, rec.timestep)
+                          for port in (plant.get_state_output_port(), plant.get_net_actuation_output_port()))
+    diagram = builder.Build()
+    simulator = Simulator(diagram)
+    context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())
     q0 = plant.GetPositions(context).copy()
     for name, value in step.start.items():
         if name in joints:
             q0[joints[name][0]] = value
     plant.SetPositions(context, q0)
+    fix_desired(plant, model, context, drives, step)
+    if not gravity:
+        plant.get_actuation_input_port().FixValue(context, np.zeros(plant.num_actuated_dofs()))
+    simulator.Initialize()
+    root = simulator.get_context()
+    nq, steps, done = plant.num_positions(), rec.steps(), 0
+    stepped = actuators[step.joint].input_start()
+    while done < steps:
+        end = min(done + CHUNK, steps)
+        try:
+            simulator.AdvanceTo(end * rec.timestep)
+        except RuntimeError:
+            if record(rec, joints, nq, stepped, state_log.FindLog(root), tau_log.FindLog(root), done, steps):
+                raise  # not a divergence the samples show: Drake's own failure
+            return
+        if not record(rec, joints, nq, stepped, state_log.FindLog(root), tau_log.FindLog(root), done, end):
+            return
+        done = end
+
+
+def gravity_feedforward(builder, plant, actuators: dict, drives: list[Drive], joints: dict) -> bool:
+    """-CalcGravityGeneralizedForces of the current state on each gravcomp drive's actuator."""
+    from pydrake.systems.controllers import InverseDynamics
+    from pydrake.systems.primitives import MatrixGain
+
+    routed = [d for d in drives if d.gravcomp]
+    if not routed:
+        return False
+    compensation = builder.AddSystem(InverseDynamics(plant, InverseDynamics.InverseDynamicsMode.kGravityCompensation))
+    select = np.zeros((plant.num_actuated_dofs(), plant.num_velocities()))
+    for d in routed:
+        select[actuators[d.joint].input_start(), joints[d.joint][1]] = 1.0
+    gain = builder.AddSystem(MatrixGain(select))
+    builder.Connect(plant.get_state_output_port(), compensation.get_input_port_estimated_state())
+    builder.Connect(compensation.get_output_port_generalized_force(), gain.get_input_port())
+    builder.Connect(gain.get_output_port(), plant.get_actuation_input_port())
+    return True
+
+
+def log_every(builder, port, period: float):
+    from pydrake.systems.primitives import LogVectorOutput
+
+    return LogVectorOutput(port, builder, period)
+
+
+def fix_desired(plant, model, context, drives: list[Drive], step: Step) -> None:
+    """The PD controllers' desired state: the step's targets."""
     controlled = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(model)
                   if plant.get_joint_actuator(i).has_controller()]
     desired = np.zeros(2 * len(controlled))
@@ -101,21 +164,14 @@ def run(plant, model, actuators: dict, drives: list[Drive], step: Step, rec: Rec
         desired[k], desired[len(controlled) + k] = targets(d, step)
     if controlled:
         plant.get_desired_state_input_port(model).FixValue(context, desired)
-    port = plant.get_actuation_input_port()
-    port.FixValue(context, np.zeros(plant.num_actuated_dofs()))
-    simulator.Initialize()
-    stepped = actuators[step.joint]
-    for i in range(rec.steps()):
-        u = np.zeros(plant.num_actuated_dofs())
-        if any(d.gravcomp for d in drives):
-            gravity = -plant.CalcGravityGeneralizedForces(context)
-            for d in drives:
-                if d.gravcomp:
-                    actuators[d.joint].set_actuation_vector([gravity[joints[d.joint][1]]], u)
-        port.FixValue(context, u)
-        q, v = plant.GetPositions(context), plant.GetVelocities(context)
-        simulator.AdvanceTo((i + 1) * rec.timestep)
-        tau = float(stepped.get_actuation_vector(plant.get_net_actuation_output_port().Eval(context))[0])
-        if not rec.record(i * rec.timestep, {n: float(q[a]) for n, (a, _) in joints.items()},
-                          {n: float(v[b]) for n, (_, b) in joints.items()}, tau):
-            return
+
+
+def record(rec: Recorder, joints: dict, nq: int, stepped: int, states, taus, start: int, end: int) -> bool:
+    """Steps ``start`` to ``end`` from the logs into ``rec``: the state at step i's start, the net
+    actuation of the stepped joint at its end.  False when the recorder saw a divergence."""
+    x, u = states.data(), taus.data()
+    i = np.arange(start, min(end, x.shape[1], u.shape[1] - 1))
+    names = list(joints)
+    q = x[[joints[n][0] for n in names]][:, i].T
+    v = x[[nq + joints[n][1] for n in names]][:, i].T
+    return rec.record_many(i * rec.timestep, names, q, v, u[stepped, i + 1])

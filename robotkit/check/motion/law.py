@@ -117,6 +117,29 @@ class Recorder:
             self.others_max_dev = max(self.others_max_dev, abs(q[j] - self.step.start.get(j, 0.0)))
         return True
 
+    def record_many(self, t: np.ndarray, names: list[str], q: np.ndarray, qd: np.ndarray,
+                    tau: np.ndarray) -> bool:
+        """:meth:`record` of each row in turn (``q``, ``qd``: one column per name in ``names``),
+        in numpy: stops at the first row that is NaN or exploded (``diverged`` set, False)."""
+        bad = ~(np.isfinite(q).all(axis=1) & np.isfinite(qd).all(axis=1))
+        speed = np.abs(qd).max(axis=1, initial=0.0)
+        stop = bad | (speed > EXPLODE_SPEED)
+        n = int(np.argmax(stop)) if stop.any() else len(t)
+        col = {name: k for k, name in enumerate(names)}
+        j = col[self.step.joint]
+        self.rows.extend(zip(t[:n].tolist(), q[:n, j].tolist(), qd[:n, j].tolist(), tau[:n].tolist()))
+        for other in self.others:
+            if n:
+                dev = float(np.abs(q[:n, col[other]] - self.step.start.get(other, 0.0)).max())
+                self.others_max_dev = max(self.others_max_dev, dev)
+        if n == len(t):
+            return True
+        if bad[n]:
+            self.diverged = f"NaN at t={float(t[n]):.4g} s"
+        else:
+            self.diverged = f"exploded at t={float(t[n]):.4g} s (|qd| {float(speed[n]):.3g})"
+        return False
+
     def trace(self) -> Trace:
         a = np.array(self.rows, dtype=float).reshape(-1, 4)
         return Trace(self.simulator, self.timestep, a[:, 0], a[:, 1], a[:, 2], a[:, 3],
