@@ -63,6 +63,8 @@ class Carried:
     collision: dict[str, list[str]] = field(default_factory=dict)
     materials: dict[str, str] = field(default_factory=dict)
     losses: list[str] = field(default_factory=list)
+    named: set[tuple[str, str, str]] = field(default_factory=set)
+    """(link, tag, name) of the named elements carried into a link so far."""
 
 
 def carry(robot: Robot, markup: bool = False) -> Carried:
@@ -163,6 +165,12 @@ def _to_link(out: Carried, ref: str, elem, robot: Robot, frames: set[str]) -> No
             host = host_of(robot, ref)[0]
             if elem.tag == "sensor":
                 _pose_relative_to(elem, ref)
+        key = (host, elem.tag, elem.get("name"))
+        if key[2] and key in out.named:  # TALOS' two sensors 'rgbd_frame_sensor': libsdformat refuses the file
+            out.losses.append(f'<gazebo reference="{ref}">: <{elem.tag} name="{key[2]}"> not in model.sdf: link '
+                              f"'{host}' has a <{elem.tag}> of that name already (SDF needs them apart)")
+            return
+        out.named.add(key)
         out.links.setdefault(host, []).append(_text(elem))
 
 

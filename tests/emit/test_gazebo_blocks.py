@@ -124,6 +124,31 @@ def test_only_what_cannot_be_carried_is_a_loss(blocks):
     ]
 
 
+def test_a_second_sensor_of_one_name_in_one_link_is_a_loss(tmp_path):
+    """TALOS' URDF names two sensors of its head camera 'rgbd_frame_sensor': libsdformat refuses
+    a link holding both (`ign sdf -k`: "sensor with name[rgbd_frame_sensor] already exists")."""
+    from robotkit.emit.sdf import losses, render_sdf
+    from robotkit.model.load import load_robots
+    from robotkit.model.resolve import finalize
+
+    text = BLOCKS.split("urdf_extras:")[0] + """urdf_extras:
+  - >-
+    <gazebo reference="wheel"><sensor name="cam" type="depth"><update_rate>6</update_rate></sensor>
+    <sensor name="cam" type="depth"><update_rate>30</update_rate></sensor></gazebo>
+"""
+    [(_, robot)] = load_robots([write_recipe(tmp_path, text, "twice.yaml")])
+    robot = finalize(robot, {}, {})
+    assert [x for x in losses(robot) if "gazebo" in x] == [
+        '<gazebo reference="wheel">: <sensor name="cam"> not in model.sdf: link \'wheel\' has a <sensor> of '
+        "that name already (SDF needs them apart)"]
+    sdf = tmp_path / "model.sdf"
+    sdf.write_text(render_sdf(robot))
+    wheel = ET.parse(sdf).getroot().find("model/link[@name='wheel']")
+    assert [s.findtext("update_rate") for s in wheel.findall("sensor")] == ["6"]
+    require("ign")
+    ign_sdf_check(sdf)
+
+
 # --- turtlebot3: its recipe's blocks against libsdformat's conversion of its URDF ------------
 
 
