@@ -43,20 +43,9 @@ SAMPLE = {  # robot: the shape it stands for
     "solo12": "quadruped, floating base",
 }
 
-# what main (acdc376) does today, from benchmarks/bench_corpus.py; each line goes when its fix
-# lands (strict: the test fails until it does)
-KNOWN: dict[tuple[str, str], str] = {
-    ("reached", "interbotix_px100"): "import refuses link names with a leading slash ('/base_link')",
-    ("reached", "talos_reduced"): "import refuses <mimic> on fixed joints",
-    ("reached", "iris"): "import refuses rotor limits of +-1e16 (limit.lower >= -10000)",
-    ("reached", "ridgeback"): "import refuses the virtual joints' limits (limit.lower >= -10000)",
-    ("own", "pr2"): "Drake refuses model.sdf: <stopKd> pasted into a <joint> from a <gazebo> block",
-    ("own", "lynxmotion_al5d"): "equivalence: 2.4e-19 against 0.0 (a tolerance relative to zero), and PyBullet",
-    ("own", "abb_irb140"): "PyBullet (URDF) puts link_5 1e-6 m from the description",
-    ("own", "ur5_robot"): "simulation: the robot starts 48.5 mm inside the floor",
-    ("reported", "lynxmotion_al5d"): "velocity limit 0 on j1..j4: check's error, never said by import",
-    ("reported", "abb_irb140"): "effort limit 0 on joint_1..6: check's error, never said by import",
-}
+# what main does today that the issue asks otherwise, one line per (test, robot); each goes when
+# its fix lands (strict: the test fails until it does).  Empty since issue 32's fixes landed.
+KNOWN: dict[tuple[str, str], str] = {}
 
 ALL = os.environ.get("ROBOTKIT_CORPUS_ALL", "") not in ("", "0")
 NAMES = table_names() if ALL else sorted(SAMPLE)
