@@ -60,6 +60,7 @@ def run_mjcf(args) -> int:
     for line in result.verdict.lines():
         print(line)
     recipe = os.path.relpath(result.recipe_path)
+    root = f"--root {shlex.quote(result.root)} " if result.root else ""
     print(f"wrote {recipe} (robot {result.robot}); build it with:")
-    print(f"robotkit build {shlex.quote(recipe)}")
+    print(f"robotkit build {root}{shlex.quote(recipe)}")
     return 0 if result.verdict.ok else 1

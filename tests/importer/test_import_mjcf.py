@@ -234,14 +234,19 @@ def test_missing_file_is_refused(tmp_path):
     assert str(exc.value).endswith("none.xml: file not found")
 
 
-def test_skydio_x2_on_the_command_line(tmp_path):
+def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     """A free-flying Menagerie model: ``base: free``, its site actuators on the ledger (stderr),
-    the verdict and the build command on stdout."""
+    the verdict and the build command on stdout (with the read rules as a user has them: its
+    meshes stay outside the project, and the command that builds it widens the build to them)."""
+    monkeypatch.delenv("ROBOTKIT_ROOT", raising=False)  # conftest widens the read rules
     proc = run_cli("import", X2, "-o", "x2.yaml", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout.splitlines()
     assert out[0] == "verified in MuJoCo against the original at 22 configurations: every quantity agrees"
-    assert out[-2:] == ["wrote x2.yaml (robot Skydio_X2); build it with:", "robotkit build x2.yaml"]
+    assert out[-2:] == ["wrote x2.yaml (robot Skydio_X2); build it with:",
+                        f"robotkit build --root {X2.parent / 'assets'} x2.yaml"]
+    built = run_cli("build", "--root", X2.parent / "assets", "x2.yaml", "--no-report", cwd=tmp_path)
+    assert built.returncode == 0, built.stderr
     assert ("ledger: x2.xml:56: actuator 'thrust1': all: dropped: a site transmission (the recipe's actuators "
             "drive joints)") in proc.stderr.splitlines()
     assert ("ledger: x2.xml:26: material 'phong3SG': all: texture dropped: the recipe's material is a colour "

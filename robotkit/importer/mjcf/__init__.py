@@ -46,6 +46,8 @@ class MjcfImport:
     verdict: Verdict | None = None
     inputs: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    root: str | None = None
+    """The folder outside the project a build of the recipe reads (``--root``), if any."""
 
 
 def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, object]:
@@ -91,8 +93,9 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
               "read through MuJoCo: inertials, shapes and poses as MuJoCo compiled them)"] + _ledger_block(ledger)
     files = [str(src.mesh_file(d)) for d in range(src.model.nmesh) if src.mesh_file(d) is not None]
     read = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
+    root = display_path(os.path.commonpath(read)) if read else None
     notes = [f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: build it "
-             f"with --root {display_path(os.path.commonpath(read))}"] if read else []
+             f"with --root {root}"] if read else []
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     try:
@@ -106,7 +109,7 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
         tmp.unlink(missing_ok=True)
         raise
     os.replace(tmp, out)
-    return MjcfImport(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes)
+    return MjcfImport(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
 
 
 def _verified(src, tree, recipe: Path, build) -> Verdict | None:
