@@ -14,10 +14,10 @@ from robotkit.check.motion.stage import has_actuators, motion_stage
 from robotkit.commands.inputs import classify, enclosing_build, package_paths
 from robotkit.emit.layout import robot_layout
 from robotkit.errors import RobotkitError
-from robotkit.importer import import_file
 from robotkit.picture import report_build_dir, report_model_file, report_urdf
-from robotkit.pipeline.runner import build
-from robotkit.recipe.load import load_recipe
+
+# a build folder's report imports neither the recipe schema (pydantic) nor the build nor the
+# importer: those are imported where a recipe is built or a URDF imported
 
 KINDS = ("recipe", "build", "urdf", "sdf", "mjcf")
 
@@ -45,6 +45,9 @@ def write_report(path: str | os.PathLike, out_dir: str | os.PathLike | None = No
         return report_build_dir(robot.root, Path(out_dir) if out_dir else robot.pictures, str(p),
                                 no_pictures=no_pictures(robot), motion=step_responses(robot))
     if what.kind == "recipe":
+        from robotkit.pipeline.runner import build
+        from robotkit.recipe.load import load_recipe
+
         loaded = load_recipe(p, args, variant)
         build([p], build_out, report=False, args=args, variant=variant or loaded.variant)
         robot = robot_layout(Path(build_out) / loaded.recipe.robot)
@@ -70,7 +73,9 @@ def no_pictures(robot) -> str | None:
 def step_responses(robot) -> dict | None:
     """The motion stage's results for a build folder with drives (its step responses are plotted);
     None without drives or when the stage cannot run (``robotkit check`` says why)."""
-    if not robot.mjcf.is_file() or not has_actuators(robot.mjcf):
+    if not robot.mjcf.is_file() or "<actuator" not in robot.mjcf.read_text(encoding="utf-8"):
+        return None  # robotkit's MJCF has no includes: no actuator element, no drives (MuJoCo not asked)
+    if not has_actuators(robot.mjcf):
         return None
     try:
         return motion_stage(robot.mjcf, robot.urdf, {robot.name: robot.root})[1]
@@ -80,6 +85,9 @@ def step_responses(robot) -> dict | None:
 
 def _built_mjcf(urdf: Path, tmp: Path, package_paths: dict[str, str]) -> tuple[Path | None, list[str]]:
     """The MJCF of a build of the URDF's import in ``tmp``, or None and the reason."""
+    from robotkit.importer import import_file
+    from robotkit.pipeline.runner import build
+
     try:
         result = import_file(str(urdf), tmp / "recipe.yaml", package_paths, {})
         build([tmp / "recipe.yaml"], tmp / "build", report=False)

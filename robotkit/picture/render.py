@@ -9,10 +9,13 @@ centres of mass, link frames, joint axes, sensor frames and fields of view.
 
 from __future__ import annotations
 
+import functools
 import io
 import math
 import os
 import re
+import struct
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -119,10 +122,54 @@ def renderer(model, height: int, width: int):
         raise RendererUnavailable.because(exc) from None
 
 
+class Canvas:
+    """An offscreen framebuffer of ``width`` x ``height`` pixels drawn in panels side by side and
+    read once (a joint's strip: its poses in one read; with OSMesa the drawing happens in the read,
+    and each read costs a fixed wait on the rasteriser's threads besides).  MuJoCo's own GL context
+    and render context, as ``mujoco.Renderer`` makes them; a RendererUnavailable without GL."""
+
+    def __init__(self, model, width: int, height: int, max_geom: int = 10000):
+        model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
+        model.vis.global_.offheight = max(model.vis.global_.offheight, height)
+        self.width, self.height = width, height
+        self.gl = self.context = None
+        try:
+            self.gl = mujoco.GLContext(width, height)
+            self.gl.make_current()
+            self.context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_150.value)
+        except Exception as exc:  # noqa: BLE001  (no GL context: the backend is missing or needs a display)
+            self.close()
+            raise RendererUnavailable.because(exc) from None
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN.value, self.context)
+        self.scene = mujoco.MjvScene(model=model, maxgeom=max_geom)
+
+    def draw(self, left: int, width: int) -> None:
+        """The scene into the panel of ``width`` pixels from ``left``, the framebuffer's height."""
+        self.gl.make_current()
+        mujoco.mjr_render(mujoco.MjrRect(left, 0, width, self.height), self.scene, self.context)
+
+    def read(self, width: int) -> np.ndarray:
+        """The framebuffer's ``width`` leftmost pixels, top row first (height x width x 3)."""
+        self.gl.make_current()
+        out = np.empty((self.height, width, 3), dtype=np.uint8)
+        mujoco.mjr_readPixels(out, None, mujoco.MjrRect(0, 0, width, self.height), self.context)
+        return np.flipud(out)
+
+    def close(self) -> None:
+        if self.context is not None:
+            self.context.free()
+            self.context = None
+        if self.gl is not None:
+            self.gl.free()
+            self.gl = None
+
+
 class Painter:
     """One MuJoCo model and an offscreen renderer; draws the pictures of a report."""
 
-    def __init__(self, model, width: int = 640, height: int = 480, data=None):
+    def __init__(self, model, width: int = 640, height: int = 480, data=None, panels: int = 0):
+        """``panels``: draw strips of up to that many pictures of ``width`` x ``height`` (a
+        :class:`Canvas`, :meth:`strip`) instead of single pictures (0)."""
         self.model = model
         self.data = data if data is not None else mujoco.MjData(model)
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
@@ -130,7 +177,8 @@ class Painter:
         model.vis.headlight.ambient[:] = 0.45
         model.vis.headlight.diffuse[:] = 0.6
         model.vis.headlight.specular[:] = 0.1
-        self.renderer = renderer(model, height, width)
+        self.width, self.height = width, height
+        self.renderer = Canvas(model, width * panels, height) if panels else renderer(model, height, width)
         self.flagged: set[str] = set()
         self.aspect = width / height
         mujoco.mj_forward(model, self.data)
@@ -166,16 +214,30 @@ class Painter:
             m.mat_rgba[:, 3] = GHOST
             m.geom_rgba[m.geom_group == COLLISION] = COLLISION_RGBA
         try:
-            scene_opt = self._option(groups)
-            self.renderer.update_scene(self.data, self._camera(azimuth, elevation), scene_opt)
-            scn = self.renderer.scene
-            scn.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
-            scn.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
-            for overlay in overlays:
-                overlay(scn)
+            self._scene(self.renderer.scene, azimuth, elevation, groups, overlays)
             return self.renderer.render().copy()
         finally:
             m.geom_rgba[:], m.mat_rgba[:] = saved
+
+    def _scene(self, scn, azimuth, elevation, groups, overlays=()) -> None:
+        """``scn``: the robot as posed, seen from ``azimuth``/``elevation``, ``groups`` drawn, no
+        shadows or reflections, the ``overlays`` added."""
+        mujoco.mjv_updateScene(self.model, self.data, self._option(groups), None, self._camera(azimuth, elevation),
+                               mujoco.mjtCatBit.mjCAT_ALL.value, scn)
+        scn.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+        scn.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+        for overlay in overlays:
+            overlay(scn)
+
+    def strip(self, poses, azimuth, elevation, groups, overlays=()) -> np.ndarray:
+        """The robot at each of ``poses`` (qpos), side by side: drawn into one framebuffer (a
+        :class:`Canvas`, ``panels`` of this painter) and read once."""
+        canvas = self.renderer
+        for i, q in enumerate(poses):
+            self.pose(q)
+            self._scene(canvas.scene, azimuth, elevation, groups, overlays)
+            canvas.draw(i * self.width, self.width)
+        return canvas.read(len(poses) * self.width)
 
     # ---------------------------------------------------------------- overlays
     def _add(self, scn, type_, size, pos, mat, rgba):
@@ -337,13 +399,12 @@ def joint_samples(hinge: bool, limited: bool, lo: float, hi: float, radius: floa
     return values, f"{why} drawn at the sample positions {shown}"
 
 
-def _save(img: np.ndarray, path: Path, level: int = 6) -> None:
-    """A PNG file (zlib ``level``: Pillow's default, 1 for the joints' strips: twice as fast, a
-    fifth larger)."""
+def _save(img: np.ndarray, path: Path) -> None:
+    """A PNG file (Pillow, its default zlib level; the joints' strips: :func:`png_bytes`)."""
     from PIL import Image  # only when a picture is saved
 
     buf = io.BytesIO()
-    Image.fromarray(img).save(buf, format="PNG", compress_level=level)
+    Image.fromarray(img).save(buf, format="PNG")
     write_if_changed(path, buf.getvalue())
 
 
@@ -353,20 +414,50 @@ LABEL_BAND = 28  # pixels above each picture of a strip, for its label
 LABEL_FONT = 17
 
 
-def _strip(images: list[np.ndarray], labels: list[str]) -> np.ndarray:
-    """Images side by side, each under its label (on a band of its own: it hides nothing)."""
-    from PIL import Image, ImageDraw, ImageFont  # only when a picture is saved
+def png_bytes(img: np.ndarray, level: int = 1) -> bytes:
+    """An RGB image (height x width x 3, uint8) as PNG bytes: rows unfiltered, zlib ``level``.
+    For the joints' strips: four times as fast as Pillow's encoder (which tries every row filter)
+    and about as small on flat-shaded pictures; byte-reproducible."""
+    h, w = img.shape[:2]
+    raw = np.empty((h, w * 3 + 1), dtype=np.uint8)
+    raw[:, 0] = 0  # filter type none
+    raw[:, 1:] = np.ascontiguousarray(img, dtype=np.uint8).reshape(h, w * 3)
 
-    h, w = images[0].shape[:2]
-    out = Image.new("RGB", (w * len(images), h + LABEL_BAND), (255, 255, 255))
-    draw = ImageDraw.Draw(out)
-    font = ImageFont.load_default(size=LABEL_FONT)
-    for i, (img, label) in enumerate(zip(images, labels)):
-        out.paste(Image.fromarray(img), (i * w, LABEL_BAND))
-        draw.text((i * w + 6, LABEL_BAND // 2), label, fill=(0, 0, 0), font=font, anchor="lm")
-        if i:
-            draw.line([(i * w, 0), (i * w, LABEL_BAND - 1)], fill=(200, 200, 200))
-    return np.asarray(out)
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    header = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)  # 8 bits, RGB, deflate, no filter choice, no interlace
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw.tobytes(), level))
+            + chunk(b"IEND", b""))
+
+
+@functools.lru_cache(maxsize=256)
+def _label(text: str, width: int, first: bool) -> np.ndarray:
+    """The band above one picture of a strip: ``text``, and a separator on its left unless
+    ``first`` (LABEL_BAND x width x 3; drawn once per text: a long chain's joints share labels)."""
+    from PIL import Image, ImageDraw  # only when a picture is saved
+
+    band = Image.new("RGB", (width, LABEL_BAND), (255, 255, 255))
+    draw = ImageDraw.Draw(band)
+    draw.text((6, LABEL_BAND // 2), text, fill=(0, 0, 0), font=_font(), anchor="lm")
+    if not first:
+        draw.line([(0, 0), (0, LABEL_BAND - 1)], fill=(200, 200, 200))
+    return np.asarray(band)
+
+
+@functools.lru_cache(maxsize=1)
+def _font():
+    from PIL import ImageFont
+
+    return ImageFont.load_default(size=LABEL_FONT)
+
+
+def _strip(pictures: np.ndarray, labels: list[str]) -> np.ndarray:
+    """``pictures`` (as many side by side as ``labels``), each under its label (on a band of its
+    own: it hides nothing)."""
+    w = pictures.shape[1] // len(labels)
+    band = np.concatenate([_label(label, w, i == 0) for i, label in enumerate(labels)], axis=1)
+    return np.concatenate([band, pictures])
 
 
 def render_pictures(mjcf: str | os.PathLike, out_dir: str | os.PathLike, flagged: set[str] = frozenset(),
@@ -408,16 +499,19 @@ def render_pictures(mjcf: str | os.PathLike, out_dir: str | os.PathLike, flagged
 
 def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
     pics = []
+    joints = p.joint_poses()
+    if not joints:
+        return pics
     samples = p.model.vis.quality.offsamples
     p.model.vis.quality.offsamples = STRIP_SAMPLES  # read when the strips' renderer is made
     try:
-        small = Painter(p.model, *STRIP_SIZE, data=p.data)  # the same model, smaller pictures for the strips
+        # the same model, smaller pictures for the strips, each strip drawn in one framebuffer
+        small = Painter(p.model, *STRIP_SIZE, data=p.data, panels=max(len(poses) for _, _, poses, _ in joints))
     finally:
         p.model.vis.quality.offsamples = samples
     small.flagged = p.flagged
     try:
-        for name, kind, poses, caption in p.joint_poses():
-            images = []
+        for name, kind, poses, caption in joints:
             points = []
             for _, q in poses:  # frame the joint's whole motion
                 small.pose(q)
@@ -429,12 +523,10 @@ def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
             moved = [int(joint.bodyid[0])]  # its frame turns even where a round link looks the same
             # this joint's axis only: a strip draws one joint (and a long chain's strips stay cheap)
             overlays = (lambda scn: small.joint_axes(scn, [int(joint.id)]), lambda scn: small.frames(scn, moved, 0.3))
-            for _, q in poses:
-                small.pose(q)
-                images.append(small._draw(135.0, -25.0, visual, ghost=False, overlays=overlays))
+            pictures = small.strip([q for _, q in poses], 135.0, -25.0, visual, overlays)
             small.pose()
             file = "joint-" + re.sub(r"[^A-Za-z0-9_.-]", "_", name) + ".png"
-            _save(_strip(images, [label for label, _ in poses]), out / file, level=1)
+            write_if_changed(out / file, png_bytes(_strip(pictures, [label for label, _ in poses])))
             pics.append(Picture(file, f"Joint {name}", f"{kind} joint {caption}; the link it moves shows its frame "
                                 "(x red, y green, z blue)", "joint"))
     finally:
