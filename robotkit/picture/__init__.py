@@ -24,7 +24,8 @@ from robotkit.picture import page
 from robotkit.picture.plots import step_plots
 
 PAGE = PurePosixPath(REPORT_HTML).name  # report.html, in whichever folder the report is written
-VERSION = 2  # 2: joint strips without multisampling; bump when the pictures or the page change for the same build
+VERSION = 3  # 2: strips without multisampling; 3: strips in one framebuffer, own PNG writer, BRIEF_JOINTS
+# bump VERSION when the pictures or the page change for the same build
 
 
 def report_build_dir(robot_dir: Path, out: Path, source: str, declared_mass: float | None = None,

@@ -336,17 +336,18 @@ class Painter:
         """(joint, kind, [(label, qpos)], caption) for each hinge and slide joint: at its lower
         limit, zero and its upper limit; a joint with no limits, or limits a full turn or more
         apart (each limit the same pose as zero), at sample angles of -90 and +90 degrees instead,
-        labelled as samples. Mimic joints follow."""
+        labelled as samples. Mimic joints follow.  A robot of more than :data:`BRIEF_JOINTS`
+        such joints is drawn without the small positive move (:func:`joint_samples`, ``brief``)."""
         m = self.model
         out = []
         followers = self._mimics()
-        for j in range(m.njnt):
+        drawn = [j for j in range(m.njnt) if int(m.jnt_type[j]) in (HINGE, SLIDE) and j not in followers]
+        brief = len(drawn) > BRIEF_JOINTS
+        for j in drawn:
             t = int(m.jnt_type[j])
-            if t not in (HINGE, SLIDE) or j in followers:
-                continue
             adr = m.jnt_qposadr[j]
             values, caption = joint_samples(t == HINGE, bool(m.jnt_limited[j]), *(float(v) for v in m.jnt_range[j]),
-                                            self.radius)
+                                            self.radius, brief)
             poses = []
             for label, value in values:
                 q = m.qpos0.copy()
@@ -374,24 +375,35 @@ def _amount(value: float, hinge: bool, sign: bool = False) -> str:
     return f"{value:{'+' if sign else ''}.3g} rad ({degrees})"
 
 
-def joint_samples(hinge: bool, limited: bool, lo: float, hi: float, radius: float) -> tuple[list, str]:
+BRIEF_JOINTS = 24
+"""A robot with more drawn joints than this has three pictures per joint's strip, not four: no
+small positive move (the upper limit shows the positive direction); a long chain's report stays
+cheap (each picture of a 100-link chain costs about 5 ms of CPU with OSMesa)."""
+
+
+def joint_samples(hinge: bool, limited: bool, lo: float, hi: float, radius: float,
+                  brief: bool = False) -> tuple[list, str]:
     """([(label, value)], caption) of the positions a joint is drawn at: its limits, zero and a
     small positive move (the direction, when the upper limit is further); a joint without limits,
-    or a hinge whose limits are a full turn or more apart, at labelled sample positions."""
+    or a hinge whose limits are a full turn or more apart, at labelled sample positions.
+    ``brief``: without the small positive move (:data:`BRIEF_JOINTS`)."""
     full_turn = hinge and limited and hi - lo >= 2 * math.pi - 1e-6
     if limited and not full_turn:
-        step = min(hi, 0.6 if hinge else (hi - lo) / 4) if hi > 0 else None
+        step = min(hi, 0.6 if hinge else (hi - lo) / 4) if hi > 0 and not brief else None
         values = [(f"lower {_amount(lo, hinge)}", lo), ("zero", 0.0)]
         if step is not None and step < hi:
             values.append((f"{_amount(step, hinge, True)}", step))
         values.append((f"upper {_amount(hi, hinge)}", hi))
+        if brief:
+            return values, "at its lower limit, zero and its upper limit"
         return values, "at its lower limit, zero, a small positive move (when the upper limit is further) and its " \
                        "upper limit"
+    hinge_samples = (-math.pi / 2, 0.0, math.pi / 2) if brief else (-math.pi / 2, 0.0, 0.6, math.pi / 2)
     if full_turn:
         why = f"with limits {_amount(lo, True)} and {_amount(hi, True)}, a full turn or more apart,"
-        samples = sorted({min(max(v, lo), hi) for v in (-math.pi / 2, 0.0, 0.6, math.pi / 2)})
+        samples = sorted({min(max(v, lo), hi) for v in hinge_samples})
     elif hinge:
-        why, samples = "with no limits (continuous),", [-math.pi / 2, 0.0, 0.6, math.pi / 2]
+        why, samples = "with no limits (continuous),", list(hinge_samples)
     else:
         why, samples = "with no limits,", [-radius / 2, 0.0, radius / 2]
     values = [("zero" if v == 0 else f"sample {_amount(v, hinge, True)}", v) for v in samples]

@@ -383,3 +383,93 @@ def test_where_mujoco_cannot_draw_a_build_writes_everything_and_warns_once(tmp_p
     assert "1 tasks run" in again.stdout  # the report alone
     assert len(list((robot / "report").glob("*.png"))) > 4
     assert "up to date" in run_cli("build", "recipes/turret_bot.yaml", "--out", "out", cwd=tmp_path).stdout
+
+
+def chain_mjcf(n: int) -> str:
+    """An MJCF chain of ``n`` boxes on hinges (limits +-1.5 rad), visual geoms in group 2 as
+    robotkit writes them."""
+    body = ""
+    for i in range(n, 0, -1):
+        body = (f'<body name="l{i}" pos="0 0 0.1"><joint name="j{i}" type="hinge" axis="0 {i % 2} {1 - i % 2}" '
+                f'range="-1.5 1.5" limited="true"/><geom type="box" size="0.04 0.01 0.05" pos="0.03 0 0.05" '
+                f'group="2" mass="0.1"/>{body}</body>')
+    return (f'<mujoco model="chain{n}"><compiler angle="radian"/><worldbody><body name="base"><geom type="box" size="0.05 0.05 0.02" '
+            f'group="2" mass="1"/>{body}</body></worldbody></mujoco>')
+
+
+def differ(a, b) -> float:
+    """Share of pixels that differ visibly."""
+    return (np.abs(a.astype(int) - b.astype(int)).max(axis=2) > 30).mean()
+
+
+@pytest.mark.slow
+def test_a_long_chain_has_three_pictures_per_joint(tmp_path):
+    """Past BRIEF_JOINTS joints a strip is lower limit, zero, upper limit (no small move), said
+    so in its caption, and the joint still moves from one picture to the next."""
+    from robotkit.picture.render import BRIEF_JOINTS
+
+    n = BRIEF_JOINTS + 1
+    (tmp_path / "chain.xml").write_text(chain_mjcf(n))
+    done = run_cli("report", tmp_path / "chain.xml", "-o", tmp_path / "report")
+    assert done.returncode == 0, done.stderr
+    html = (tmp_path / "report" / "report.html").read_text()
+    assert "<b>Joint j1</b>: hinge joint at its lower limit, zero and its upper limit; the link it moves" in html
+    w, h = STRIP_SIZE
+    for joint in ("j1", f"j{n}"):
+        strip = pixels(tmp_path / "report" / f"joint-{joint}.png")
+        assert strip.shape == (h + 28, 3 * w, 3)
+        panels = [strip[28:, i * w:(i + 1) * w] for i in range(3)]
+        assert min(differ(a, b) for i, a in enumerate(panels) for b in panels[i + 1:]) > 0.001, joint
+    assert sorted(p.name for p in (tmp_path / "report").glob("joint-*.png")) == sorted(
+        f"joint-j{i}.png" for i in range(1, n + 1))
+
+
+STRIP_AGAINST_PICTURES = """
+import sys
+import numpy as np
+from robotkit.picture.render import Painter, STRIP_SIZE, VISUAL, load_model
+
+model = load_model(sys.argv[1])
+model.vis.quality.offsamples = 0
+strip = Painter(model, *STRIP_SIZE, panels=4)
+single = Painter(model, *STRIP_SIZE)
+name, kind, poses, caption = strip.joint_poses()[1]
+pictures = strip.strip([q for _, q in poses], 135.0, -25.0, {VISUAL: True})
+w = STRIP_SIZE[0]
+for i, (_, q) in enumerate(poses):
+    single.pose(q)
+    alone = single._draw(135.0, -25.0, {VISUAL: True}, ghost=False)
+    panel = pictures[:, i * w:(i + 1) * w]
+    print(int((np.abs(panel.astype(int) - alone.astype(int)).max(axis=2) > 30).sum()), panel.shape == alone.shape)
+strip.close()
+single.close()
+"""
+
+
+@pytest.mark.slow
+def test_a_strip_drawn_in_one_framebuffer_is_its_pictures_drawn_one_by_one(tmp_path):
+    """Painter.strip draws a joint's poses side by side in one framebuffer and reads it once:
+    each panel is the picture of that pose drawn alone (in another process: no GL here)."""
+    import subprocess
+    import sys
+
+    (tmp_path / "chain.xml").write_text(chain_mjcf(3))
+    done = subprocess.run([sys.executable, "-c", STRIP_AGAINST_PICTURES, str(tmp_path / "chain.xml")],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    rows = [line.split() for line in done.stdout.splitlines()]
+    assert len(rows) == 4  # lower, zero, +0.6 rad, upper
+    assert all(shape == "True" and int(count) <= 20 for count, shape in rows), rows
+
+
+def test_png_bytes_is_a_png_of_the_same_pixels(tmp_path):
+    """The strips' PNG writer: Pillow reads back the very pixels, and the bytes are the same each time."""
+    from robotkit.picture.render import png_bytes
+
+    rng = np.random.default_rng(0)
+    img = rng.integers(0, 256, size=(37, 53, 3), dtype=np.uint8)
+    img[:10] = (235, 238, 242)  # a flat band, as the background
+    data = png_bytes(img)
+    (tmp_path / "a.png").write_bytes(data)
+    assert np.array_equal(np.asarray(Image.open(tmp_path / "a.png").convert("RGB")), img)
+    assert png_bytes(img.copy()) == data
