@@ -377,8 +377,8 @@ def _amount(value: float, hinge: bool, sign: bool = False) -> str:
 
 BRIEF_JOINTS = 24
 """A robot with more drawn joints than this has three pictures per joint's strip, not four: no
-small positive move (the upper limit shows the positive direction); a long chain's report stays
-cheap (each picture of a 100-link chain costs about 5 ms of CPU with OSMesa)."""
+small positive move (the upper limit shows the positive direction), each of BRIEF_STRIP_SIZE; a
+long chain's report stays cheap (a 100-link chain's strip cost 25 ms of CPU with OSMesa, 13 ms so)."""
 
 
 def joint_samples(hinge: bool, limited: bool, lo: float, hi: float, radius: float,
@@ -421,6 +421,7 @@ def _save(img: np.ndarray, path: Path) -> None:
 
 
 STRIP_SIZE = (256, 192)  # pixels of each picture of a strip
+BRIEF_STRIP_SIZE = (192, 144)  # the same past BRIEF_JOINTS joints
 STRIP_SAMPLES = 0  # no multisampling in the joints' strips: half their drawing time (OSMesa draws on the CPU)
 LABEL_BAND = 28  # pixels above each picture of a strip, for its label
 LABEL_FONT = 17
@@ -518,7 +519,8 @@ def _joint_pictures(p: Painter, out: Path, visual: dict) -> list[Picture]:
     p.model.vis.quality.offsamples = STRIP_SAMPLES  # read when the strips' renderer is made
     try:
         # the same model, smaller pictures for the strips, each strip drawn in one framebuffer
-        small = Painter(p.model, *STRIP_SIZE, data=p.data, panels=max(len(poses) for _, _, poses, _ in joints))
+        size = BRIEF_STRIP_SIZE if len(joints) > BRIEF_JOINTS else STRIP_SIZE
+        small = Painter(p.model, *size, data=p.data, panels=max(len(poses) for _, _, poses, _ in joints))
     finally:
         p.model.vis.quality.offsamples = samples
     small.flagged = p.flagged

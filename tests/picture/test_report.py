@@ -405,8 +405,8 @@ def differ(a, b) -> float:
 @pytest.mark.slow
 def test_a_long_chain_has_three_pictures_per_joint(tmp_path):
     """Past BRIEF_JOINTS joints a strip is lower limit, zero, upper limit (no small move), said
-    so in its caption, and the joint still moves from one picture to the next."""
-    from robotkit.picture.render import BRIEF_JOINTS
+    so in its caption, in smaller pictures, and the joint still moves from one picture to the next."""
+    from robotkit.picture.render import BRIEF_JOINTS, BRIEF_STRIP_SIZE
 
     n = BRIEF_JOINTS + 1
     (tmp_path / "chain.xml").write_text(chain_mjcf(n))
@@ -414,7 +414,7 @@ def test_a_long_chain_has_three_pictures_per_joint(tmp_path):
     assert done.returncode == 0, done.stderr
     html = (tmp_path / "report" / "report.html").read_text()
     assert "<b>Joint j1</b>: hinge joint at its lower limit, zero and its upper limit; the link it moves" in html
-    w, h = STRIP_SIZE
+    w, h = BRIEF_STRIP_SIZE
     for joint in ("j1", f"j{n}"):
         strip = pixels(tmp_path / "report" / f"joint-{joint}.png")
         assert strip.shape == (h + 28, 3 * w, 3)
