@@ -6,6 +6,8 @@
 
 from __future__ import annotations
 
+import ast
+import functools
 import inspect
 import json
 import typing
@@ -69,8 +71,38 @@ def _expressions(node):
 
 
 
+@functools.lru_cache(maxsize=1)
+def documented() -> None:
+    """Every schema model's fields described by their attribute docstrings (a string under the
+    field, as pydantic's ``use_attribute_docstrings`` reads them), the models rebuilt so that
+    their JSON Schema has them: done here, once, rather than at every import of the schema."""
+    from pydantic import BaseModel
+
+    models = [v for v in vars(s).values() if isinstance(v, type) and issubclass(v, BaseModel)
+              and v.__module__ == s.__name__]
+    for model in models:
+        docs = {}
+        for cls in reversed(model.__mro__):
+            if cls in models:
+                docs.update(_attribute_docs(cls))
+        for name, field in model.model_fields.items():
+            if field.description is None and name in docs:
+                field.description = docs[name]
+    for model in models:  # in the module's order: a model after the models it holds
+        model.model_rebuild(force=True)
+
+
+def _attribute_docs(cls) -> dict[str, str]:
+    """The docstrings under the annotated attributes of ``cls``'s own body."""
+    body = ast.parse(inspect.cleandoc("\n" + inspect.getsource(cls))).body[0].body
+    return {a.target.id: inspect.cleandoc(b.value.value) for a, b in zip(body, body[1:])
+            if isinstance(a, ast.AnnAssign) and isinstance(a.target, ast.Name) and isinstance(b, ast.Expr)
+            and isinstance(b.value, ast.Constant) and isinstance(b.value.value, str)}
+
+
 def json_schema(part: bool = False) -> str:
     """The JSON Schema of a recipe (or, ``part``, of a part file)."""
+    documented()
     data = _expressions((s.Part if part else s.Recipe).model_json_schema())
     data["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     data["title"] = "robotkit part" if part else "robotkit recipe"
@@ -149,6 +181,7 @@ def _section(model, title: str) -> list[str]:
 
 def markdown() -> str:
     """The reference: one section per schema model (every key of the JSON Schema)."""
+    documented()
     reachable: set = set()
     _models(s.Recipe, reachable)
     missing = sorted(m.__name__ for m in reachable - {m for m, _ in SECTIONS})

@@ -182,7 +182,9 @@ FrameName = Annotated[str, AfterValidator(check_frame_name)]
 
 
 class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", use_attribute_docstrings=True, allow_inf_nan=False)
+    # the fields' docstrings describe them in the reference only: read there (robotkit.recipe.reference
+    # .documented), not at import (pydantic reads every class's source: a fifth of a warm build's start)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
 class Origin(Strict):
