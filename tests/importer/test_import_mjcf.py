@@ -176,7 +176,7 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     assert result.verdict.ok, result.verdict.lines()
     assert result.verdict.configurations == 22  # the keyframe, the zero configuration, 20 random ones
     text = (folder / "features.yaml").read_text()
-    assert "# verified in MuJoCo against the original at 22 configurations: every quantity agrees" in text
+    assert "# verified in MuJoCo against the original at 22 configurations and 1 rollout: every quantity agrees" in text
     assert "#   features.xml:53: tendon 'fingers': all: dropped: the recipe has no tendons" in text
     assert yaml.safe_load(text)["robot"] == "features"
     assert ("  # MJCF ref 0.02: the origin takes the body back to the joint's zero, so joint values (limits,\n"
@@ -184,17 +184,59 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     assert "  # one of the three revolute joints ball joint 'wrist_ball' becomes (x, y, z of its body)\n" in text
 
 
-def test_verification_catches_a_rebuild_that_differs(rebuilt, features):
+def test_verification_catches_a_rebuild_that_differs(rebuilt, features, tmp_path):
     _, folder = rebuilt
-    mjcf = folder / "copy" / "mjcf" / "features.xml"
-    text = mjcf.read_text()
-    assert 'mass="0.5"' in text
-    mjcf.write_text(text.replace('mass="0.5"', 'mass="0.6"'))
+    mjcf = _mutated(folder, tmp_path, "mjcf/features.xml", 'mass="0.5"', 'mass="0.6"')
     _, _, src, tree = features
     verdict = verify(src, tree, mjcf)
     assert not verdict.ok
     assert verdict.failures[:2] == ["total mass: mass off by 2.49e-02 (tolerance 1e-09)",
                                     "body 'fore' at keyframe 'home': mass off by 2.00e-01 (tolerance 1e-09)"]
+
+
+def _mutated(folder: Path, tmp_path: Path, name: str, old: str, new: str) -> Path:
+    """A copy of the rebuilt robot's folder with ``old`` replaced by ``new`` in its file ``name``
+    (mjcf/features.xml, urdf/features.urdf); the copy's MJCF."""
+    copy = tmp_path / "copy"
+    shutil.copytree(folder / "copy", copy)
+    text = (copy / name).read_text()
+    assert old in text
+    (copy / name).write_text(text.replace(old, new))
+    return copy / "mjcf" / "features.xml"
+
+
+def test_verification_loads_the_rebuilt_urdf_in_pinocchio(rebuilt, features, tmp_path):
+    """Only the URDF differs (its forearm heavier): Pinocchio's mass matrix and gravity forces,
+    matched to MuJoCo's by joint name, catch it."""
+    _, folder = rebuilt
+    mjcf = _mutated(folder, tmp_path, "urdf/features.urdf", '<mass value="0.5"/>', '<mass value="0.6"/>')
+    verdict = verify(features[2], features[3], mjcf)
+    assert verdict.failures and all(f.startswith("URDF ") and "in Pinocchio at" in f for f in verdict.failures)
+    assert verdict.failures[0].startswith("URDF mass matrix in Pinocchio at keyframe 'home': pinocchio off by ")
+    assert verdict.worst["matrix"][0] < 1e-6  # the MJCF still agrees
+
+
+def test_verification_rollout_catches_what_the_configurations_do_not(rebuilt, features, tmp_path):
+    """Damping moves nothing at rest: only the 0.5 s rollout from the keyframe sees it."""
+    _, folder = rebuilt
+    mjcf = _mutated(folder, tmp_path, "mjcf/features.xml", 'damping="0.5"', 'damping="0.6"')
+    verdict = verify(features[2], features[3], mjcf)
+    assert verdict.rollouts == 1
+    assert len(verdict.failures) == 1 and verdict.failures[0].startswith("rollout from keyframe 'home': body ")
+
+
+def test_verification_checks_equalities_and_actuators(rebuilt, features, tmp_path):
+    _, folder = rebuilt
+    text = (folder / "copy" / "mjcf" / "features.xml").read_text()
+    equality = text[text.index("<equality>"):text.index("</equality>") + len("</equality>")]
+    mjcf = _mutated(folder, tmp_path, "mjcf/features.xml", equality, "")
+    text = mjcf.read_text()
+    mjcf.write_text(text.replace('kp="10"', 'kp="11"', 1))
+    verdict = verify(features[2], features[3], mjcf)
+    assert "equality #0 missing from the rebuild: equality off by 1.00e+00 (tolerance 1e-09)" in verdict.failures
+    assert ("equality count: 0 rebuilt, 1 kept of the original's 1: equality off by 1.00e+00 (tolerance 1e-09)"
+            in verdict.failures)
+    assert any(f.startswith("actuator 'grip' gain, bias and gear: actuator off by ") for f in verdict.failures)
 
 
 def test_refused_mjcf_is_one_line_at_its_line_and_nothing_written(tmp_path):
@@ -242,7 +284,7 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     proc = run_cli("import", X2, "-o", "x2.yaml", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout.splitlines()
-    assert out[0] == "verified in MuJoCo against the original at 22 configurations: every quantity agrees"
+    assert out[0] == "verified in MuJoCo against the original at 22 configurations and 1 rollout: every quantity agrees"
     assert out[-2:] == ["wrote x2.yaml (robot Skydio_X2); build it with:",
                         f"robotkit build --root {X2.parent / 'assets'} x2.yaml"]
     built = run_cli("build", "--root", X2.parent / "assets", "x2.yaml", "--no-report", cwd=tmp_path)

@@ -115,6 +115,7 @@ def add_equalities(src, tree, recipe: dict, ledger) -> None:
                 if coef[0]:
                     mimic["offset"] = coef[0]
                 tree.joints[child]["mimic"] = mimic
+                tree.mimics[e] = (child, leader)
                 continue
         label = f"equality {EQ_KINDS.get(t, t)}" + (f" '{name}'" if name else f" #{e}")
         ledger.add(where, label, "all",

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from robotkit import mj
-from robotkit.emit.layout import robot_layout
+from robotkit.emit.layout import URDF, output_path
 from robotkit.importer.mjcf.pinocchio_mass import PinocchioModel
 from robotkit.importer.mjcf.rollout import rollouts
 from robotkit.importer.mjcf.state import mapped, velocity_map
@@ -68,7 +68,8 @@ def verify(src, tree, rebuilt_path) -> Verdict:
     chain = sum(float(rm.body_mass[rm.body(n).id]) for n in tree.chain_links)
     total_o, total_r = float(om.body_mass.sum()), float(rm.body_mass.sum()) - chain
     _check(verdict, "mass", abs(total_o - total_r) / total_o if total_o else 0.0, "total mass")
-    pin = _pinocchio(verdict, om, tree, robot_layout(Path(rebuilt_path).parent.parent).urdf)
+    urdf = Path(rebuilt_path).parent.parent / output_path(URDF, Path(rebuilt_path).stem)
+    pin = _pinocchio(verdict, om, tree, urdf)
     rng = np.random.default_rng(SEED + 1)
     for label, q in configs:
         T = _at(mujoco, om, od, rm, rd, tree, q)
@@ -139,60 +140,55 @@ def _moving_bias(verdict: Verdict, mujoco, om, od, rm, rd, T, rng, label: str) -
 
 
 def _actuators(verdict: Verdict, om, rm, tree) -> dict[int, int]:
-    """Each original actuator the recipe kept (on the ledger otherwise): the rebuilt one on its
-    joint has its type (gain, bias, dynamics), gain and bias, and gear (a motor's moved into its
-    control); and the rebuilt model has no other.  {original actuator: rebuilt actuator}."""
+    """Each original actuator the recipe kept (:attr:`Tree.actuated`; the others are on the
+    ledger): the rebuilt one on its joint has its types (gain, bias, dynamics), gain, bias and gear
+    (a motor's gear is in its control, which the ledger says); the rebuilt model has no other.
+    {original actuator: rebuilt actuator}."""
     rebuilt = {rm.joint(int(rm.actuator_trnid[a][0])).name: a for a in range(rm.nu) if rm.actuator_trntype[a] == 0}
     kept = {}
-    for a in range(om.nu):
-        if om.actuator_trntype[a] != 0 or int(om.actuator_trnid[a][0]) not in tree.joint_map:
-            continue
-        r = rebuilt.get(tree.joint_map[int(om.actuator_trnid[a][0])][0])
+    for a, joint in tree.actuated.items():
+        where = f"actuator '{om.actuator(a).name}'" if om.actuator(a).name else f"actuator #{a}"
+        r = rebuilt.get(joint)
         if r is None:
-            continue  # not kept: on the ledger
+            _check(verdict, "actuator", 1.0, f"{where} missing from the rebuild")
+            continue
         kept[a] = r
-        where = f"actuator '{om.actuator(a).name or a}'"
         types = [(int(m.actuator_gaintype[i]), int(m.actuator_biastype[i]), int(m.actuator_dyntype[i]))
                  for m, i in ((om, a), (rm, r))]
         _check(verdict, "actuator", float(types[0] != types[1]), f"{where} gain, bias and dynamics types")
-        motor = types[0][1] == 0  # a motor's gear is in its control (the ledger says so): not compared
+        motor = types[0][1] == 0
         mine, theirs = (np.concatenate([m.actuator_gainprm[i][:3], m.actuator_biasprm[i][:3],
                                         [1.0 if motor else m.actuator_gear[i][0]]]) for m, i in ((om, a), (rm, r)))
         err = float(np.abs(mine - theirs).max() / max(np.abs(mine).max(), 1e-300))
         _check(verdict, "actuator", err, f"{where} gain, bias and gear")
-    _check(verdict, "actuator", float(rm.nu != len(kept)),
-           f"actuator count: {rm.nu} rebuilt, {len(kept)} kept of the original's {om.nu}")
+    _check(verdict, "actuator", float(rm.nu != len(tree.actuated)),
+           f"actuator count: {rm.nu} rebuilt, {len(tree.actuated)} kept of the original's {om.nu}")
     return kept
 
 
 def _equalities(verdict: Verdict, om, rm, tree) -> set[int]:
-    """Each original joint equality the recipe kept as a mimic joint: a rebuilt joint equality
-    couples the same joints by the same line (either way round); the rebuilt model has no other.
-    The original's kept equalities."""
+    """Each original joint equality the recipe kept as a mimic joint (:attr:`Tree.mimics`; the
+    others are on the ledger): a rebuilt joint equality couples the same joints by the same line
+    (mimic = offset + multiplier x leader, the original's possibly turned round); the rebuilt
+    model has no other equality.  The original's kept equalities."""
     rebuilt = {}
     for e in range(rm.neq):
         if int(rm.eq_type[e]) == 2 and int(rm.eq_obj2id[e]) >= 0:
             rebuilt[(rm.joint(int(rm.eq_obj1id[e])).name, rm.joint(int(rm.eq_obj2id[e])).name)] = rm.eq_data[e][:2]
-    kept = set()
-    for e in range(om.neq):
-        a, b = int(om.eq_obj1id[e]), int(om.eq_obj2id[e])
-        if int(om.eq_type[e]) != 2 or b < 0 or a not in tree.joint_map or b not in tree.joint_map:
+    for e, (child, leader) in tree.mimics.items():
+        where = f"equality '{om.eq(e).name}'" if om.eq(e).name else f"equality #{e}"
+        if (child, leader) not in rebuilt:
+            _check(verdict, "equality", 1.0, f"{where} missing from the rebuild")
             continue
-        ja, jb = tree.joint_map[a][0], tree.joint_map[b][0]
         c0, c1 = (float(v) for v in om.eq_data[e][:2])
-        if (ja, jb) in rebuilt:
-            r0, r1 = rebuilt[(ja, jb)]
-        elif (jb, ja) in rebuilt and rebuilt[(jb, ja)][1]:
-            d0, d1 = rebuilt[(jb, ja)]
-            r0, r1 = -d0 / d1, 1 / d1
-        else:
-            continue  # not kept: on the ledger
-        kept.add(e)
-        err = max(abs(c0 - r0), abs(c1 - r1)) / max(abs(c0), abs(c1), 1e-300)
-        _check(verdict, "equality", float(err), f"equality '{om.eq(e).name or e}' coupling")
-    _check(verdict, "equality", float(rm.neq != len(kept)),
-           f"equality count: {rm.neq} rebuilt, {len(kept)} kept of the original's {om.neq}")
-    return kept
+        if tree.joint_map[int(om.eq_obj1id[e])][0] != child:  # turned round: the driven joint leads
+            c0, c1 = -c0 / c1, 1 / c1
+        r0, r1 = (float(v) for v in rebuilt[(child, leader)])
+        _check(verdict, "equality", max(abs(c0 - r0), abs(c1 - r1)) / max(abs(c0), abs(c1), 1e-300),
+               f"{where} coupling")
+    _check(verdict, "equality", float(rm.neq != len(tree.mimics)),
+           f"equality count: {rm.neq} rebuilt, {len(tree.mimics)} kept of the original's {om.neq}")
+    return set(tree.mimics)
 
 
 def _check(verdict: Verdict, kind: str, err: float, where: str) -> None:
