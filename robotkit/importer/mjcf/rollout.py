@@ -8,8 +8,8 @@ the end of every hold.
 What is on the ledger is taken out of both first, so that the rollout compares everything
 else: the rebuilt model runs with the original's simulation options (timestep, integrator,
 gravity, fluid density...); the original's dropped equality constraints are off, its tendons and joint springs
-have no stiffness, damping or friction, its dropped actuators no force; ball joints (three
-angles in the rebuild) have no armature, damping, friction or limit in either.  Contacts are
+have no stiffness, damping or friction, its dropped actuators no force.  (A model with a ball
+joint has no rollout: :func:`robotkit.importer.mjcf.verify.verify` says so.)  Contacts are
 off in both (the robot alone has no floor; its collision shapes are compared at rest)."""
 
 from __future__ import annotations
@@ -58,20 +58,7 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
         if a not in kept:
             om.actuator_gainprm[a][:] = 0
             om.actuator_biasprm[a][:] = 0
-    for j, names in tree.joint_map.items():
-        if int(om.jnt_type[j]) != BALL:
-            continue
-        _loose(om, [j])
-        _loose(rm, [rm.joint(n).id for n in names])
     return om, rm
-
-
-def _loose(m, joints: list[int]) -> None:
-    for j in joints:
-        m.jnt_limited[j] = 0
-        d, n = int(m.jnt_dofadr[j]), (3 if int(m.jnt_type[j]) == BALL else 1)
-        for field in (m.dof_armature, m.dof_damping, m.dof_frictionloss):
-            field[d:d + n] = 0
 
 
 def _controls(om, rm, kept: dict[int, int], rng) -> list[tuple[np.ndarray, np.ndarray]]:
