@@ -7,10 +7,12 @@ the end of every hold.
 
 What is on the ledger is taken out of both first, so that the rollout compares everything
 else: the rebuilt model runs with the original's simulation options (timestep, integrator,
-gravity, fluid density...); the original's dropped equality constraints are off, its tendons and joint springs
-have no stiffness, damping or friction, its dropped actuators no force.  (A model with a ball
-joint has no rollout: :func:`robotkit.importer.mjcf.verify.verify` says so.)  Contacts are
-off in both (the robot alone has no floor; its collision shapes are compared at rest)."""
+gravity, fluid density...); the original's dropped equality constraints are off (the kept ones
+have the rebuilt's softness), its tendons and joint springs have no stiffness, damping or
+friction, its joints' limits and friction loss have the rebuilt's softness, and its dropped
+actuators no force.  A model with a ball joint has no rollout
+(:func:`robotkit.importer.mjcf.verify.verify` says so).  Contacts are off in both: the robot
+alone has no floor, and the contact parameters the recipe cannot hold are on the ledger."""
 
 from __future__ import annotations
 
@@ -47,10 +49,21 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
             setattr(rm.opt, name, copy.copy(value))
     for m in (om, rm):
         m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    rebuilt_eq = {(rm.joint(int(rm.eq_obj1id[e])).name, rm.joint(int(rm.eq_obj2id[e])).name): e
+                  for e in range(rm.neq) if int(rm.eq_type[e]) == 2 and int(rm.eq_obj2id[e]) >= 0}
     for e in range(om.neq):
         if e not in equalities:
             om.eq_active0[e] = 0
+        elif tree.mimics[e] in rebuilt_eq:  # its softness: the rebuilt's (MuJoCo's defaults)
+            r = rebuilt_eq[tree.mimics[e]]
+            om.eq_solref[e], om.eq_solimp[e] = rm.eq_solref[r], rm.eq_solimp[r]
     om.jnt_stiffness[:] = 0
+    for j, names in tree.joint_map.items():  # limit and friction softness: the rebuilt's (MuJoCo's defaults)
+        if int(om.jnt_type[j]) in (SLIDE, HINGE):
+            r = rm.joint(names[0]).id
+            d, e = int(om.jnt_dofadr[j]), int(rm.jnt_dofadr[r])
+            om.jnt_solref[j], om.jnt_solimp[j], om.jnt_margin[j] = rm.jnt_solref[r], rm.jnt_solimp[r], rm.jnt_margin[r]
+            om.dof_solref[d], om.dof_solimp[d] = rm.dof_solref[e], rm.dof_solimp[e]
     for field in ("tendon_stiffness", "tendon_damping", "tendon_frictionloss", "tendon_limited"):
         if hasattr(om, field):
             getattr(om, field)[:] = 0
