@@ -6,6 +6,7 @@ shared set in the slow tier)."""
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 from pathlib import Path
@@ -154,6 +155,24 @@ def test_ledger_word_for_word(features):
         "features.xml:31: joint 'wrist_ball' (ball): all: approximated: three revolute joints about the body's x, y, z "
         "through two massless links; its armature, damping and friction act on each angle, not on the angular "
         "velocity",
+    ]
+
+
+def test_constraint_softness_the_rebuild_lacks_is_on_the_ledger(tmp_path):
+    """MuJoCo's limit, friction-loss and equality softness: the rebuilt MJCF has its defaults."""
+    (tmp_path / "soft.xml").write_text(
+        '<mujoco>\n<worldbody>\n<body name="a">\n<geom size="0.1"/>\n'
+        '<joint name="j" range="-1 1" solreflimit="0.005 1" frictionloss="0.1" solimpfriction="0.8 0.9 0.01 0.5 2"/>\n'
+        '<body name="b"><geom size="0.1"/><joint name="k" range="-1 1"/></body>\n</body>\n</worldbody>\n'
+        '<equality><joint joint1="k" joint2="j" solref="0.01 1"/></equality>\n</mujoco>\n')
+    ledger = convert(tmp_path / "soft.xml", tmp_path / "soft.yaml")[1].lines()
+    assert ledger[0].startswith("soft.xml: option integrator: all: Euler dropped")
+    assert ledger[1:] == [
+        "soft.xml:8: equality joint #0: all: a mimic joint: solref 0.01 1, solimp 0.9 0.95 0.001 0.5 2 dropped: the "
+        "rebuilt MJCF has MuJoCo's defaults (the recipe has no constraint softness)",
+        "soft.xml:5: joint 'j': all: solreflimit 0.005 1, solimplimit 0.9 0.95 0.001 0.5 2; solreffriction 0.02 1, "
+        "solimpfriction 0.8 0.9 0.01 0.5 2 dropped: the rebuilt MJCF has MuJoCo's defaults (the recipe has no "
+        "constraint softness)",
     ]
 
 
@@ -325,6 +344,9 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     assert ("ledger: x2.xml:26: material 'phong3SG': all: texture dropped: the recipe's material is a colour "
             "(its rgba kept)") in proc.stderr.splitlines()
     recipe = yaml.safe_load((tmp_path / "x2.yaml").read_text())
+    ledger = [line.removeprefix("ledger: ") for line in proc.stderr.splitlines() if line.startswith("ledger: ")]
+    assert recipe["metadata"]["ledger"] == ledger  # and the build's report.json carries it
+    assert json.loads((tmp_path / "build" / "Skydio_X2" / "report.json").read_text())["ledger"] == ledger
     assert recipe["base"] == "free" and list(recipe["links"]) == ["x2"]
     mesh = next(s for s in recipe["links"]["x2"]["visual"] if "mesh" in s)
     assert mesh["scale"] == 0.01  # set in the default class
