@@ -168,7 +168,7 @@ def test_constraint_softness_the_rebuild_lacks_is_on_the_ledger(tmp_path):
     ledger = convert(tmp_path / "soft.xml", tmp_path / "soft.yaml")[1].lines()
     assert ledger[0].startswith("soft.xml: option integrator: all: Euler dropped")
     assert ledger[1:] == [
-        "soft.xml:8: equality joint #0: all: a mimic joint: solref 0.01 1, solimp 0.9 0.95 0.001 0.5 2 dropped: the "
+        "soft.xml:9: equality joint #0: all: a mimic joint: solref 0.01 1, solimp 0.9 0.95 0.001 0.5 2 dropped: the "
         "rebuilt MJCF has MuJoCo's defaults (the recipe has no constraint softness)",
         "soft.xml:5: joint 'j': all: solreflimit 0.005 1, solimplimit 0.9 0.95 0.001 0.5 2; solreffriction 0.02 1, "
         "solimpfriction 0.8 0.9 0.01 0.5 2 dropped: the rebuilt MJCF has MuJoCo's defaults (the recipe has no "
