@@ -39,12 +39,24 @@ def run(args) -> int:
     return 0
 
 
+VERIFIED_OUTPUTS = "outputs: [mjcf, urdf]  # what the verification compares\n"
+"""The formats the verification's build writes (the recipe's ``outputs:``): the MJCF it compares
+in MuJoCo and the URDF it loads in Pinocchio; nothing else (the SDF, the ROS package...)."""
+
+
 def build_mjcf(recipe: Path, folder: str) -> Path:
-    """Build ``recipe`` into ``folder`` (no report); the rebuilt MJCF's path."""
+    """Build ``recipe`` into ``folder`` (no report, only :data:`VERIFIED_OUTPUTS`, from a copy
+    beside it, so that its mesh paths read the same); the rebuilt MJCF's path."""
     from robotkit.emit.layout import robot_layout
     from robotkit.pipeline.runner import build
 
-    result = build([recipe], folder, report=False)
+    recipe = Path(recipe)
+    copy = recipe.with_name(f".{recipe.name}.verify.yaml")
+    copy.write_text(recipe.read_text(encoding="utf-8").rstrip("\n") + "\n" + VERIFIED_OUTPUTS, encoding="utf-8")
+    try:
+        result = build([copy], folder, report=False)
+    finally:
+        copy.unlink(missing_ok=True)
     return robot_layout(Path(folder) / result.robots[0]).mjcf
 
 

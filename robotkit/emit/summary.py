@@ -102,6 +102,8 @@ def summary(robot: Robot, facts: dict) -> dict:
         out["left_out"] = lost
     if robot.drive_report:  # the tuner's gains, their reasons and checks (robotkit.model.gains)
         out["actuators"] = json.loads(robot.drive_report)
+    if robot.metadata.ledger:  # what an import could not carry (robotkit.importer)
+        out["ledger"] = list(robot.metadata.ledger)
     if robot.poses:
         out["poses"] = {p.name: dict(p.values) for p in robot.poses}
     if robot.collision_matrix is not None:  # robotkit.model.selfcollision

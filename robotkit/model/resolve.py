@@ -382,7 +382,7 @@ def _metadata(md) -> Metadata:
     authors = tuple(Author(a.name, a.email) for a in md.authors)
     maintainers = tuple(Author(m.name, m.email) for m in md.maintainers) or tuple(a for a in authors if a.email)
     urls = tuple((k, v) for k, v in md.urls.model_dump().items() if v)
-    return Metadata(md.version, md.description, authors, md.license, maintainers, urls)
+    return Metadata(md.version, md.description, authors, md.license, maintainers, urls, tuple(md.ledger))
 
 
 OPTICAL = (-math.pi / 2, 0.0, -math.pi / 2)

@@ -233,6 +233,8 @@ class Metadata:
     """Given ones, else the authors with an e-mail address; may be empty (the build warns)."""
     urls: tuple[tuple[str, str], ...] = ()
     """(type, address) pairs: website, repository, bugtracker."""
+    ledger: tuple[str, ...] = ()
+    """What an import could not carry from the original (report.json's ``ledger``)."""
 
 
 @dataclass(frozen=True)

@@ -543,6 +543,8 @@ class Metadata(Strict):
     license: str | None = None
     """Licence of the robot description (SPDX identifier), written to package.xml."""
     urls: Urls = Urls()
+    ledger: list[str] = []
+    """What an import could not carry from the original (``robotkit import``: one line per element, ``where: element: formats: what happened``), copied into the build's ``report.json`` under ``ledger``."""
 
     @field_validator("version")
     @classmethod

@@ -6,6 +6,7 @@ shared set in the slow tier)."""
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 from pathlib import Path
@@ -157,6 +158,24 @@ def test_ledger_word_for_word(features):
     ]
 
 
+def test_constraint_softness_the_rebuild_lacks_is_on_the_ledger(tmp_path):
+    """MuJoCo's limit, friction-loss and equality softness: the rebuilt MJCF has its defaults."""
+    (tmp_path / "soft.xml").write_text(
+        '<mujoco>\n<worldbody>\n<body name="a">\n<geom size="0.1"/>\n'
+        '<joint name="j" range="-1 1" solreflimit="0.005 1" frictionloss="0.1" solimpfriction="0.8 0.9 0.01 0.5 2"/>\n'
+        '<body name="b"><geom size="0.1"/><joint name="k" range="-1 1"/></body>\n</body>\n</worldbody>\n'
+        '<equality><joint joint1="k" joint2="j" solref="0.01 1"/></equality>\n</mujoco>\n')
+    ledger = convert(tmp_path / "soft.xml", tmp_path / "soft.yaml")[1].lines()
+    assert ledger[0].startswith("soft.xml: option integrator: all: Euler dropped")
+    assert ledger[1:] == [
+        "soft.xml:9: equality joint #0: all: a mimic joint: solref 0.01 1, solimp 0.9 0.95 0.001 0.5 2 dropped: the "
+        "rebuilt MJCF has MuJoCo's defaults (the recipe has no constraint softness)",
+        "soft.xml:5: joint 'j': all: solreflimit 0.005 1, solimplimit 0.9 0.95 0.001 0.5 2; solreffriction 0.02 1, "
+        "solimpfriction 0.8 0.9 0.01 0.5 2 dropped: the rebuilt MJCF has MuJoCo's defaults (the recipe has no "
+        "constraint softness)",
+    ]
+
+
 @pytest.fixture(scope="module")
 def rebuilt(tmp_path_factory):
     """The features robot imported with its verification, and a copy of its rebuilt MJCF."""
@@ -175,8 +194,11 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     result, folder = rebuilt
     assert result.verdict.ok, result.verdict.lines()
     assert result.verdict.configurations == 22  # the keyframe, the zero configuration, 20 random ones
+    assert result.verdict.rollouts == 0
     text = (folder / "features.yaml").read_text()
-    assert "# verified in MuJoCo against the original at 22 configurations: every quantity agrees" in text
+    assert "# verified in MuJoCo against the original at 22 configurations and 0 rollouts: every quantity agrees" in text
+    assert ("#   note: no rollout: ball joint 'wrist_ball' is three revolute joints through massless links in the "
+            "rebuild (approximated, on the ledger), whose motion parts from the ball's") in text
     assert "#   features.xml:53: tendon 'fingers': all: dropped: the recipe has no tendons" in text
     assert yaml.safe_load(text)["robot"] == "features"
     assert ("  # MJCF ref 0.02: the origin takes the body back to the joint's zero, so joint values (limits,\n"
@@ -184,17 +206,87 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     assert "  # one of the three revolute joints ball joint 'wrist_ball' becomes (x, y, z of its body)\n" in text
 
 
-def test_verification_catches_a_rebuild_that_differs(rebuilt, features):
+def test_verification_catches_a_rebuild_that_differs(rebuilt, features, tmp_path):
     _, folder = rebuilt
-    mjcf = folder / "copy" / "mjcf" / "features.xml"
-    text = mjcf.read_text()
-    assert 'mass="0.5"' in text
-    mjcf.write_text(text.replace('mass="0.5"', 'mass="0.6"'))
+    mjcf = _mutated(folder, tmp_path, "mjcf/features.xml", 'mass="0.5"', 'mass="0.6"')
     _, _, src, tree = features
     verdict = verify(src, tree, mjcf)
     assert not verdict.ok
     assert verdict.failures[:2] == ["total mass: mass off by 2.49e-02 (tolerance 1e-09)",
                                     "body 'fore' at keyframe 'home': mass off by 2.00e-01 (tolerance 1e-09)"]
+
+
+def _mutated(folder: Path, tmp_path: Path, name: str, old: str, new: str) -> Path:
+    """A copy of the rebuilt robot's folder with ``old`` replaced by ``new`` in its file ``name``
+    (mjcf/features.xml, urdf/features.urdf); the copy's MJCF."""
+    copy = tmp_path / "copy"
+    shutil.copytree(folder / "copy", copy)
+    text = (copy / name).read_text()
+    assert old in text
+    (copy / name).write_text(text.replace(old, new))
+    return copy / "mjcf" / "features.xml"
+
+
+def test_verification_loads_the_rebuilt_urdf_in_pinocchio(rebuilt, features, tmp_path):
+    """Only the URDF differs (its forearm heavier): Pinocchio's mass matrix and gravity forces,
+    matched to MuJoCo's by joint name, catch it."""
+    _, folder = rebuilt
+    mjcf = _mutated(folder, tmp_path, "urdf/features.urdf", '<mass value="0.5"/>', '<mass value="0.6"/>')
+    verdict = verify(features[2], features[3], mjcf)
+    assert verdict.failures and all(f.startswith("URDF ") and "in Pinocchio at" in f for f in verdict.failures)
+    assert verdict.failures[0].startswith("URDF mass matrix in Pinocchio at keyframe 'home': pinocchio off by ")
+    assert verdict.worst["matrix"][0] < 1e-6  # the MJCF still agrees
+
+
+@pytest.fixture(scope="module")
+def hinged(tmp_path_factory):
+    """The features robot with its ball joint a hinge (a model with a ball joint has no rollout),
+    imported with its verification, and a copy of its rebuilt folder."""
+    folder = tmp_path_factory.mktemp("hinged")
+    shutil.copy(FEATURES.parent / "rotor.stl", folder)
+    text = FEATURES.read_text().replace('type="ball"', 'axis="1 0 0"')
+    text = text.replace('qpos="0.5 0.75 0.05 0.9238795 0 0.3826834 0 0.01 0.01"', 'qpos="0.5 0.75 0.05 0.3 0.01 0.01"')
+    (folder / "features.xml").write_text(text)
+
+    def build(recipe, out):
+        built = build_mjcf(recipe, out)
+        shutil.copytree(built.parent.parent, folder / "copy")
+        return built
+
+    return import_mjcf(folder / "features.xml", folder / "features.yaml", build=build), folder
+
+
+def test_rollout_from_each_keyframe_agrees(hinged):
+    result, _ = hinged
+    assert result.verdict.ok, result.verdict.lines()
+    assert result.verdict.rollouts == 1
+    assert result.verdict.lines()[0] == ("verified in MuJoCo against the original at 22 configurations and 1 rollout: "
+                                         "every quantity agrees")
+    assert 0 < result.verdict.worst["rollout"][0] < 1e-4
+
+
+def test_verification_rollout_catches_what_the_configurations_do_not(hinged, tmp_path):
+    """Damping moves nothing at rest: only the 0.5 s rollout from the keyframe sees it."""
+    result, folder = hinged
+    mjcf = _mutated(folder, tmp_path, "mjcf/features.xml", 'damping="0.5"', 'damping="0.6"')
+    _, _, src, tree = convert(folder / "features.xml", tmp_path / "r.yaml")
+    verdict = verify(src, tree, mjcf)
+    assert verdict.rollouts == 1
+    assert len(verdict.failures) == 1 and verdict.failures[0].startswith("rollout from keyframe 'home': body ")
+
+
+def test_verification_checks_equalities_and_actuators(rebuilt, features, tmp_path):
+    _, folder = rebuilt
+    text = (folder / "copy" / "mjcf" / "features.xml").read_text()
+    equality = text[text.index("<equality>"):text.index("</equality>") + len("</equality>")]
+    mjcf = _mutated(folder, tmp_path, "mjcf/features.xml", equality, "")
+    text = mjcf.read_text()
+    mjcf.write_text(text.replace('kp="10"', 'kp="11"', 1))
+    verdict = verify(features[2], features[3], mjcf)
+    assert "equality #0 missing from the rebuild: equality off by 1.00e+00 (tolerance 1e-09)" in verdict.failures
+    assert ("equality count: 0 rebuilt, 1 kept of the original's 1: equality off by 1.00e+00 (tolerance 1e-09)"
+            in verdict.failures)
+    assert any(f.startswith("actuator 'grip' gain, bias and gear: actuator off by ") for f in verdict.failures)
 
 
 def test_refused_mjcf_is_one_line_at_its_line_and_nothing_written(tmp_path):
@@ -242,7 +334,7 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     proc = run_cli("import", X2, "-o", "x2.yaml", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout.splitlines()
-    assert out[0] == "verified in MuJoCo against the original at 22 configurations: every quantity agrees"
+    assert out[0] == "verified in MuJoCo against the original at 22 configurations and 1 rollout: every quantity agrees"
     assert out[-2:] == ["wrote x2.yaml (robot Skydio_X2); build it with:",
                         f"robotkit build --root {X2.parent / 'assets'} x2.yaml"]
     built = run_cli("build", "--root", X2.parent / "assets", "x2.yaml", "--no-report", cwd=tmp_path)
@@ -252,6 +344,9 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     assert ("ledger: x2.xml:26: material 'phong3SG': all: texture dropped: the recipe's material is a colour "
             "(its rgba kept)") in proc.stderr.splitlines()
     recipe = yaml.safe_load((tmp_path / "x2.yaml").read_text())
+    ledger = [line.removeprefix("ledger: ") for line in proc.stderr.splitlines() if line.startswith("ledger: ")]
+    assert recipe["metadata"]["ledger"] == ledger  # and the build's report.json carries it
+    assert json.loads((tmp_path / "build" / "Skydio_X2" / "report.json").read_text())["ledger"] == ledger
     assert recipe["base"] == "free" and list(recipe["links"]) == ["x2"]
     mesh = next(s for s in recipe["links"]["x2"]["visual"] if "mesh" in s)
     assert mesh["scale"] == 0.01  # set in the default class
@@ -259,8 +354,13 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
 
 MENAGERIE = ASSETS / "menagerie"
 SHARED = ["dynamixel_2r/dynamixel_2r.xml", "low_cost_robot_arm/low_cost_robot_arm.xml", "trs_so_arm100/so_arm100.xml",
-          "ufactory_xarm7/xarm7.xml", "trossen_vx300s/vx300s.xml", "kinova_gen3/gen3.xml", "robotiq_2f85/2f85.xml",
-          "bitcraze_crazyflie_2/cf2.xml", "agility_cassie/cassie.xml", "umi_gripper/umi_gripper.xml"]
+          "ufactory_xarm7/xarm7.xml", "ufactory_xarm7/xarm7_nohand.xml", "ufactory_xarm7/hand.xml",
+          "trossen_vx300s/vx300s.xml", "kinova_gen3/gen3.xml", "robotiq_2f85/2f85.xml", "bitcraze_crazyflie_2/cf2.xml",
+          "agility_cassie/cassie.xml", "umi_gripper/umi_gripper.xml", "google_barkour_vb/barkour_vb.xml",
+          "google_barkour_vb/barkour_vb_mjx.xml", "pal_tiago/tiago.xml", "pal_tiago/tiago_position.xml",
+          "pal_tiago/tiago_velocity.xml", "pal_tiago/tiago_motor.xml", "wonik_allegro/left_hand.xml",
+          "wonik_allegro/right_hand.xml"]
+"""Every entry file of the shared set (skydio_x2 is in tests/data)."""
 
 
 @pytest.mark.slow
@@ -270,5 +370,6 @@ def test_shared_menagerie_model_imports_and_agrees(model, tmp_path):
         pytest.skip("the shared Menagerie set is not here")
     result = import_mjcf(MENAGERIE / model, tmp_path / "r.yaml", build=build_mjcf)
     assert result.verdict.ok, result.verdict.lines()
+    assert (result.verdict.rollouts == 0) == (model == "agility_cassie/cassie.xml")  # its ball joints: no rollout
     worst = result.verdict.worst
     assert np.isfinite([v[0] for v in worst.values()]).all()

@@ -67,6 +67,8 @@ def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, o
     add_poses(src, tree, recipe, ledger)
     add_excludes(src, tree, recipe, ledger)
     ledger_rest(src, tree, ledger)
+    if len(ledger):  # the build copies it into report.json
+        recipe["metadata"] = {"ledger": ledger.lines()}
     if materials:
         recipe["materials"] = materials
     recipe["links"], recipe["joints"] = tree.links, tree.joints
@@ -99,17 +101,23 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     try:
+        body = dump_recipe(recipe, None, comments)  # once: the verdict joins the header after the build
         with widened(read):  # the original's meshes, where they are
-            tmp.write_text(dump_recipe(recipe, header, comments), encoding="utf-8")
+            tmp.write_text(_comments(header) + body, encoding="utf-8")
             _resolves(tmp, src.path)
             verdict = _verified(src, tree, tmp, build)
         if verdict is not None:
-            tmp.write_text(dump_recipe(recipe, header + verdict.lines(), comments), encoding="utf-8")
+            tmp.write_text(_comments(header + verdict.lines()) + body, encoding="utf-8")
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
     os.replace(tmp, out)
     return MjcfImport(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
+
+
+def _comments(lines: list[str]) -> str:
+    """The header as :func:`dump_recipe` writes it."""
+    return "".join(f"# {line}".rstrip() + "\n" for line in lines)
 
 
 def _verified(src, tree, recipe: Path, build) -> Verdict | None:

@@ -45,6 +45,7 @@ def add_actuators(src, tree, recipe: dict, ledger) -> None:
         joint = tree.joint_map[int(m.actuator_trnid[a][0])][0]
         interface, gains = _kind(m, a)
         out[joint] = {"interface": interface, **gains}
+        tree.actuated[a] = joint
         _limits(src, a, joint, interface, efforts, speeds, where, name, ledger)
     if out:
         recipe["actuators"] = out

@@ -115,6 +115,11 @@ def add_equalities(src, tree, recipe: dict, ledger) -> None:
                 if coef[0]:
                     mimic["offset"] = coef[0]
                 tree.joints[child]["mimic"] = mimic
+                tree.mimics[e] = (child, leader)
+                if not np.allclose(m.eq_solref[e], SOLREF) or not np.allclose(m.eq_solimp[e], SOLIMP):
+                    ledger.add(where, f"equality joint '{name}'" if name else f"equality joint #{e}", "all",
+                               f"a mimic joint: solref {_numbers(m.eq_solref[e])}, solimp {_numbers(m.eq_solimp[e])} "
+                               "dropped: the rebuilt MJCF has MuJoCo's defaults (the recipe has no constraint softness)")
                 continue
         label = f"equality {EQ_KINDS.get(t, t)}" + (f" '{name}'" if name else f" #{e}")
         ledger.add(where, label, "all",
@@ -136,6 +141,11 @@ def ledger_rest(src, tree, ledger) -> None:
             ledger.add(src.where(e), label, "all", "dropped: the recipe has no " + what + "s"
                        + (" (sites are frames: none in the recipe)" if kind == "site" else ""))
     for j in range(m.njnt):
+        softness = _softness(m, j)
+        if softness:
+            ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}'", "all",
+                       f"{softness} dropped: the rebuilt MJCF has MuJoCo's defaults (the recipe has no constraint "
+                       "softness)")
         if m.jnt_stiffness[j]:
             ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}'", "all",
                        f"spring dropped (stiffness {float(m.jnt_stiffness[j]):g}): the recipe has no joint springs")
@@ -144,3 +154,26 @@ def ledger_rest(src, tree, ledger) -> None:
                        "approximated: three revolute joints about the body's x, y, z through two massless links; "
                        "its armature, damping and friction act on each angle, not on the angular velocity"
                        + (" (its cone limit as each angle's range)" if m.jnt_limited[j] else ""))
+
+
+SOLREF, SOLIMP = (0.02, 1.0), (0.9, 0.95, 0.001, 0.5, 2.0)
+"""MuJoCo's default constraint softness, which the rebuilt MJCF has."""
+
+
+def _softness(m, j: int) -> str:
+    """A hinge's or slide's limit and friction-loss softness that is not MuJoCo's default ('' if none)."""
+    if int(m.jnt_type[j]) not in (HINGE, SLIDE):
+        return ""
+    d, out = int(m.jnt_dofadr[j]), []
+    if m.jnt_limited[j]:
+        if not np.allclose(m.jnt_solref[j], SOLREF) or not np.allclose(m.jnt_solimp[j], SOLIMP):
+            out.append(f"solreflimit {_numbers(m.jnt_solref[j])}, solimplimit {_numbers(m.jnt_solimp[j])}")
+        if m.jnt_margin[j]:
+            out.append(f"margin {float(m.jnt_margin[j]):g}")
+    if m.dof_frictionloss[d] and (not np.allclose(m.dof_solref[d], SOLREF) or not np.allclose(m.dof_solimp[d], SOLIMP)):
+        out.append(f"solreffriction {_numbers(m.dof_solref[d])}, solimpfriction {_numbers(m.dof_solimp[d])}")
+    return "; ".join(out)
+
+
+def _numbers(values) -> str:
+    return " ".join(f"{float(x):g}" for x in values)

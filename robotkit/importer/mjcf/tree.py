@@ -37,6 +37,8 @@ class Tree:
     base: str = "fixed"
     chain_links: list = field(default_factory=list)
     notes: dict = field(default_factory=dict)  # joint name -> comment above it
+    actuated: dict = field(default_factory=dict)  # MuJoCo actuator id -> the recipe joint it drives (kept ones)
+    mimics: dict = field(default_factory=dict)  # MuJoCo equality id -> (mimic joint, leader) (kept ones)
     ledger: list = field(default_factory=list)
 
 
