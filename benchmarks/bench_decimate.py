@@ -69,6 +69,15 @@ def t_robotkit(V, F, target):
     return out.vertices, out.faces
 
 
+def t_robotkit_shortcuts(V, F, target):
+    import trimesh
+
+    from robotkit.mesh.decimate import decimate
+
+    out, _ = decimate(trimesh.Trimesh(V, F, process=False), target_faces=target, samples=0, shortcuts=True)
+    return out.vertices, out.faces
+
+
 def t_meshlib(V, F, target):
     import meshlib.mrmeshnumpy as mn
     import meshlib.mrmeshpy as mm
@@ -154,7 +163,7 @@ def t_pymeshlab(V, F, target):
     return m.vertex_matrix(), m.face_matrix()
 
 
-TOOLS = {"robotkit": t_robotkit, "meshlib": t_meshlib, "meshoptimizer": t_meshoptimizer,
+TOOLS = {"robotkit": t_robotkit, "robotkit-shortcuts": t_robotkit_shortcuts, "meshlib": t_meshlib, "meshoptimizer": t_meshoptimizer,
          "fast-simplification": t_fast_simplification, "pymeshlab": t_pymeshlab}
 
 
@@ -234,13 +243,13 @@ def one(path: str, keep: float, repeat: int, samples: int, tools: list[str], fix
         row["tools"][name] = {"faces": int(len(f)), "time": min(times[name]), "cpu": min(cpus[name]),
                               "closed": is_closed(f),
                               "hausdorff": hausdorff(V, F, np.asarray(v, np.float64), f, samples)}
-    if "robotkit" in results:  # whether robotkit's quality check sent it to MeshLib alone
+    if "robotkit-shortcuts" in results:  # whether the shortcuts' heuristic check sent it to MeshLib alone
         import trimesh
 
         from robotkit.mesh.decimate import decimate
 
-        row["tools"]["robotkit"]["fallback"] = decimate(trimesh.Trimesh(V, F, process=False), target_faces=target,
-                                                         samples=0)[1]["fallback"]
+        row["tools"]["robotkit-shortcuts"]["fallback"] = decimate(
+            trimesh.Trimesh(V, F, process=False), target_faces=target, samples=0, shortcuts=True)[1]["fallback"]
     return row
 
 
@@ -320,21 +329,22 @@ def summary(rows, tools):
         kept = sum(r["tools"][t]["closed"] for r in closed_in)
         print(f"  {t:20} ran {len(ok):3}; within 2 % of the target {within:3}; closed kept closed "
               f"{kept}/{len(closed_in)}")
-    both = [r for r in rows if all("error" not in r["tools"].get(t, {"error": 1}) for t in ("robotkit", "meshlib"))]
-    if both:
-        h = np.array([r["tools"]["robotkit"]["hausdorff"] / max(r["tools"]["meshlib"]["hausdorff"], 1e-300)
+    for mine in ("robotkit", "robotkit-shortcuts"):
+        both = [r for r in rows if all("error" not in r["tools"].get(t, {"error": 1}) for t in (mine, "meshlib"))]
+        if not both:
+            continue
+        h = np.array([r["tools"][mine]["hausdorff"] / max(r["tools"]["meshlib"]["hausdorff"], 1e-300)
                       for r in both])
-        print(f"  Hausdorff robotkit / meshlib: median {np.median(h):.2f}, max {h.max():.2f}, "
+        print(f"  Hausdorff {mine} / meshlib: median {np.median(h):.2f}, max {h.max():.2f}, "
               f"<= 1.0 on {int((h <= 1.0 + 1e-9).sum())}/{len(h)}, <= 1.05 on {int((h <= 1.05).sum())}/{len(h)}; "
-              f"robotkit fell back to MeshLib alone on "
-              f"{sum(bool(r['tools']['robotkit'].get('fallback')) for r in both)}/{len(both)}")
+              f"fell back to MeshLib alone on {sum(bool(r['tools'][mine].get('fallback')) for r in both)}/{len(both)}")
     both = [r for r in rows if all("error" not in r["tools"].get(t, {"error": 1}) for t in ("robotkit", "pymeshlab"))]
     if both:
         h = np.array([r["tools"]["robotkit"]["hausdorff"] / max(r["tools"]["pymeshlab"]["hausdorff"], 1e-300)
                       for r in both])
         print(f"  Hausdorff robotkit / pymeshlab: median {np.median(h):.2f}, max {h.max():.2f}, "
               f"<= 1.05 on {int((h <= 1.05).sum())}/{len(h)}")
-    for other in ("pymeshlab", "meshlib", "meshoptimizer", "fast-simplification"):
+    for other in ("pymeshlab", "meshlib", "robotkit-shortcuts", "meshoptimizer", "fast-simplification"):
         both = [r for r in rows if "error" not in r["tools"].get("robotkit", {"error": 1})
                 and "error" not in r["tools"].get(other, {"error": 1})]
         if not both or other not in tools:
