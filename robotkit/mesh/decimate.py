@@ -2,9 +2,7 @@
 
 Decimation is MeshLib's (PyPI ``meshlib``) quadric edge collapse,
 ``decimateMesh`` with ``maxDeletedFaces`` = faces - target and no error
-bound, so it stops at the requested face count, after a first pass by
-meshoptimizer (PyPI ``meshoptimizer``, the Python binding in zeux/meshoptimizer)
-where that pass keeps the topology.  The libraries were chosen by measurement
+bound, so it stops at the requested face count.  The library was chosen by measurement
 (``benchmarks/bench_decimate.py``, docs/performance.md) against
 fast-simplification (used before), meshoptimizer alone and pymeshlab on every
 visual mesh of the examples and of the robots in shared/assets: MeshLib is the
@@ -15,37 +13,33 @@ Hausdorff distance, meshoptimizer alone is 4-10 times faster but opened 21 of 48
 closed meshes (tyres, lidar), pymeshlab opened closed meshes and crashes on
 some inputs.
 
-The first pass (:func:`_prepass`) takes meshoptimizer to 2 times the target
-and keeps its result only if it is a clean surface: every edge of at most two
-faces, no directed edge twice, no degenerate or repeated face, and no border
-where the input had none.  meshoptimizer does not check that a collapse keeps
-the surface manifold, and on thin parts it leaves duplicate faces; then the
-vertices round the defects are locked (its ``vertex_lock``) and it runs once
-more, to 4 times the target; where that fails too, or the first run leaves many defects, MeshLib does
-the work alone, first without moving vertices to 3 times the target, then with
-its optimal positions.  Where the pass is taken MeshLib has a fifth of the faces to collapse,
-2-4 times less time in all, and the Hausdorff distance was smaller in the median
-(0.85 of MeshLib alone's).  MeshLib checks every
-collapse (topology, flips), so a closed mesh stays closed.  Edge collapses keep
-holes: a mesh that lacks triangles of its tessellation (the KUKA iiwa's
-``link_7`` lacks 37) stops far above a low target, so when MeshLib stops above
-the target the holes of three edges are filled (:func:`_fill_missing_triangles`)
-and the decimation runs again.
+**The guarantee (issue 33)**: every result is within 2 % of its target and at or under MeshLib's
+Hausdorff distance at the same face count.  It holds by construction: by default the result *is*
+MeshLib's as a user calls it (:func:`_meshlib_alone`: the same bytes as ``decimateMesh`` on the
+input's float32 coordinates, checked on the 51 meshes of the benchmark), and the missing
+triangles of a tessellation are filled where MeshLib would stop above the target.  The shortcuts
+of issue 17 (``shortcuts=True``) are 2-4 times faster where they are kept, but no cheap check
+tells whether their result is as close as MeshLib's (see docs/performance.md, *Issue 33*), so
+they are not the default:
 
-The shortcuts (the first pass, the fast stage) are checked (issue 33, :func:`_guarantee`):
-the input's vertices (about ``CHECK_POINTS`` of them) are measured against the result, exactly,
-and where the input is further from it than ``GUARANTEE_FACTOR`` times the error MeshLib's last
-stage reports, MeshLib decimates the input alone and its result is kept; the report's
-``check`` and ``fallback`` say so.  On CAD meshes the first pass had dropped thin parts (the
-Kinova Gen3's links at a tenth of their faces: 7-8 times MeshLib's distance).  The check is a
-heuristic, not a proof: MeshLib alone's distance is not known without running it (see
-docs/performance.md, *Issue 33*).
+- meshoptimizer's first pass (:func:`_prepass`, PyPI ``meshoptimizer``, the Python binding in
+  zeux/meshoptimizer) to 2 times the target, kept only if it is a clean surface: every edge of
+  at most two faces, no directed edge twice, no degenerate or repeated face, and no border where
+  the input had none; where it fails, the vertices round the defects are locked (its
+  ``vertex_lock``) and it runs once more, to 4 times the target; where that fails too, MeshLib's
+  fast stage: first without moving vertices to 3 times the target, then with its optimal
+  positions;
+- then a heuristic check (:func:`_guarantee`): the input's vertices (about ``CHECK_POINTS``) are
+  measured against the result, and where the input is further from it than
+  ``GUARANTEE_FACTOR`` times the error MeshLib's last stage reports, MeshLib decimates the input
+  alone; the report's ``check`` and ``fallback`` say so.
 
 MeshLib builds a half-edge mesh: faces it cannot place (repeated or degenerate
 faces) are dropped on the way in, and the result is counted from what it
-returns.  It works in float32, so the mesh is moved to its bounding-box centre
-and scaled to a 1000-unit diagonal for both passes (the same result for a mesh
-in metres and in millimetres), and mapped back after.  Visual data (UVs,
+returns.  It works in float32: MeshLib alone gets the coordinates scaled by a power of two
+(exact, so the plain call's result comes back bit for bit); the shortcuts' path moves the mesh
+to its bounding-box centre and scales it to a 1000-unit diagonal (meshoptimizer's error bound
+is absolute; the same bytes for a mesh in metres and in millimetres), and maps it back after.  Visual data (UVs,
 colours) is dropped.  The result is deterministic: meshoptimizer is sequential,
 and MeshLib makes one sequential pass (``subdivideParts=1``; builds run meshes
 in parallel processes already, and MeshLib's threaded parts were no faster at
