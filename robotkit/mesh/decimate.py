@@ -172,17 +172,8 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
         details["holes_filled"] = filled
         out = trimesh.Trimesh(v, f, process=False)  # MeshLib packs: every vertex is used
     else:
-        diag = float(np.linalg.norm(hi - lo)) or 1.0
-        k = NORMALISED_DIAGONAL / diag
-        degenerate = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
-        if degenerate.any():  # MeshLib drops them: the UR5's meshes are closed without them
-            F = F[~degenerate]
-            census = _edge_census(F, len(V))
-        closed = vol_in is not None or census == CLOSED  # CLOSED and no volume: inside out
-        Vn = (V - centre) * k
-        v, f, details = _decimate_core(Vn, F, target, closed, defective=census[0])
-        v, f, details = _guarantee(Vn, F, v, f, details, target, closed, k)
-        out = trimesh.Trimesh(v / k + centre, f, process=False)  # MeshLib packs: every vertex is used
+        v, f, details = _with_shortcuts(V, F, target, census, vol_in is not None, lo, hi)
+        out = trimesh.Trimesh(v, f, process=False)  # MeshLib packs: every vertex is used
     F_out = np.asarray(out.faces, dtype=np.int64)
     V_out = np.asarray(out.vertices, dtype=np.float64)
     vol_out = _closed_volume(V_out, F_out, _edge_census(F_out, len(V_out)), centre)
@@ -197,6 +188,25 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     report["volume_change"] = vol_out / vol_in - 1.0 if vol_in and vol_out else None
     report["distance"] = surface_distance(mesh, out, samples, seed) if samples else None
     return out, report
+
+
+def _with_shortcuts(V: np.ndarray, F: np.ndarray, target: int, census: tuple, is_volume: bool, lo: np.ndarray,
+                    hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
+    """``decimate(..., shortcuts=True)``: (vertices, faces, details) by :func:`_decimate_core`
+    and :func:`_guarantee` on the mesh moved to its bounding-box centre (``lo``, ``hi``) and
+    scaled to a ``NORMALISED_DIAGONAL``-unit diagonal, mapped back; ``census``: the input's
+    :func:`_edge_census`, ``is_volume``: whether it is a closed volume."""
+    centre = 0.5 * (lo + hi)
+    k = NORMALISED_DIAGONAL / (float(np.linalg.norm(hi - lo)) or 1.0)
+    degenerate = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
+    if degenerate.any():  # MeshLib drops them: the UR5's meshes are closed without them
+        F = F[~degenerate]
+        census = _edge_census(F, len(V))
+    closed = is_volume or census == CLOSED  # CLOSED and no volume: inside out
+    Vn = (V - centre) * k
+    v, f, details = _decimate_core(Vn, F, target, closed, defective=census[0])
+    v, f, details = _guarantee(Vn, F, v, f, details, target, closed, k)
+    return v / k + centre, f, details
 
 
 def _meshlib_alone(V: np.ndarray, F: np.ndarray, target: int) -> tuple[np.ndarray, np.ndarray, int]:
