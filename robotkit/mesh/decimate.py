@@ -2,9 +2,7 @@
 
 Decimation is MeshLib's (PyPI ``meshlib``) quadric edge collapse,
 ``decimateMesh`` with ``maxDeletedFaces`` = faces - target and no error
-bound, so it stops at the requested face count, after a first pass by
-meshoptimizer (PyPI ``meshoptimizer``, the Python binding in zeux/meshoptimizer)
-where that pass keeps the topology.  The libraries were chosen by measurement
+bound, so it stops at the requested face count.  The library was chosen by measurement
 (``benchmarks/bench_decimate.py``, docs/performance.md) against
 fast-simplification (used before), meshoptimizer alone and pymeshlab on every
 visual mesh of the examples and of the robots in shared/assets: MeshLib is the
@@ -15,37 +13,33 @@ Hausdorff distance, meshoptimizer alone is 4-10 times faster but opened 21 of 48
 closed meshes (tyres, lidar), pymeshlab opened closed meshes and crashes on
 some inputs.
 
-The first pass (:func:`_prepass`) takes meshoptimizer to 2 times the target
-and keeps its result only if it is a clean surface: every edge of at most two
-faces, no directed edge twice, no degenerate or repeated face, and no border
-where the input had none.  meshoptimizer does not check that a collapse keeps
-the surface manifold, and on thin parts it leaves duplicate faces; then the
-vertices round the defects are locked (its ``vertex_lock``) and it runs once
-more, to 4 times the target; where that fails too, or the first run leaves many defects, MeshLib does
-the work alone, first without moving vertices to 3 times the target, then with
-its optimal positions.  Where the pass is taken MeshLib has a fifth of the faces to collapse,
-2-4 times less time in all, and the Hausdorff distance was smaller in the median
-(0.85 of MeshLib alone's).  MeshLib checks every
-collapse (topology, flips), so a closed mesh stays closed.  Edge collapses keep
-holes: a mesh that lacks triangles of its tessellation (the KUKA iiwa's
-``link_7`` lacks 37) stops far above a low target, so when MeshLib stops above
-the target the holes of three edges are filled (:func:`_fill_missing_triangles`)
-and the decimation runs again.
+**The guarantee (issue 33)**: every result is within 2 % of its target and at or under MeshLib's
+Hausdorff distance at the same face count.  It holds by construction: by default the result *is*
+MeshLib's as a user calls it (:func:`_meshlib_alone`: the same bytes as ``decimateMesh`` on the
+input's float32 coordinates, checked on the 51 meshes of the benchmark), and the missing
+triangles of a tessellation are filled where MeshLib would stop above the target.  The shortcuts
+of issue 17 (``shortcuts=True``) are 2-4 times faster where they are kept, but no cheap check
+tells whether their result is as close as MeshLib's (see docs/performance.md, *Issue 33*), so
+they are not the default:
 
-The shortcuts (the first pass, the fast stage) are checked (issue 33, :func:`_guarantee`):
-the input's vertices (about ``CHECK_POINTS`` of them) are measured against the result, exactly,
-and where the input is further from it than ``GUARANTEE_FACTOR`` times the error MeshLib's last
-stage reports, MeshLib decimates the input alone and its result is kept; the report's
-``check`` and ``fallback`` say so.  On CAD meshes the first pass had dropped thin parts (the
-Kinova Gen3's links at a tenth of their faces: 7-8 times MeshLib's distance).  The check is a
-heuristic, not a proof: MeshLib alone's distance is not known without running it (see
-docs/performance.md, *Issue 33*).
+- meshoptimizer's first pass (:func:`_prepass`, PyPI ``meshoptimizer``, the Python binding in
+  zeux/meshoptimizer) to 2 times the target, kept only if it is a clean surface: every edge of
+  at most two faces, no directed edge twice, no degenerate or repeated face, and no border where
+  the input had none; where it fails, the vertices round the defects are locked (its
+  ``vertex_lock``) and it runs once more, to 4 times the target; where that fails too, MeshLib's
+  fast stage: first without moving vertices to 3 times the target, then with its optimal
+  positions;
+- then a heuristic check (:func:`_guarantee`): the input's vertices (about ``CHECK_POINTS``) are
+  measured against the result, and where the input is further from it than
+  ``GUARANTEE_FACTOR`` times the error MeshLib's last stage reports, MeshLib decimates the input
+  alone; the report's ``check`` and ``fallback`` say so.
 
 MeshLib builds a half-edge mesh: faces it cannot place (repeated or degenerate
 faces) are dropped on the way in, and the result is counted from what it
-returns.  It works in float32, so the mesh is moved to its bounding-box centre
-and scaled to a 1000-unit diagonal for both passes (the same result for a mesh
-in metres and in millimetres), and mapped back after.  Visual data (UVs,
+returns.  It works in float32: MeshLib alone gets the coordinates scaled by a power of two
+(exact, so the plain call's result comes back bit for bit); the shortcuts' path moves the mesh
+to its bounding-box centre and scales it to a 1000-unit diagonal (meshoptimizer's error bound
+is absolute; the same bytes for a mesh in metres and in millimetres), and maps it back after.  Visual data (UVs,
 colours) is dropped.  The result is deterministic: meshoptimizer is sequential,
 and MeshLib makes one sequential pass (``subdivideParts=1``; builds run meshes
 in parallel processes already, and MeshLib's threaded parts were no faster at
@@ -113,11 +107,11 @@ def library() -> dict:
     """The decimation libraries and their versions, for cache keys and reports."""
     return {"library": LIBRARY, "library_version": _version(LIBRARY),
             "prepass_library": PREPASS_LIBRARY, "prepass_library_version": _version(PREPASS_LIBRARY),
-            "guarantee": f"meshlib-alone-above-{GUARANTEE_FACTOR}-error"}
+            "guarantee": "meshlib-alone-as-called-plainly"}
 
 
 def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, *,
-             samples: int = DEFAULT_SAMPLES, seed: int = 0) -> tuple[trimesh.Trimesh, dict]:
+             samples: int = DEFAULT_SAMPLES, seed: int = 0, shortcuts: bool = False) -> tuple[trimesh.Trimesh, dict]:
     """Return ``(decimated mesh, report)``.  Give exactly one of ``target_faces`` or ``ratio``.
 
     ``ratio`` is the fraction of faces to *keep* (0 < ratio <= 1).  A target
@@ -139,6 +133,13 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     ``samples`` is 0).  ``check`` and ``fallback``: the quality check of a shortcut's result,
     and whether MeshLib alone ran because it failed (:func:`_guarantee`; ``check`` is None
     when MeshLib alone was the path taken at once).
+
+    The guarantee of issue 33 (at or under MeshLib's distance at the same face count) holds by
+    construction: by default (``shortcuts`` false) the result *is* MeshLib's, called as a user
+    calls it (:func:`_meshlib_alone`: the same bytes as ``decimateMesh`` on the input's float32
+    coordinates).  ``shortcuts`` true: meshoptimizer's first pass or MeshLib's fast stage, with
+    the heuristic check of :func:`_guarantee` (2-4 times faster where it keeps the shortcut, no
+    guarantee).
     """
     n = int(len(mesh.faces))
     if (target_faces is None) == (ratio is None):
@@ -166,18 +167,13 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     details = {**_NO_PREPASS, "fast_stage": None, "holes_filled": 0, "check": None, "fallback": False}
     if target >= n:
         out = trimesh.Trimesh(V.copy(), F.copy(), process=False)
+    elif not shortcuts:
+        v, f, filled = _meshlib_alone(V, F, target)
+        details["holes_filled"] = filled
+        out = trimesh.Trimesh(v, f, process=False)  # MeshLib packs: every vertex is used
     else:
-        diag = float(np.linalg.norm(hi - lo)) or 1.0
-        k = NORMALISED_DIAGONAL / diag
-        degenerate = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
-        if degenerate.any():  # MeshLib drops them: the UR5's meshes are closed without them
-            F = F[~degenerate]
-            census = _edge_census(F, len(V))
-        closed = vol_in is not None or census == CLOSED  # CLOSED and no volume: inside out
-        Vn = (V - centre) * k
-        v, f, details = _decimate_core(Vn, F, target, closed, defective=census[0])
-        v, f, details = _guarantee(Vn, F, v, f, details, target, closed, k)
-        out = trimesh.Trimesh(v / k + centre, f, process=False)  # MeshLib packs: every vertex is used
+        v, f, details = _with_shortcuts(V, F, target, census, vol_in is not None, lo, hi)
+        out = trimesh.Trimesh(v, f, process=False)  # MeshLib packs: every vertex is used
     F_out = np.asarray(out.faces, dtype=np.int64)
     V_out = np.asarray(out.vertices, dtype=np.float64)
     vol_out = _closed_volume(V_out, F_out, _edge_census(F_out, len(V_out)), centre)
@@ -192,6 +188,56 @@ def decimate(mesh, target_faces: int | None = None, ratio: float | None = None, 
     report["volume_change"] = vol_out / vol_in - 1.0 if vol_in and vol_out else None
     report["distance"] = surface_distance(mesh, out, samples, seed) if samples else None
     return out, report
+
+
+def _with_shortcuts(V: np.ndarray, F: np.ndarray, target: int, census: tuple, is_volume: bool, lo: np.ndarray,
+                    hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, dict]:
+    """``decimate(..., shortcuts=True)``: (vertices, faces, details) by :func:`_decimate_core`
+    and :func:`_guarantee` on the mesh moved to its bounding-box centre (``lo``, ``hi``) and
+    scaled to a ``NORMALISED_DIAGONAL``-unit diagonal, mapped back; ``census``: the input's
+    :func:`_edge_census`, ``is_volume``: whether it is a closed volume."""
+    centre = 0.5 * (lo + hi)
+    k = NORMALISED_DIAGONAL / (float(np.linalg.norm(hi - lo)) or 1.0)
+    degenerate = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
+    if degenerate.any():  # MeshLib drops them: the UR5's meshes are closed without them
+        F = F[~degenerate]
+        census = _edge_census(F, len(V))
+    closed = is_volume or census == CLOSED  # CLOSED and no volume: inside out
+    Vn = (V - centre) * k
+    v, f, details = _decimate_core(Vn, F, target, closed, defective=census[0])
+    v, f, details = _guarantee(Vn, F, v, f, details, target, closed, k)
+    return v / k + centre, f, details
+
+
+def _meshlib_alone(V: np.ndarray, F: np.ndarray, target: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """MeshLib's decimation of (V, F) to ``target`` faces, the same bytes as MeshLib called plainly
+    (``decimateMesh`` on float32 coordinates, ``maxDeletedFaces``, its defaults otherwise, as
+    ``benchmarks/bench_decimate.py``'s ``meshlib`` column calls it): (float64 vertices, int64
+    faces, missing triangles filled).
+
+    The coordinates are scaled by the power of two nearest to a ``NORMALISED_DIAGONAL``-unit
+    diagonal and not moved: float32 rounding commutes with a power of two, so MeshLib sees the
+    plain call's coordinates times that power, makes the same collapses (measured: the same
+    faces on the Kinova Gen3's and Panda's meshes) and the result maps back exactly.  MeshLib's
+    settings have no absolute threshold left (the stabilizer weighs squared lengths against
+    squared lengths), so the scale is for float32's range only.  Where MeshLib stops above the
+    target and the input lacks triangles of its tessellation (:func:`_fill_missing_triangles`),
+    it runs again with those filled, and the result with fewer faces is kept: a plain call
+    misses the target there.
+    """
+    lo, hi = (V.min(axis=0), V.max(axis=0)) if len(V) else (np.zeros(3), np.zeros(3))
+    diag = float(np.linalg.norm(hi - lo))
+    s = 2.0 ** round(np.log2(NORMALISED_DIAGONAL / diag)) if diag > 0 and np.isfinite(diag) else 1.0
+    Vf = np.ascontiguousarray(V * s, dtype=np.float32)
+    v, f = _meshlib_decimate(Vf, F, target)
+    filled = 0
+    if len(f) > target:
+        Vh, Fh, holes = _fill_missing_triangles(Vf, F)
+        if holes:
+            vh, fh = _meshlib_decimate(Vh, Fh, target)
+            if len(fh) < len(f):
+                v, f, filled = vh, fh, holes
+    return v / s, f, filled
 
 
 def _guarantee(Vn: np.ndarray, F: np.ndarray, v: np.ndarray, f: np.ndarray, details: dict, target: int,

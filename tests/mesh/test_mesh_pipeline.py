@@ -269,15 +269,24 @@ def test_decimate_torus_ratio_is_deterministic():
     assert ra["distance"]["max"] < 0.01 * 0.5  # well under 1 % of the torus size
 
 
-def test_decimate_does_not_depend_on_units():
-    """Decimation thresholds are absolute (MeshLib's stabilizer, float32): robotkit normalises the size first."""
+@pytest.mark.parametrize("shortcuts", [False, True])
+def test_decimate_does_not_depend_on_units(shortcuts):
+    """The shortcuts' thresholds are absolute (meshoptimizer's error, float32): that path
+    normalises the size first, and gives the same bytes in mm and m.  MeshLib alone (the default)
+    has no absolute threshold and is called on the coordinates as given, scaled by a power of two:
+    the same surface up to float32 rounding (1000 is no power of two), not the same bytes: the
+    torus's many ties go the other way, and the distances differ by 9 % (measured)."""
     torus_m = trimesh.creation.torus(major_radius=0.2, minor_radius=0.05, major_sections=96, minor_sections=48)
     torus_mm = trimesh.Trimesh(np.asarray(torus_m.vertices) * 1000.0, torus_m.faces, process=False)
-    a, ra = decimate(torus_m, target_faces=900, samples=500)
-    b, rb = decimate(torus_mm, target_faces=900, samples=500)
-    np.testing.assert_array_equal(a.faces, b.faces)
-    np.testing.assert_allclose(np.asarray(b.vertices) / 1000.0, a.vertices, rtol=0, atol=1e-12)  # 5e-11 of the size
-    assert ra["distance"]["max"] == pytest.approx(rb["distance"]["max"] / 1000.0, rel=1e-6)
+    a, ra = decimate(torus_m, target_faces=900, samples=500, shortcuts=shortcuts)
+    b, rb = decimate(torus_mm, target_faces=900, samples=500, shortcuts=shortcuts)
+    if shortcuts:
+        np.testing.assert_array_equal(a.faces, b.faces)
+        np.testing.assert_allclose(np.asarray(b.vertices) / 1000.0, a.vertices, rtol=0, atol=1e-12)  # 5e-11 of the size
+        assert ra["distance"]["max"] == pytest.approx(rb["distance"]["max"] / 1000.0, rel=1e-6)
+    else:
+        assert 882 <= ra["faces_after"] == rb["faces_after"] <= 900
+        assert ra["distance"]["max"] == pytest.approx(rb["distance"]["max"] / 1000.0, rel=0.15)
 
 
 REAL_VISUALS = sorted(str(p.relative_to(REPO)) for p in (REPO / "recipes" / "meshes").rglob("*")
@@ -301,7 +310,7 @@ def test_decimate_reaches_the_target_and_keeps_closed_meshes_closed_on_real_mesh
     assert len(meshes) == 11
     misses, rounds = [], {}
     for rel, mesh in meshes:
-        out, report = decimate(mesh, ratio=keep, samples=0)
+        out, report = decimate(mesh, ratio=keep, samples=0, shortcuts=True)
         target = report["target_faces"]
         assert report["faces_after"] == len(out.faces) and report["library"] == "meshlib"
         assert report["prepass_library"] == "meshoptimizer"
@@ -341,7 +350,7 @@ def test_first_pass_locks_the_vertices_round_meshoptimizers_defects():
     assert details == {"prepass": 4.0, "prepass_rounds": 2, "prepass_locked": details["prepass_locked"]}
     assert details["prepass_locked"] > 0
     assert _edge_census(faces, len(V)) == CLOSED and len(faces) <= 4 * 2167
-    out, report = decimate(mesh, target_faces=2167, samples=0)
+    out, report = decimate(mesh, target_faces=2167, samples=0, shortcuts=True)
     assert report["is_volume_after"] and 2124 <= report["faces_after"] <= 2167 and report["prepass"] == 4.0
 
 
@@ -379,7 +388,7 @@ def test_meshlib_fast_stage_where_the_first_pass_gives_up(monkeypatch):
     monkeypatch.setattr(decimate_module, "FAST_STAGE", 3.0)
     monkeypatch.setattr(decimate_module, "GUARANTEE_FACTOR", float("inf"))
     tire = load_mesh(str(REPO / "recipes/meshes/turtlebot3/left_tire.stl"))
-    out, report = decimate(tire, target_faces=2167, samples=2000)
+    out, report = decimate(tire, target_faces=2167, samples=2000, shortcuts=True)
     assert report["prepass"] is None and report["prepass_rounds"] == 1 and report["fast_stage"] == 3.0
     assert report["is_volume_after"] and 2124 <= report["faces_after"] <= 2167
     V = np.asarray(tire.vertices)
@@ -408,7 +417,7 @@ def test_decimate_fills_missing_triangles_that_stop_it_above_the_target(monkeypa
             used |= set(sphere.faces[i])
     assert len(taken) == 40
     holed = trimesh.Trimesh(sphere.vertices, np.delete(sphere.faces, taken, axis=0), process=False)
-    out, report = decimate(holed, target_faces=100, samples=0)
+    out, report = decimate(holed, target_faces=100, samples=0, shortcuts=first_pass)
     assert 98 <= report["faces_after"] <= 100 and report["is_volume_after"]
     if not first_pass:
         assert report["holes_filled"] == 40
