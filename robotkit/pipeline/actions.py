@@ -360,8 +360,9 @@ def _proxy_pieces(mesh, kind: str, strategy: dict, params: dict):
                     preprocess=c["preprocess"], preprocess_resolution=c["preprocess_resolution"], seed=c["seed"],
                     max_hull_vertices=strategy["max_vertices"], mcts_iterations=c["mcts_iterations"],
                     input_faces=INPUT_FACES)  # in the cache key: the effective parameters
-        op, make = "collision-coacd/4", (lambda: decompose(mesh, **args))  # /2: bodies joined (coacd_input)
-        # /3: its large inputs decimated with the meshoptimizer first pass; /4: first pass with locks
+        op, make = "collision-coacd/5", (lambda: decompose(mesh, **args))  # /2: bodies joined (coacd_input)
+        # /3: its large inputs decimated with the meshoptimizer first pass; /4: first pass with locks;
+        # /5: large inputs decimated by MeshLib alone (decimate's default since issue 33)
     pieces, info = cache.get_or_compute(op, {**args, "fidelity_samples": 4000}, [mesh], with_report(make))
     return list(pieces) if isinstance(pieces, (list, tuple)) else [pieces], info["fidelity"]
 
