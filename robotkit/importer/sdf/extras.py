@@ -1,0 +1,92 @@
+"""What an SDF model holds beside links and joints: sensors and plugins (kept verbatim as
+``<gazebo>`` blocks of the recipe's ``urdf_extras``, which the build carries into model.sdf and
+the URDF: MJCF loses them, stated), ``<frame>``s (a massless link fixed where the frame is),
+model.config's metadata, and every other element the recipe has no place for (stated)."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+
+from robotkit.importer.sdf.frames import pose_of
+from robotkit.importer.sdf.model import children
+from robotkit.importer.sdf.tree import origin_of
+from robotkit.urdfxml import is_element
+
+LINK_KEPT = {"pose", "inertial", "visual", "collision", "sensor"}
+LINK_DEFAULTS = {"gravity": "true", "self_collide": "false", "kinematic": "false", "enable_wind": "false",
+                 "must_be_base_link": "false"}
+MODEL_KEPT = {"pose", "static", "link", "joint", "frame", "plugin", "model"}
+
+
+def add_extras(src, m, tree, recipe: dict, ledger) -> None:
+    extras: list[str] = []
+    for name, link in m.links.items():
+        O = np.linalg.inv(tree.offset(name, link.T))
+        for sensor in children(link.el, "sensor"):
+            extras.append(_block(sensor, O, name))
+            ledger.add(src.where("sensor", sensor.get("name")), f"sensor '{sensor.get('name')}' "
+                       f"({sensor.get('type')}) of link '{name}'", "MJCF",
+                       "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
+        _other(src, link.el, name, ledger)
+    for plugin in m.plugins:
+        extras.append(_block(plugin, None, None))
+        ledger.add(src.where("plugin", plugin.get("name")), f"plugin '{plugin.get('name')}' "
+                   f"({plugin.get('filename')})", "MJCF",
+                   "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
+    for el in (c for c in src.model if is_element(c) and c.tag not in MODEL_KEPT):
+        if not (el.tag in ("self_collide", "allow_auto_disable", "enable_wind") and (el.text or "").strip() in
+                ("false", "0", "true" if el.tag == "allow_auto_disable" else "-")):
+            ledger.add(src.where(el.tag, el.get("name")), f"model <{el.tag}>", "all", "dropped: no place in the recipe")
+    _frames(src, m, tree, ledger)
+    if extras:
+        recipe["urdf_extras"] = extras
+
+
+def _block(el, O, link: str | None) -> str:
+    from lxml import etree  # heavy: only when the model has one
+
+    el = copy.deepcopy(el)
+    if O is not None and not np.allclose(O, np.eye(4)):
+        _, P = pose_of(el)
+        pose = el.find("pose")
+        if pose is None:
+            pose = etree.SubElement(el, "pose")
+        o = origin_of(O @ P) or {}
+        pose.text = " ".join(f"{v:.17g}" for v in list(o.get("xyz", [0, 0, 0])) + list(o.get("rpy", [0, 0, 0])))
+        pose.attrib.pop("relative_to", None)
+    block = etree.Element("gazebo", reference=link) if link else etree.Element("gazebo")
+    block.append(el)
+    etree.indent(block, space="  ")
+    return etree.tostring(block, encoding="unicode").strip()
+
+
+def _other(src, el, name: str, ledger) -> None:
+    for child in el:
+        if not is_element(child) or child.tag in LINK_KEPT:
+            continue
+        if LINK_DEFAULTS.get(child.tag) == (child.text or "").strip().lower():
+            continue
+        ledger.add(src.where("link", name), f"<{child.tag}> of link '{name}'", "all", "dropped: no place in the recipe")
+    for c in children(el, "collision"):
+        if c.find("surface") is not None:
+            ledger.add(src.where("collision", c.get("name")), f"collision '{c.get('name')}' of link '{name}' <surface>",
+                       "all", "dropped: friction and contact parameters (the recipe's are per link)")
+
+
+def _frames(src, m, tree, ledger) -> None:
+    for name, (attached, T) in m.frames.items():
+        base = attached if attached in tree.frame else None
+        if base is None or name in tree.links:
+            ledger.add(src.where("frame", name), f"frame '{name}'", "all", f"dropped: attached to '{attached}', "
+                       "not a link")
+            continue
+        tree.links[name] = {}
+        tree.frame[name] = T
+        joint = {"type": "fixed", "parent": base, "child": name}
+        o = origin_of(np.linalg.inv(tree.frame[base]) @ T)
+        if o:
+            joint["origin"] = o
+        tree.joints[f"{name}_frame"] = joint
+        tree.link_notes[name] = f"SDF <frame> '{name}' (attached to '{attached}'): a massless link fixed there"
