@@ -63,16 +63,19 @@ def _block(el, O, link: str | None) -> str:
 
 
 def _other(src, el, name: str, ledger) -> None:
+    """One line per link for what it holds that the recipe has no place for."""
+    dropped = []
     for child in el:
         if not is_element(child) or child.tag in LINK_KEPT:
             continue
-        if LINK_DEFAULTS.get(child.tag) == (child.text or "").strip().lower():
-            continue
-        ledger.add(src.where("link", name), f"<{child.tag}> of link '{name}'", "all", "dropped: no place in the recipe")
-    for c in children(el, "collision"):
-        if c.find("surface") is not None:
-            ledger.add(src.where("collision", c.get("name")), f"collision '{c.get('name')}' of link '{name}' <surface>",
-                       "all", "dropped: friction and contact parameters (the recipe's are per link)")
+        value = {"1": "true", "0": "false"}.get((child.text or "").strip().lower(), (child.text or "").strip().lower())
+        if LINK_DEFAULTS.get(child.tag) != value:
+            dropped.append(f"<{child.tag}>")
+    dropped += [f"the <surface> of collision '{c.get('name')}'" for c in children(el, "collision")
+                if c.find("surface") is not None]
+    if dropped:
+        ledger.add(src.where("link", name), f"link '{name}'", "all", f"dropped: {', '.join(dropped)} (no place in "
+                   "the recipe: its contact parameters are per link, not per collision)")
 
 
 def _frames(src, m, tree, ledger) -> None:

@@ -51,7 +51,7 @@ def locate(path: str | os.PathLike) -> tuple[Path, dict]:
         raise RobotkitError(Problem("a model folder without model.config", file=str(p)))
     files, meta = read_config(config)
     for version, name in sorted(files, key=lambda f: _version(f[0]), reverse=True):
-        if _version(version) > (1, 2) and (p / name).is_file():
+        if (not version or _version(version) > (1, 2)) and (p / name).is_file():
             return p / name, meta
     raise RobotkitError(Problem("model.config names no SDF file newer than 1.2 that exists in the folder",
                                 file=str(config)))
@@ -83,7 +83,7 @@ def printed(file: Path, model_path: Path | None) -> subprocess.CompletedProcess:
     if model_path is not None:
         for key in ENV_KEYS:
             env[key] = os.pathsep.join(filter(None, [str(model_path), env.get(key, "")]))
-    return subprocess.run(["ign", "sdf", "-p", str(file.absolute())], capture_output=True, text=True, env=env)
+    return subprocess.run(["ign", "sdf", "-p", str(Path(file).absolute())], capture_output=True, text=True, env=env)
 
 
 def read(path: str | os.PathLike) -> Source:
@@ -118,6 +118,7 @@ def _model(root):
 
 def _words(stderr: str) -> str:
     """libsdformat's first error, on one line."""
+    stderr = re.sub(r"\x1b\[[0-9;]*m", "", stderr)
     lines = [ln.strip() for ln in stderr.splitlines() if ln.strip() and "libignition-tools-backward" not in ln]
     errors = [ln for ln in lines if "rror" in ln] or lines
     return " ".join(errors[0].split()) if errors else "libsdformat refused the file"

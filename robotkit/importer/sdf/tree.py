@@ -116,13 +116,20 @@ def _joint(src, tree: Tree, j, chain_mass: float, ledger) -> None:
     if j.type in CHAINS:
         n = CHAINS[j.type]
         axes = [np.eye(3)[k] for k in range(3)] if j.type == "ball" else [R.T @ a for a in j.axes[:2]]
+        if len(axes) < n:  # a universal joint without its axes: x and y of its frame
+            axes = [np.eye(3)[k] for k in range(n)]
         names = [f"{j.name}_{'xyz'[k]}" if j.type == "ball" else f"{j.name}_{k + 1}" for k in range(n)]
         how = ("three revolute joints about its frame's x, y, z" if j.type == "ball" else
                "two revolute joints, about its axis then its axis2")
         ledger.add(where, f"joint '{j.name}' ({j.type})", "all",
                    f"approximated: {how} ({', '.join(names)}), through massless links")
     else:
-        axes, names = [R.T @ j.axes[0]] if j.axes else [np.array([1.0, 0, 0])], [j.name]
+        axes, names = [R.T @ j.axes[0]] if j.axes else [np.array([0, 0, 1.0])], [j.name]
+        if _locked(j):
+            tree.joints[j.name] = _fixed(tree, j.parent, j.child)
+            ledger.add(where, f"joint '{j.name}' ({j.type})", "all", "a fixed joint: its limits are equal (it "
+                       "cannot move)")
+            return
     if j.type == "screw":
         pitch = j.el.findtext("thread_pitch") or j.el.findtext("screw_thread_pitch") or "1"
         ledger.add(where, f"joint '{j.name}' (screw)", "all", f"approximated: a revolute joint (its translation "
@@ -143,6 +150,12 @@ def _joint(src, tree: Tree, j, chain_mass: float, ledger) -> None:
     tree.joint_map[j.name] = names
 
 
+def _locked(j) -> bool:
+    lim = j.el.find("axis/limit")
+    lo, hi = (lim.findtext(k) if lim is not None else None for k in ("lower", "upper"))
+    return j.type in ("revolute", "prismatic") and lo is not None and hi is not None and float(lo) == float(hi)
+
+
 def _motion(src, tree: Tree, j, axis, k: int, ledger) -> dict:
     """type, axis, limit, dynamics of one revolute/prismatic stage of SDF joint ``j``."""
     el = j.el.find("axis2" if k == 1 and j.type in ("universal", "revolute2") else "axis")
@@ -150,6 +163,10 @@ def _motion(src, tree: Tree, j, axis, k: int, ledger) -> dict:
     num = lambda node, tag: float(node.findtext(tag)) if node is not None and node.findtext(tag) else None  # noqa
     lo, hi = num(lim, "lower"), num(lim, "upper")
     prismatic = j.type == "prismatic"
+    if lo is not None and hi is not None and lo == hi:  # an axis that cannot move
+        ledger.add(src.where("joint", j.name), f"joint '{j.name}' ({j.type}), axis {k + 1}", "all",
+                   "a fixed joint: its limits are equal (it cannot move)")
+        return {"type": "fixed"}
     out: dict = {"type": "prismatic" if prismatic else "revolute", "axis": clean(axis / np.linalg.norm(axis))}
     unlimited = lo is None or hi is None or abs(lo) >= HUGE or abs(hi) >= HUGE or j.type == "continuous"
     if unlimited and not prismatic:

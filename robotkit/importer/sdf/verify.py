@@ -56,7 +56,9 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
     verdict = Verdict(worst={k: (0.0, "") for k in TOL})
     pairs = [(j, names[0]) for j, names in tree.joint_map.items() if len(names) == 1
              and original.joints[j].type in ("revolute", "continuous", "prismatic") and names[0] in rebuilt.joints]
-    _joints(verdict, original, rebuilt, tree)
+    root = next(n for n in original.links if not any(j.child == n for j in original.joints.values()))
+    _joints(verdict, original, rebuilt, tree, (original.links[root].T @ tree.offset(root, original.links[root].T),
+                                                rebuilt.links[root].T))
     rng = np.random.default_rng(SEED)
     configs = [("the zero configuration", {})]
     for i in range(SAMPLES if pairs else 0):
@@ -64,7 +66,6 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
              for j, _ in pairs}
         configs.append((f"random configuration {i + 1}", q))
     names = dict(pairs)
-    root = next(n for n in original.links if not any(j.child == n for j in original.joints.values()))
     for label, q in configs:
         po = _relative(poses(original, q), root, tree.offset(root, original.links[root].T))
         pr = _relative(poses(rebuilt, {names[j]: v for j, v in q.items()}), root, np.eye(4))
@@ -87,7 +88,9 @@ def _check(verdict: Verdict, kind: str, err: float, where: str) -> None:
         verdict.failures.append(f"{where}: {kind} off by {err:.2e} (tolerance {TOL[kind]:g})")
 
 
-def _joints(verdict: Verdict, original, rebuilt, tree) -> None:
+def _joints(verdict: Verdict, original, rebuilt, tree, roots) -> None:
+    """Each kept joint's kind, and its axis in its model's root link frame."""
+    Ro, Rr = (T[:3, :3] for T in roots)
     for j, names in tree.joint_map.items():
         oj = original.joints[j]
         if len(names) != 1 or oj.type not in KIND:
@@ -98,7 +101,7 @@ def _joints(verdict: Verdict, original, rebuilt, tree) -> None:
                                     f"{rj.type if rj else 'missing'} in the rebuild")
             continue
         if oj.axes and rj.axes:
-            _check(verdict, "axis", float(np.abs(oj.axes[0] - rj.axes[0]).max()), f"joint '{j}' axis")
+            _check(verdict, "axis", float(np.abs(Ro.T @ oj.axes[0] - Rr.T @ rj.axes[0]).max()), f"joint '{j}' axis")
 
 
 def poses(model, q: dict) -> dict:
