@@ -57,7 +57,7 @@ def convert(path, out: Path):
                    "XML, as Gazebo classic loads it")
     renamed = joints_apart_from_links([c for c in src.model if is_element(c)])
     for old, new in renamed.items():
-        ledger.add(src.where("joint", new), f"joint '{old}'", "all", f"renamed '{new}' (a link has its name: "
+        ledger.add(src.where("joint", old), f"joint '{old}'", "all", f"renamed '{new}' (a link has its name: "
                    "libsdformat refuses the pair)")
     m = read_model(src.model, str(src.path))
     tree = build_tree(src, m, ledger)

@@ -26,7 +26,7 @@ def add_extras(src, m, tree, recipe: dict, ledger) -> None:
         O = np.linalg.inv(tree.offset(name, link.T))
         for sensor in children(link.el, "sensor"):
             extras.append(_block(sensor, O, name))
-            ledger.add(src.where("sensor", sensor.get("name")), f"sensor '{sensor.get('name')}' "
+            ledger.add(src.where("sensor", sensor.get("name"), name), f"sensor '{sensor.get('name')}' "
                        f"({sensor.get('type')}) of link '{name}'", "MJCF",
                        "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
         _other(src, link.el, name, ledger)

@@ -62,12 +62,12 @@ def _shape(src, el, O, out: Path, ledger, files: list, kind: str) -> list[dict]:
             _at({"sphere": {"radius": r}}, _moved(e[:3])) for e in ends]
     if shape.tag == "ellipsoid":
         radii = num("radii", "1 1 1")
-        ledger.add(src.where(kind, el.get("name")), f"{label} (ellipsoid)", "all",
+        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (ellipsoid)", "all",
                    "approximated: the box of its half-axes " + " ".join(f"{r:g}" for r in radii))
         return [_at({"box": {"size": [2 * r for r in radii]}}, T)]
     if shape.tag == "mesh":
         return _mesh(src, el, shape, T, out, ledger, files, label, kind)
-    ledger.add(src.where(kind, el.get("name")), f"{label} ({shape.tag})", "all", "dropped: the recipe has no such shape")
+    ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} ({shape.tag})", "all", "dropped: the recipe has no such shape")
     return []
 
 
@@ -95,10 +95,10 @@ def _mesh(src, el, shape, T, out: Path, ledger, files, label: str, kind: str) ->
     uri = (shape.findtext("uri") or "").strip()
     file = mesh_file(src, uri)
     if file is None or not file.is_file():
-        ledger.add(src.where(kind, el.get("name")), f"{label} (mesh {uri})", "all", "dropped: its file is not found")
+        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (mesh {uri})", "all", "dropped: its file is not found")
         return []
     if shape.find("submesh") is not None:
-        ledger.add(src.where(kind, el.get("name")), f"{label} (mesh {uri})", "all",
+        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (mesh {uri})", "all",
                    "approximated: the whole mesh file (the recipe names no submesh)")
     files.append(str(file.resolve()))
     out_shape = {"mesh": Path(os.path.relpath(file.resolve(), out.parent)).as_posix()}

@@ -29,15 +29,16 @@ class Source:
     config: dict = field(default_factory=dict)  # model.config: name, version, description, authors
     model_path: Path | None = None
 
-    def where(self, kind: str, name: str | None) -> str:
-        """``file:line`` of the element ``<kind name="name">`` in the original file (the file alone
-        when it is not there: it came from an include)."""
-        if name:
-            pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name)}[\"']")
-            for i, line in enumerate(self.lines, 1):
-                if pattern.search(line):
-                    return f"{self.path}:{i}"
-        return str(self.path)
+    def where(self, kind: str, name: str | None, link: str | None = None) -> str:
+        """``file:line`` of the element ``<kind name="name">`` in the original file (inside link
+        ``link`` when given); the file alone when it is not there (it came from an include)."""
+        start = self.line_of("link", link) if link else 1
+        line = self.line_of(kind, name, start or 1) if name else None
+        return f"{self.path}:{line}" if line else str(self.path)
+
+    def line_of(self, kind: str, name: str | None, start: int = 1) -> int | None:
+        pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name or '')}[\"']")
+        return next((i for i, line in enumerate(self.lines[start - 1:], start) if pattern.search(line)), None)
 
 
 def locate(path: str | os.PathLike) -> tuple[Path, dict]:
