@@ -25,6 +25,7 @@ from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.ledger import Ledger
 from robotkit.importer.names import joints_apart_from_links
 from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
+from robotkit.importer.sdf.contacts import add_contacts
 from robotkit.importer.sdf.extras import add_extras
 from robotkit.importer.sdf.model import read_model
 from robotkit.importer.sdf.shapes import add_shapes
@@ -56,6 +57,7 @@ def convert(path, out: Path):
         ledger.add(str(src.path), "the file", "all", f"libsdformat refuses it ({src.refused}): read from its own "
                    "XML, as Gazebo classic loads it")
     renamed = joints_apart_from_links([c for c in src.model if is_element(c)])
+    src.renamed = {new: old for old, new in renamed.items()}
     for old, new in renamed.items():
         ledger.add(src.where("joint", old), f"joint '{old}'", "all", f"renamed '{new}' (a link has its name: "
                    "libsdformat refuses the pair)")
@@ -64,13 +66,14 @@ def convert(path, out: Path):
     materials: dict = {}
     repaired: dict = {}
     files = add_shapes(src, m, tree, out, ledger, materials, repaired)
+    surfaces = add_contacts(m, tree)
     recipe: dict = {"robot": _robot_name(m.name)}
     meta = _metadata(src.config)
     if meta:
         recipe["metadata"] = meta
     if tree.base == "free":
         recipe["base"] = "free"
-    add_extras(src, m, tree, recipe, ledger)
+    add_extras(src, m, tree, recipe, ledger, surfaces)
     if materials:
         recipe["materials"] = materials
     recipe["links"], recipe["joints"] = tree.links, tree.joints

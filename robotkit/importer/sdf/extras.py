@@ -20,7 +20,7 @@ LINK_DEFAULTS = {"gravity": "true", "self_collide": "false", "kinematic": "false
 MODEL_KEPT = {"pose", "static", "link", "joint", "frame", "plugin", "model"}
 
 
-def add_extras(src, m, tree, recipe: dict, ledger) -> None:
+def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
     extras: list[str] = []
     for name, link in m.links.items():
         O = np.linalg.inv(tree.offset(name, link.T))
@@ -29,7 +29,7 @@ def add_extras(src, m, tree, recipe: dict, ledger) -> None:
             ledger.add(src.where("sensor", sensor.get("name"), name), f"sensor '{sensor.get('name')}' "
                        f"({sensor.get('type')}) of link '{name}'", "MJCF",
                        "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
-        _other(src, link.el, name, ledger)
+        _other(src, link.el, name, ledger, surfaces.get(name, []))
     for plugin in m.plugins:
         extras.append(_block(plugin, None, None))
         ledger.add(src.where("plugin", plugin.get("name")), f"plugin '{plugin.get('name')}' "
@@ -62,20 +62,19 @@ def _block(el, O, link: str | None) -> str:
     return etree.tostring(block, encoding="unicode").strip()
 
 
-def _other(src, el, name: str, ledger) -> None:
-    """One line per link for what it holds that the recipe has no place for."""
-    dropped = []
+def _other(src, el, name: str, ledger, dropped: list) -> None:
+    """One line per link for what it holds that the recipe has no place for (``dropped``: of its
+    collisions' surfaces)."""
+    dropped = list(dropped)
     for child in el:
         if not is_element(child) or child.tag in LINK_KEPT:
             continue
         value = {"1": "true", "0": "false"}.get((child.text or "").strip().lower(), (child.text or "").strip().lower())
         if LINK_DEFAULTS.get(child.tag) != value:
-            dropped.append(f"<{child.tag}>")
-    dropped += [f"the <surface> of collision '{c.get('name')}'" for c in children(el, "collision")
-                if c.find("surface") is not None]
+            dropped.insert(0, f"<{child.tag}> {value}".strip())
     if dropped:
-        ledger.add(src.where("link", name), f"link '{name}'", "all", f"dropped: {', '.join(dropped)} (no place in "
-                   "the recipe: its contact parameters are per link, not per collision)")
+        ledger.add(src.where("link", name), f"link '{name}'", "all", "dropped (no place in the recipe, whose contact "
+                   f"is a link's mu1, mu2, kp, kd): {', '.join(dropped)}")
 
 
 def _frames(src, m, tree, ledger) -> None:

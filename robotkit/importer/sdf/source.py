@@ -28,10 +28,12 @@ class Source:
     refused: str = ""  # libsdformat's words when it refused the file
     config: dict = field(default_factory=dict)  # model.config: name, version, description, authors
     model_path: Path | None = None
+    renamed: dict = field(default_factory=dict)  # new joint name -> the file's
 
     def where(self, kind: str, name: str | None, link: str | None = None) -> str:
         """``file:line`` of the element ``<kind name="name">`` in the original file (inside link
         ``link`` when given); the file alone when it is not there (it came from an include)."""
+        name = self.renamed.get(name, name) if kind == "joint" else name
         start = self.line_of("link", link) if link else 1
         line = self.line_of(kind, name, start or 1) if name else None
         return f"{self.path}:{line}" if line else str(self.path)
