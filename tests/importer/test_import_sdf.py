@@ -99,3 +99,88 @@ def test_folder_without_model_config_exit_2(tmp_path):
     proc = run_cli("import", "empty", "-o", tmp_path / "out" / "x.yaml", cwd=tmp_path)
     assert (proc.returncode, proc.stderr) == (2, "empty: a model folder without model.config\n")
     assert not (tmp_path / "out").exists()
+
+
+SYNTHETIC = """<?xml version="1.0"?>
+<sdf version="1.9">
+  <model name="bench">
+    <static>true</static>
+    <link name="base">
+      <pose>0 0 0.5 0 0 0</pose>
+      <inertial><mass>2</mass><inertia><ixx>0.1</ixx><iyy>0.1</iyy><izz>0.1</izz></inertia></inertial>
+      <collision name="c"><geometry><capsule><radius>0.1</radius><length>0.4</length></capsule></geometry></collision>
+      <visual name="v"><geometry><capsule><radius>0.1</radius><length>0.4</length></capsule></geometry>
+        <material><diffuse>0.2 0.4 0.6 1</diffuse></material></visual>
+      <sensor name="imu" type="imu"><update_rate>50</update_rate></sensor>
+    </link>
+    <link name="arm">
+      <pose>0.3 0 0.5 0 0 0</pose>
+      <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+    </link>
+    <joint name="hinge" type="revolute">
+      <pose>0 0.1 0 0 0 0</pose>
+      <parent>base</parent><child>arm</child>
+      <axis><xyz>0 1 0</xyz><limit><lower>-1</lower><upper>1</upper><effort>5</effort><velocity>2</velocity></limit>
+        <dynamics><damping>0.3</damping><friction>0.1</friction></dynamics></axis>
+    </joint>
+    <frame name="tool" attached_to="arm"><pose>0.1 0 0 0 0 0</pose></frame>
+    <plugin name="p" filename="libp.so"><x>1</x></plugin>
+  </model>
+</sdf>
+"""
+
+
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("synthetic")
+    (tmp / "bench.sdf").write_text(SYNTHETIC)
+    built = {}
+
+    def build(recipe, folder):
+        path = build_sdf(recipe, folder)
+        built["sdf"] = path.read_text()
+        return path
+
+    result = import_sdf(tmp / "bench.sdf", tmp / "bench.yaml", build=build)
+    return result, yaml.safe_load(result.recipe_path.read_text()), built["sdf"]
+
+
+def test_static_model_is_fixed_to_world(synthetic):
+    result, recipe, _ = synthetic
+    assert result.verdict.ok, result.verdict.lines()
+    assert "base" not in recipe or recipe.get("base") != "free"
+    assert _joints(recipe)["base_fixed"]["parent"] == "world"
+
+
+def test_joint_off_its_child_moves_the_link_frame_limits_dynamics(synthetic):
+    _, recipe, _ = synthetic
+    hinge = _joints(recipe)["hinge"]
+    assert hinge["origin"]["xyz"] == [0.3, 0.1, 0]
+    assert hinge["axis"] == [0, 1, 0]
+    assert hinge["limit"] == {"lower": -1, "upper": 1, "effort": 5, "velocity": 2}
+    assert hinge["dynamics"] == {"damping": 0.3, "friction": 0.1}
+    assert recipe["links"]["arm"]["inertial"]["com"] == [0, -0.1, 0]  # in the joint's frame
+
+
+def test_capsule_is_a_cylinder_and_two_spheres_with_its_colour(synthetic):
+    _, recipe, _ = synthetic
+    visual = recipe["links"]["base"]["visual"]
+    assert [next(k for k in ("cylinder", "sphere") if k in s) for s in visual] == ["cylinder", "sphere", "sphere"]
+    assert [s.get("origin", {}).get("xyz") for s in visual[1:]] == [[0, 0, -0.2], [0, 0, 0.2]]
+    assert recipe["materials"][visual[0]["material"]]["rgba"] == [0.2, 0.4, 0.6, 1]
+
+
+def test_frame_is_a_massless_link_fixed_where_it_is(synthetic):
+    _, recipe, _ = synthetic
+    assert recipe["links"]["tool"] == {} or "inertial" not in recipe["links"]["tool"]
+    joint = _joints(recipe)["tool_frame"]
+    assert (joint["type"], joint["parent"], joint["child"]) == ("fixed", "arm", "tool")
+    assert joint["origin"]["xyz"] == pytest.approx([0.1, -0.1, 0], abs=1e-15)
+
+
+def test_sensor_and_plugin_carried_verbatim_into_model_sdf(synthetic):
+    result, recipe, rebuilt = synthetic
+    assert any(e.startswith('<gazebo reference="base">\n  <sensor name="imu" type="imu">') for e in recipe["urdf_extras"])
+    assert '<sensor name="imu" type="imu">' in rebuilt.replace("'", '"') and 'filename="libp.so"' in rebuilt
+    assert any("sensor 'imu' (imu) of link 'base': MJCF: dropped (kept verbatim" in line for line in result.ledger)
+    assert any("plugin 'p' (libp.so): MJCF: dropped (kept verbatim" in line for line in result.ledger)
