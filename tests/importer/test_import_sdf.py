@@ -184,3 +184,14 @@ def test_sensor_and_plugin_carried_verbatim_into_model_sdf(synthetic):
     assert '<sensor name="imu" type="imu">' in rebuilt.replace("'", '"') and 'filename="libp.so"' in rebuilt
     assert any("sensor 'imu' (imu) of link 'base': MJCF: dropped (kept verbatim" in line for line in result.ledger)
     assert any("plugin 'p' (libp.so): MJCF: dropped (kept verbatim" in line for line in result.ledger)
+
+
+def test_included_model_found_on_the_model_path_with_scoped_names(tmp_path):
+    result = import_sdf(MODELS / "nested_hokuyo" / "model.sdf", tmp_path / "n.yaml", build=build_sdf)
+    recipe = yaml.safe_load(result.recipe_path.read_text())
+    assert result.verdict.ok, result.verdict.lines()
+    assert "hokuyo/link" in recipe["links"]  # model://hokuyo's link 'link', hokuyo::link in SDF
+    joint = _joints(recipe)["hokuyo_joint"]
+    assert (joint["parent"], joint["child"]) == ("chassis", "hokuyo/link")
+    assert joint["origin"]["xyz"] == [0.2, 0, 0.13]
+    assert result.inputs[-1].endswith("gazebo_models/hokuyo/meshes/hokuyo.dae")

@@ -64,7 +64,20 @@ def read_model(el, file: str) -> Model:
         else:
             m.frames[name] = node, frames.get(name)
     m.plugins = children(el, "plugin")
+    _flat_names(m)
     return m
+
+
+def _flat_names(m: Model) -> None:
+    """A nested model's ``model::name`` as ``model/name`` (a ROS frame name the recipe takes)."""
+    flat = lambda n: n.replace("::", "/")  # noqa: E731
+    for lk in m.links.values():
+        lk.name = flat(lk.name)
+    for j in m.joints.values():
+        j.name, j.parent, j.child = flat(j.name), flat(j.parent), flat(j.child)
+    m.links = {flat(k): v for k, v in m.links.items()}
+    m.joints = {flat(k): v for k, v in m.joints.items()}
+    m.frames = {flat(k): (flat(a), T) for k, (a, T) in m.frames.items()}
 
 
 def _scope(el, scope: str, m: Model, frames: Frames, pending: list) -> None:

@@ -47,7 +47,7 @@ def build_tree(src, m, ledger) -> Tree:
     for j in m.joints.values():
         why = _unmapped(j, m, parent_of)
         if why:
-            ledger.add(src.where("joint", j.name.split("::")[-1]), f"joint '{j.name}' ({j.type})", "all", why)
+            ledger.add(src.where("joint", j.name.split("/")[-1]), f"joint '{j.name}' ({j.type})", "all", why)
             continue
         parent_of[j.child] = j
     roots = [n for n in m.links if n not in parent_of]
@@ -111,7 +111,7 @@ def _joint(src, tree: Tree, j, chain_mass: float, ledger) -> None:
         tree.joints[j.name] = _fixed(tree, j.parent, j.child)
         tree.joint_map[j.name] = [j.name]
         return
-    where = src.where("joint", j.name.split("::")[-1])
+    where = src.where("joint", j.name.split("/")[-1])
     R = j.T[:3, :3]
     if j.type in CHAINS:
         n = CHAINS[j.type]
