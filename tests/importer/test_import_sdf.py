@@ -110,7 +110,7 @@ SYNTHETIC = """<?xml version="1.0"?>
       <inertial><mass>2</mass><inertia><ixx>0.1</ixx><iyy>0.1</iyy><izz>0.1</izz></inertia></inertial>
       <collision name="c"><geometry><capsule><radius>0.1</radius><length>0.4</length></capsule></geometry></collision>
       <visual name="v"><geometry><capsule><radius>0.1</radius><length>0.4</length></capsule></geometry>
-        <material><diffuse>0.2 0.4 0.6 1</diffuse></material></visual>
+        <material><diffuse>0.2 0.4 0.6 1</diffuse></material><transparency>0.5</transparency></visual>
       <sensor name="imu" type="imu"><update_rate>50</update_rate></sensor>
     </link>
     <link name="arm">
@@ -121,7 +121,7 @@ SYNTHETIC = """<?xml version="1.0"?>
       <pose>0 0.1 0 0 0 0</pose>
       <parent>base</parent><child>arm</child>
       <axis><xyz>0 1 0</xyz><limit><lower>-1</lower><upper>1</upper><effort>5</effort><velocity>2</velocity></limit>
-        <dynamics><damping>0.3</damping><friction>0.1</friction></dynamics></axis>
+        <dynamics><damping>0.3</damping><friction>0.1</friction><spring_stiffness>3</spring_stiffness></dynamics></axis>
     </joint>
     <frame name="tool" attached_to="arm"><pose>0.1 0 0 0 0 0</pose></frame>
     <plugin name="p" filename="libp.so"><x>1</x></plugin>
@@ -195,3 +195,11 @@ def test_included_model_found_on_the_model_path_with_scoped_names(tmp_path):
     assert (joint["parent"], joint["child"]) == ("chassis", "hokuyo/link")
     assert joint["origin"]["xyz"] == [0.2, 0, 0.13]
     assert result.inputs[-1].endswith("gazebo_models/hokuyo/meshes/hokuyo.dae")
+
+
+def test_what_the_recipe_cannot_hold_is_named_on_the_ledger(synthetic):
+    result, _, _ = synthetic
+    where = str(Path(result.inputs[0]))
+    assert f"{where}:5: link 'base': all: dropped (no place in the recipe): visual 'v' <transparency>" in result.ledger
+    assert (f"{where}:17: joint 'hinge': all: dropped (no place in the recipe): <axis><dynamics><spring_stiffness> 3"
+            in result.ledger)

@@ -39,7 +39,8 @@ def add_contacts(m, tree) -> dict[str, list[str]]:
             if kept:
                 tree.links[name]["contact"] = kept
         if other:
-            dropped[name] = [f"its collisions' {', '.join(dict.fromkeys(other))}"]
+            dropped[name] = [f"its collisions' {', '.join(dict.fromkeys(other))} (the recipe's contact is a link's "
+                             "mu1, mu2, kp, kd)"]
     return dropped
 
 

@@ -10,6 +10,7 @@ import copy
 import numpy as np
 
 from robotkit.importer.sdf.frames import pose_of
+from robotkit.importer.sdf.leftovers import joint_leftovers, shape_leftovers
 from robotkit.importer.sdf.model import children
 from robotkit.importer.sdf.tree import origin_of
 from robotkit.urdfxml import is_element
@@ -40,6 +41,19 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
                 ("false", "0", "true" if el.tag == "allow_auto_disable" else "-")):
             ledger.add(src.where(el.tag, el.get("name")), f"model <{el.tag}>", "all", "dropped: no place in the recipe")
     _frames(src, m, tree, ledger)
+    for name, j in m.joints.items():
+        left = joint_leftovers(j.el)
+        if left and name in tree.joint_map:
+            ledger.add(src.where("joint", name.split("/")[-1]), f"joint '{name}'", "all",
+                       f"dropped (no place in the recipe): {', '.join(left)}")
+    for nested in src.model.iter("model"):
+        for plugin in children(nested, "plugin") if nested is not src.model else ():
+            ledger.add(str(src.path), f"plugin '{plugin.get('name')}' of included model '{nested.get('name')}'",
+                       "all", "dropped (its names are the included model's)")
+    _, P = pose_of(src.model)
+    if not np.allclose(P, np.eye(4), rtol=0, atol=0):
+        ledger.add(src.where("model", m.name), f"model '{m.name}' <pose>", "all", "dropped: where the model stands "
+                   "in a world (the recipe describes the robot; a world places it)")
     if extras:
         recipe["urdf_extras"] = extras
 
@@ -65,7 +79,7 @@ def _block(el, O, link: str | None) -> str:
 def _other(src, el, name: str, ledger, dropped: list) -> None:
     """One line per link for what it holds that the recipe has no place for (``dropped``: of its
     collisions' surfaces)."""
-    dropped = list(dropped)
+    dropped = list(dropped) + shape_leftovers(el)
     for child in el:
         if not is_element(child) or child.tag in LINK_KEPT:
             continue
@@ -73,8 +87,8 @@ def _other(src, el, name: str, ledger, dropped: list) -> None:
         if LINK_DEFAULTS.get(child.tag) != value:
             dropped.insert(0, f"<{child.tag}> {value}".strip())
     if dropped:
-        ledger.add(src.where("link", name), f"link '{name}'", "all", "dropped (no place in the recipe, whose contact "
-                   f"is a link's mu1, mu2, kp, kd): {', '.join(dropped)}")
+        ledger.add(src.where("link", name), f"link '{name}'", "all",
+                   f"dropped (no place in the recipe): {', '.join(dropped)}")
 
 
 def _frames(src, m, tree, ledger) -> None:
