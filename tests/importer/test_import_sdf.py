@@ -94,6 +94,17 @@ def test_bad_sdf_one_line_exit_2_nothing_written(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def test_sdf_libsdformat_refuses_and_its_xml_cannot_be_read_exit_2(tmp_path):
+    bad = tmp_path / "pose.sdf"
+    bad.write_text('<sdf version="1.9"><model name="m"><link name="a"><pose>a b c 0 0 0</pose></link></model></sdf>\n')
+    proc = run_cli("import", bad, "-o", tmp_path / "out" / "x.yaml", cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("pose.sdf: libsdformat refuses it (") and proc.stderr.count("\n") == 1
+    assert proc.stderr.endswith("), and its XML holds a value that is not a number: could not convert string to "
+                                "float: 'a'\n")
+    assert not (tmp_path / "out").exists()
+
+
 def test_folder_without_model_config_exit_2(tmp_path):
     (tmp_path / "empty").mkdir()
     proc = run_cli("import", "empty", "-o", tmp_path / "out" / "x.yaml", cwd=tmp_path)

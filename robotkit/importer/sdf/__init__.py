@@ -61,7 +61,11 @@ def convert(path, out: Path):
     for old, new in renamed.items():
         ledger.add(src.where("joint", old), f"joint '{old}'", "all", f"renamed '{new}' (a link has its name: "
                    "libsdformat refuses the pair)")
-    m = read_model(src.model, str(src.path))
+    try:
+        m = read_model(src.model, str(src.path))
+    except ValueError as exc:  # a number that is none, in a file libsdformat refused
+        why = f"libsdformat refuses it ({src.refused}), and its XML holds " if src.refused else "it holds "
+        raise RobotkitError(Problem(f"{why}a value that is not a number: {exc}", file=str(src.path))) from None
     tree = build_tree(src, m, ledger)
     materials: dict = {}
     repaired: dict = {}

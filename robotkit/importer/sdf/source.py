@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -82,6 +83,8 @@ def read_config(config: Path) -> tuple[list[tuple[str, str]], dict]:
 
 def printed(file: Path, model_path: Path | None) -> subprocess.CompletedProcess:
     """``ign sdf -p FILE`` with ``model_path`` on every model path libsdformat reads."""
+    if shutil.which("ign") is None:
+        return subprocess.CompletedProcess(["ign"], 127, "", "Error: ign (libsdformat's command) is not installed")
     env = dict(os.environ)
     if model_path is not None:
         for key in ENV_KEYS:
