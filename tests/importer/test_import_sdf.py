@@ -11,15 +11,22 @@ import yaml
 
 from robotkit.commands.import_ import build_sdf
 from robotkit.importer import import_sdf
-from tests.conftest import run_cli
+from tests.conftest import ASSETS, run_cli
 
 pytestmark = pytest.mark.skipif(shutil.which("ign") is None, reason="needs libsdformat's ign sdf")
 MODELS = Path(__file__).resolve().parents[1] / "data" / "gazebo_models"
 
 
-def _imported(tmp_path: Path, name: str, build=build_sdf):
-    result = import_sdf(MODELS / name, tmp_path / f"{name}.yaml", build=build)
-    return result, yaml.safe_load(result.recipe_path.read_text())
+SHARED = ASSETS / "gazebo_models"
+_DONE: dict[str, tuple] = {}
+
+
+def _imported(tmp_path: Path, name: str):
+    """The import (and verification) of a test model, once per session."""
+    if name not in _DONE:
+        result = import_sdf(MODELS / name, tmp_path / f"{name}.yaml", build=build_sdf)
+        _DONE[name] = result, yaml.safe_load(result.recipe_path.read_text())
+    return _DONE[name]
 
 
 def _joints(recipe: dict) -> dict:
@@ -214,3 +221,12 @@ def test_what_the_recipe_cannot_hold_is_named_on_the_ledger(synthetic):
     assert f"{where}:5: link 'base': all: dropped (no place in the recipe): visual 'v' <transparency>" in result.ledger
     assert (f"{where}:17: joint 'hinge': all: dropped (no place in the recipe): <axis><dynamics><spring_stiffness> 3"
             in result.ledger)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", sorted(p.name for p in SHARED.iterdir() if (p / "model.config").is_file())
+                         if SHARED.is_dir() else [])
+def test_every_shared_gazebo_model_imports_and_verifies(model, tmp_path):
+    result = import_sdf(SHARED / model, tmp_path / f"{model}.yaml", build=build_sdf)
+    assert result.verdict.ok, result.verdict.lines()
+    assert len(result.ledger) <= 30
