@@ -21,6 +21,12 @@ from robotkit.importer.sdf.model import children
 from robotkit.importer.sdf.tree import origin_of
 
 PRIMITIVES = ("box", "cylinder", "sphere")
+GAZEBO_COLOURS = {"Gazebo/White": "1 1 1", "Gazebo/Grey": "0.7 0.7 0.7", "Gazebo/DarkGrey": "0.175 0.175 0.175",
+                  "Gazebo/FlatBlack": "0.1 0.1 0.1", "Gazebo/Black": "0 0 0", "Gazebo/Red": "1 0 0",
+                  "Gazebo/Green": "0 1 0", "Gazebo/Blue": "0 0 1", "Gazebo/Yellow": "1 1 0", "Gazebo/Purple": "1 0 1",
+                  "Gazebo/Turquoise": "0 1 1", "Gazebo/Orange": "1 0.5088 0.0468"}
+"""The diffuse colour of Gazebo classic's standard materials (media/materials/scripts/gazebo.material),
+for a visual that names one and gives no colour: the other formats' colour."""
 
 
 def add_shapes(src, m, tree, out: Path, ledger, materials: dict, repaired: dict) -> list[str]:
@@ -29,8 +35,10 @@ def add_shapes(src, m, tree, out: Path, ledger, materials: dict, repaired: dict)
     for name, link in m.links.items():
         O = np.linalg.inv(tree.offset(name, link.T))  # SDF link frame -> recipe frame
         entry = tree.links[name]
-        visual = [s for v in children(link.el, "visual") for s in _shape(src, v, O, out, ledger, files, "visual")
-                  for s in [dict(s, material=_material(v, materials)) if _material(v, materials) else s]]
+        visual = []
+        for v in children(link.el, "visual"):
+            mat = _material(src, v, materials, ledger)
+            visual += [dict(s, material=mat) if mat else s for s in _shape(src, v, O, out, ledger, files, "visual")]
         collision = [s for c in children(link.el, "collision") for s in _shape(src, c, O, out, ledger, files,
                                                                                  "collision")]
         if visual:
@@ -108,14 +116,18 @@ def _mesh(src, el, shape, T, out: Path, ledger, files, label: str, kind: str) ->
     return [_at(out_shape, T)]
 
 
-def _material(el, materials: dict) -> str | None:
+def _material(src, el, materials: dict, ledger) -> str | None:
     mat = el.find("material")
     if mat is None:
         return None
-    text = mat.findtext("diffuse") or mat.findtext("ambient")
     script = (mat.findtext("script/name") or "").strip()
+    text = mat.findtext("diffuse") or mat.findtext("ambient") or GAZEBO_COLOURS.get(script)
     if text is None and not script:
         return None
+    if text is None and script not in src.unknown_scripts:
+        src.unknown_scripts.add(script)
+        ledger.add(src.where("visual", el.get("name"), el.getparent().get("name")), f"material script '{script}'",
+                   "URDF, MJCF", "approximated: white (a Gazebo material script without a colour; model.sdf names it)")
     rgba = [float(v) for v in (text or "1 1 1 1").split()] + [1.0]
     rgba = [min(max(v, 0.0), 1.0) for v in rgba[:4]]
     value = {"rgba": rgba, **({"gazebo": script} if script else {})}

@@ -30,6 +30,7 @@ class Source:
     config: dict = field(default_factory=dict)  # model.config: name, version, description, authors
     model_path: Path | None = None
     renamed: dict = field(default_factory=dict)  # new joint name -> the file's
+    unknown_scripts: set = field(default_factory=set)  # Gazebo material names without a known colour
 
     def where(self, kind: str, name: str | None, link: str | None = None) -> str:
         """``file:line`` of the element ``<kind name="name">`` in the original file (inside link
