@@ -134,6 +134,8 @@ SYNTHETIC = """<?xml version="1.0"?>
     <link name="arm">
       <pose>0.3 0 0.5 0 0 0</pose>
       <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+      <visual name="grey"><geometry><box><size>0.1 0.1 0.1</size></box></geometry>
+        <material><script><name>Gazebo/Grey</name></script></material></visual>
     </link>
     <joint name="hinge" type="revolute">
       <pose>0 0.1 0 0 0 0</pose>
@@ -186,6 +188,8 @@ def test_capsule_is_a_cylinder_and_two_spheres_with_its_colour(synthetic):
     assert [next(k for k in ("cylinder", "sphere") if k in s) for s in visual] == ["cylinder", "sphere", "sphere"]
     assert [s.get("origin", {}).get("xyz") for s in visual[1:]] == [[0, 0, -0.2], [0, 0, 0.2]]
     assert recipe["materials"][visual[0]["material"]]["rgba"] == [0.2, 0.4, 0.6, 1]
+    grey = recipe["links"]["arm"]["visual"]["material"]  # Gazebo's standard material, named without a colour
+    assert recipe["materials"][grey] == {"rgba": [0.7, 0.7, 0.7, 1], "gazebo": "Gazebo/Grey"}
 
 
 def test_frame_is_a_massless_link_fixed_where_it_is(synthetic):
@@ -219,7 +223,7 @@ def test_what_the_recipe_cannot_hold_is_named_on_the_ledger(synthetic):
     result, _, _ = synthetic
     where = str(Path(result.inputs[0]))
     assert f"{where}:5: link 'base': all: dropped (no place in the recipe): visual 'v' <transparency>" in result.ledger
-    assert (f"{where}:17: joint 'hinge': all: dropped (no place in the recipe): <axis><dynamics><spring_stiffness> 3"
+    assert (f"{where}:19: joint 'hinge': all: dropped (no place in the recipe): <axis><dynamics><spring_stiffness> 3"
             in result.ledger)
 
 
