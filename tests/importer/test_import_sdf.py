@@ -234,3 +234,22 @@ def test_every_shared_gazebo_model_imports_and_verifies(model, tmp_path):
     result = import_sdf(SHARED / model, tmp_path / f"{model}.yaml", build=build_sdf)
     assert result.verdict.ok, result.verdict.lines()
     assert len(result.ledger) <= 30
+
+
+def test_joint_to_world_roots_the_recipe_in_world(tmp_path):
+    (tmp_path / "w.sdf").write_text("""<sdf version="1.9"><model name="w">
+<link name="base"><pose>0 0 1 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+<link name="arm"><pose>0 0 1.5 0 0 0</pose><inertial><mass>2</mass></inertial></link>
+<joint name="fix" type="fixed"><parent>world</parent><child>base</child></joint>
+<joint name="j" type="prismatic"><parent>base</parent><child>arm</child>
+  <axis><xyz>0 0 1</xyz><limit><lower>0</lower><upper>0.5</upper></limit></axis></joint>
+</model></sdf>
+""")
+    result = import_sdf(tmp_path / "w.sdf", tmp_path / "w.yaml", build=build_sdf)
+    recipe = yaml.safe_load(result.recipe_path.read_text())
+    assert result.verdict.ok and result.verdict.configurations == 11, result.verdict.lines()
+    assert "base" not in recipe or recipe.get("base") != "free"
+    assert recipe["joints"]["fix"] == {"type": "fixed", "parent": "world", "child": "base", "origin": {"xyz": [0, 0, 1]}}
+    # SDF's defaults where the inertial gives no tensor: unit moments; no effort or velocity limit: 0
+    assert recipe["links"]["arm"]["inertial"] == {"mass": 2, "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}
+    assert _joints(recipe)["j"]["limit"] == {"lower": 0, "upper": 0.5, "effort": 0, "velocity": 0}

@@ -56,7 +56,7 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
     verdict = Verdict(worst={k: (0.0, "") for k in TOL})
     pairs = [(j, names[0]) for j, names in tree.joint_map.items() if len(names) == 1
              and original.joints[j].type in ("revolute", "continuous", "prismatic") and names[0] in rebuilt.joints]
-    root = next(n for n in original.links if not any(j.child == n for j in original.joints.values()))
+    root = _root(original)
     _joints(verdict, original, rebuilt, tree, (original.links[root].T @ tree.offset(root, original.links[root].T),
                                                 rebuilt.links[root].T))
     rng = np.random.default_rng(SEED)
@@ -72,6 +72,12 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
         _links(verdict, original, rebuilt, tree, repaired, po, pr, label)
     verdict.configurations = len(configs)
     return verdict
+
+
+def _root(model) -> str:
+    """The first link no joint from another link moves (a link jointed to the world counts)."""
+    inner = {j.child for j in model.joints.values() if j.parent in model.links}
+    return next((n for n in model.links if n not in inner), next(iter(model.links)))
 
 
 def _relative(poses: dict, root: str, offset) -> dict:
