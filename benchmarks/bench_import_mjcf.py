@@ -1,4 +1,6 @@
-"""MJCF import over the shared MuJoCo Menagerie set: per model, the import (read through MuJoCo,
+"""MJCF import over the shared MuJoCo Menagerie set, and SDF import over the shared Gazebo model
+set (``--gazebo DIR``: each model folder with a model.config, read through libsdformat, the
+rebuilt model.sdf compared through libsdformat): per model, the import (read through MuJoCo,
 convert, write, and the verification's comparison in MuJoCo), the build of the recipe the
 verification makes, whether the rebuild agrees with the original, and the ledger's size; then
 the totals and the distribution.
@@ -11,7 +13,8 @@ converts 85 of 85 Menagerie variants at 0.63 s each on average, unverified (its 
 
 Usage (from the repository root):
 
-    python benchmarks/bench_import_mjcf.py [--menagerie DIR] [--only NAME...]
+    python benchmarks/bench_import_mjcf.py [--menagerie DIR] [--gazebo DIR] [--sets menagerie gazebo]
+                                           [--only NAME...]
 """
 
 from __future__ import annotations
@@ -26,11 +29,12 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from robotkit.commands.import_ import build_mjcf  # noqa: E402
+from robotkit.commands.import_ import build_mjcf, build_sdf  # noqa: E402
 from robotkit.errors import RobotkitError  # noqa: E402
-from robotkit.importer import import_mjcf  # noqa: E402
+from robotkit.importer import import_mjcf, import_sdf  # noqa: E402
 
 MENAGERIE = REPO.parent / "shared" / "assets" / "menagerie"
+GAZEBO = REPO.parent / "shared" / "assets" / "gazebo_models"
 
 
 def models(folder: Path, only: list[str]) -> list[Path]:
@@ -43,43 +47,69 @@ def models(folder: Path, only: list[str]) -> list[Path]:
     return found
 
 
-def one(model: Path, out: Path) -> dict:
+def gazebo_models(folder: Path, only: list[str]) -> list[Path]:
+    """Every model folder (a model.config) of a Gazebo model set."""
+    return [d for d in sorted(p for p in folder.iterdir() if p.is_dir())
+            if (d / "model.config").is_file() and (not only or d.name in only)]
+
+
+def one(model: Path, out: Path, kind: str = "mjcf") -> dict:
     built = {}
+    importer, builder = (import_sdf, build_sdf) if kind == "sdf" else (import_mjcf, build_mjcf)
+    label = model.name if kind == "sdf" else f"{model.parent.name}/{model.name}"
 
     def build(recipe, folder):
         start = time.perf_counter()
-        path = build_mjcf(recipe, folder)
+        path = builder(recipe, folder)
         built["s"] = time.perf_counter() - start
         return path
 
     start = time.perf_counter()
     try:
-        result = import_mjcf(model, out / f"{model.stem}.yaml", build=build)
+        result = importer(model, out / f"{model.stem}.yaml", build=build)
     except RobotkitError as exc:
-        return {"model": f"{model.parent.name}/{model.name}", "error": str(exc).splitlines()[0]}
+        return {"model": label, "error": str(exc).splitlines()[0]}
     total = time.perf_counter() - start
     v = result.verdict
-    return {"model": f"{model.parent.name}/{model.name}", "import": total - built.get("s", 0.0),
+    return {"model": label, "import": total - built.get("s", 0.0),
             "build": built.get("s", 0.0), "ok": v.ok, "configs": v.configurations,
             "worst": max(e for e, _ in v.worst.values()), "ledger": len(result.ledger)}
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--menagerie", type=Path, default=MENAGERIE)
-    ap.add_argument("--only", nargs="*", default=[], help="model folder names")
-    args = ap.parse_args()
+def run_set(title: str, todo: list[Path], kind: str) -> list[dict]:
+    """Import (and verify) each model of one set, a line each, then the set's totals."""
     rows = []
-    print(f"{'model':52} {'import s':>9} {'build s':>8} {'verified':>9} {'largest rel. diff':>18} {'ledger':>7}")
-    with tempfile.TemporaryDirectory(prefix="bench-mjcf-") as tmp:
-        for i, model in enumerate(models(args.menagerie, args.only)):
-            row = one(model, Path(tmp) / str(i))
+    print(f"\n{title}\n{'model':52} {'import s':>9} {'build s':>8} {'verified':>9} {'largest rel. diff':>18} "
+          f"{'ledger':>7}")
+    with tempfile.TemporaryDirectory(prefix=f"bench-{kind}-") as tmp:
+        for i, model in enumerate(todo):
+            row = one(model, Path(tmp) / str(i), kind)
             rows.append(row)
             if "error" in row:
                 print(f"{row['model']:52} refused: {row['error']}")
                 continue
             print(f"{row['model']:52} {row['import']:9.2f} {row['build']:8.2f} "
                   f"{'yes' if row['ok'] else 'NO':>9} {row['worst']:18.1e} {row['ledger']:7d}", flush=True)
+    totals(rows)
+    return rows
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--menagerie", type=Path, default=MENAGERIE)
+    ap.add_argument("--gazebo", type=Path, default=GAZEBO, help="a folder of Gazebo model folders")
+    ap.add_argument("--sets", nargs="*", default=["menagerie", "gazebo"], choices=["menagerie", "gazebo"])
+    ap.add_argument("--only", nargs="*", default=[], help="model folder names")
+    args = ap.parse_args()
+    rows = []
+    if "menagerie" in args.sets:
+        rows += run_set(f"MJCF: {args.menagerie}", models(args.menagerie, args.only), "mjcf")
+    if "gazebo" in args.sets:
+        rows += run_set(f"SDF: {args.gazebo}", gazebo_models(args.gazebo, args.only), "sdf")
+    return 0 if all(r.get("ok") for r in rows) else 1
+
+
+def totals(rows: list[dict]) -> None:
     done = [r for r in rows if "error" not in r]
     if done:
         imports = [r["import"] for r in done]
@@ -89,7 +119,6 @@ def main() -> int:
         print(f"import + verification: mean {statistics.mean(imports):.2f} s, median {statistics.median(imports):.2f} s, "
               f"max {max(imports):.2f} s; build: mean {statistics.mean(builds):.2f} s, "
               f"median {statistics.median(builds):.2f} s, max {max(builds):.2f} s")
-    return 0 if all(r.get("ok") for r in rows) else 1
 
 
 if __name__ == "__main__":

@@ -185,15 +185,17 @@ def _xacro_arg(text: str) -> tuple[str, str]:
 
 def _add_import(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
-        "import", help="turn an existing URDF, xacro or MJCF file into a recipe",
+        "import", help="turn an existing URDF, xacro, MJCF or SDF file (or Gazebo model folder) into a recipe",
         description="Expand FILE (.urdf, or .xacro with $(find PKG) and package://PKG resolved through "
                     "--package-path) and write a recipe that builds into an equivalent URDF. Physical "
                     "inertials are kept as given, the others get --inertia-policy (each stated in a comment "
                     "above its link) unless --recompute-inertials; <gazebo>, <transmission> and other "
                     "elements the recipe cannot express are carried verbatim in urdf_extras. An MJCF (.xml) "
                     "is read through MuJoCo; what the recipe cannot hold is listed (the ledger), and the "
-                    "recipe is built and compared with the original in MuJoCo.")
-    p.add_argument("file", metavar="FILE", help="URDF, xacro or MJCF (.xml) file")
+                    "recipe is built and compared with the original in MuJoCo. An SDF (.sdf, or a Gazebo "
+                    "model folder with model.config) is read through libsdformat the same way, and compared "
+                    "with the rebuilt model.sdf through libsdformat.")
+    p.add_argument("file", metavar="FILE", help="URDF, xacro, MJCF (.xml) or SDF (.sdf) file, or a Gazebo model folder")
     p.add_argument("-o", "--out", "--output", dest="output", required=True, metavar="RECIPE.yaml",
                    help="the recipe file written: -o/--out is a file here, the one command whose output is a "
                         "file (the others' -o/--out is a folder); its meshes are referenced from there")

@@ -1,6 +1,7 @@
 """``robotkit import FILE [--package-path PKG=DIR]... [--arg NAME:=VALUE]... -o RECIPE.yaml``:
 a URDF or xacro file into a recipe (:func:`robotkit.importer.import_file`), or an MJCF file
-(:func:`robotkit.importer.import_mjcf`, verified by building the recipe in a temporary folder)."""
+(:func:`robotkit.importer.import_mjcf`) or an SDF file or Gazebo model folder
+(:func:`robotkit.importer.import_sdf`), each verified by building the recipe in a temporary folder."""
 
 from __future__ import annotations
 
@@ -17,8 +18,9 @@ NOTES = ("metadata from ",)
 
 
 def run(args) -> int:
-    if SUFFIXES.get(Path(args.file).suffix.lower()) == "mjcf":
-        return run_mjcf(args)
+    kind = "sdf" if Path(args.file).is_dir() else SUFFIXES.get(Path(args.file).suffix.lower())
+    if kind in ("mjcf", "sdf"):
+        return run_mjcf(args, kind)
     if args.density is not None and not args.recompute_inertials:
         print("robotkit: error: --density needs --recompute-inertials", file=sys.stderr)
         return 2
@@ -60,11 +62,23 @@ def build_mjcf(recipe: Path, folder: str) -> Path:
     return robot_layout(Path(folder) / result.robots[0]).mjcf
 
 
-def run_mjcf(args) -> int:
-    """An MJCF import: the ledger and the verification printed; 1 when the rebuild disagrees."""
-    from robotkit.importer import import_mjcf
+def build_sdf(recipe: Path, folder: str) -> Path:
+    """Build ``recipe`` into ``folder`` (no report); the rebuilt model.sdf's path."""
+    from robotkit.emit.layout import robot_layout
+    from robotkit.pipeline.runner import build
 
-    result = import_mjcf(args.file, args.output, build=build_mjcf)
+    result = build([recipe], folder, report=False)
+    return robot_layout(Path(folder) / result.robots[0]).sdf
+
+
+def run_mjcf(args, kind: str = "mjcf") -> int:
+    """An MJCF or SDF import: the ledger and the verification printed; 1 when the rebuild disagrees."""
+    from robotkit.importer import import_mjcf, import_sdf
+
+    if kind == "sdf":
+        result = import_sdf(args.file, args.output, build=build_sdf)
+    else:
+        result = import_mjcf(args.file, args.output, build=build_mjcf)
     for line in result.notes:
         print(f"note: {line}", file=sys.stderr)
     for line in result.ledger:

@@ -291,3 +291,10 @@ def import_mjcf(path, out_recipe, build=None):
     from robotkit.importer.mjcf import import_mjcf as _import
 
     return _import(path, out_recipe, build)
+
+
+def import_sdf(path, out_recipe, build=None):
+    """Import an SDF file or a Gazebo model folder (robotkit.importer.sdf.import_sdf)."""
+    from robotkit.importer.sdf import import_sdf as _import
+
+    return _import(path, out_recipe, build=build)

@@ -1,0 +1,179 @@
+"""Import an SDF file or a Gazebo model folder into a recipe (``robotkit import model.sdf`` or
+``robotkit import MODEL_FOLDER``), read through libsdformat.
+
+    model.sdf ──ign sdf -p (libsdformat)──▶ links, joints, shapes, inertials, frames, sensors,
+    plugins, model.config metadata ──▶ RECIPE.yaml (+ a ledger of what it cannot hold)
+
+:func:`import_sdf` is the entry point.  What the recipe cannot hold, and each repair, is on the
+ledger (one line per element), printed and in the recipe's header.  With a ``build`` (recipe,
+folder -> the rebuilt model.sdf), the recipe is built in a temporary folder and the rebuilt
+model.sdf compared with the original through libsdformat (:mod:`robotkit.importer.sdf.verify`).
+Nothing is written when the file cannot be read or the recipe would be invalid."""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from pydantic import ValidationError
+
+from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.importer.defaults import factor_defaults
+from robotkit.importer.mjcf.ledger import Ledger
+from robotkit.importer.names import joints_apart_from_links
+from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
+from robotkit.importer.sdf.contacts import add_contacts
+from robotkit.importer.sdf.extras import add_extras
+from robotkit.importer.sdf.model import read_model
+from robotkit.importer.sdf.shapes import add_shapes
+from robotkit.importer.sdf.source import read
+from robotkit.importer.sdf.tree import build_tree
+from robotkit.importer.sdf.verify import Verdict, verify
+from robotkit.model.load import load_robots
+from robotkit.paths import recipe_policy, widened
+from robotkit.recipe.schema import Recipe
+from robotkit.urdfxml import is_element
+
+
+@dataclass
+class SdfImport:
+    recipe_path: Path
+    robot: str
+    ledger: list[str] = field(default_factory=list)
+    verdict: Verdict | None = None
+    inputs: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    root: str | None = None
+
+
+def convert(path, out: Path):
+    """(recipe dict, ledger, source, model, tree, repaired links, mesh files) of an SDF file or model folder."""
+    src = read(path)
+    ledger = Ledger()
+    if src.refused:
+        ledger.add(str(src.path), "the file", "all", f"libsdformat refuses it ({src.refused}): read from its own "
+                   "XML, as Gazebo classic loads it")
+    renamed = joints_apart_from_links([c for c in src.model if is_element(c)])
+    src.renamed = {new: old for old, new in renamed.items()}
+    for old, new in renamed.items():
+        ledger.add(src.where("joint", old), f"joint '{old}'", "all", f"renamed '{new}' (a link has its name: "
+                   "libsdformat refuses the pair)")
+    try:
+        m = read_model(src.model, str(src.path))
+    except ValueError as exc:  # a number that is none, in a file libsdformat refused
+        why = f"libsdformat refuses it ({src.refused}), and its XML holds " if src.refused else "it holds "
+        raise RobotkitError(Problem(f"{why}a value that is not a number: {exc}", file=str(src.path))) from None
+    tree = build_tree(src, m, ledger)
+    materials: dict = {}
+    repaired: dict = {}
+    files = add_shapes(src, m, tree, out, ledger, materials, repaired)
+    surfaces = add_contacts(m, tree)
+    recipe: dict = {"robot": _robot_name(m.name)}
+    meta = _metadata(src.config)
+    if meta:
+        recipe["metadata"] = meta
+    if tree.base == "free":
+        recipe["base"] = "free"
+    add_extras(src, m, tree, recipe, ledger, surfaces)
+    if materials:
+        recipe["materials"] = materials
+    recipe["links"], recipe["joints"] = tree.links, tree.joints
+    return recipe, ledger, src, m, tree, repaired, files
+
+
+def _robot_name(name: str) -> str:
+    name = re.sub(r"[^A-Za-z0-9_.\-]", "_", name)
+    return name if re.match(r"[A-Za-z_]", name) else "_" + name
+
+
+def _metadata(config: dict) -> dict:
+    out: dict = {}
+    if config.get("version"):
+        out["version"] = config["version"]
+    if config.get("description"):
+        out["description"] = config["description"]
+    if config.get("authors"):
+        out["authors"] = config["authors"]
+    return out
+
+
+def import_sdf(path, out_recipe, build=None) -> SdfImport:
+    """Import the SDF file or model folder ``path`` into ``out_recipe``; ``build(recipe, folder)``
+    builds a recipe into a folder and returns the rebuilt model.sdf's path (the verification's)."""
+    out = Path(out_recipe).absolute()
+    recipe, ledger, src, m, tree, repaired, files = convert(path, out)
+    name_mesh_folders(recipe)
+    _validate(recipe, src.path)
+    _factor_defaults(recipe)
+    comments = {"links": {**{n: "a massless link of a joint the recipe writes as a chain (ball, universal)"
+                             for n in tree.chain_links}, **tree.link_notes, **repaired}, "joints": tree.notes}
+    how = "read through libsdformat" if src.via == "libsdformat" else "read from its XML (libsdformat refuses it)"
+    header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (SDF, {how})"]
+    header += _ledger_block(ledger)
+    read_dirs = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
+    root = display_path(os.path.commonpath(read_dirs)) if read_dirs else None
+    notes = [f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: build it "
+             f"with --root {root}"] if read_dirs else []
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.tmp")
+    try:
+        with widened(read_dirs):
+            tmp.write_text(dump_recipe(recipe, header, comments), encoding="utf-8")
+            _resolves(tmp, src.path)
+            verdict = _verified(m, tree, set(repaired), tmp, build)
+        if verdict is not None:
+            tmp.write_text(dump_recipe(recipe, header + verdict.lines(), comments), encoding="utf-8")
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    os.replace(tmp, out)
+    return SdfImport(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
+
+
+def _factor_defaults(recipe: dict) -> None:
+    """:func:`factor_defaults` with each link's shapes and inertial set aside: measuring them is
+    most of its time (a ragdoll's 18 s of 23), and a shared collision as a link default would be
+    merged into a link's own (a box and a cylinder in one)."""
+    shapes = ("visual", "collision", "inertial")
+    aside = {name: {k: link[k] for k in shapes if k in link} for name, link in recipe["links"].items()}
+    recipe["links"] = {name: {k: v for k, v in link.items() if k not in shapes} for name, link in recipe["links"].items()}
+    factor_defaults(recipe)
+    recipe["links"] = {name: {**link, **aside[name]} for name, link in recipe["links"].items()}
+
+
+def _verified(m, tree, repaired: set, recipe: Path, build) -> Verdict | None:
+    if build is None:
+        return None
+    with tempfile.TemporaryDirectory(prefix="robotkit-import-") as folder:
+        return verify(m, tree, repaired, build(recipe, folder))
+
+
+def _resolves(recipe: Path, source: Path) -> None:
+    """Load and resolve the written recipe as the build will; problems name the SDF file."""
+    try:
+        load_robots([recipe])
+    except RobotkitError as exc:
+        raise RobotkitError([replace(p, file=str(source), line=None) if p.file == str(recipe) else p
+                             for p in exc.problems]) from None
+
+
+def _ledger_block(ledger: Ledger) -> list[str]:
+    if not len(ledger):
+        return ["ledger: nothing of the original is lost"]
+    lines = [f"ledger: {len(ledger)} element{'s' if len(ledger) > 1 else ''} of the original not carried unchanged "
+             "(where: element: formats: what happened)"]
+    for line in ledger.lines():
+        lines.extend("  " + part for part in wrap(line, 110))
+    return lines
+
+
+def _validate(recipe: dict, source: Path) -> None:
+    try:
+        Recipe.model_validate(recipe)
+    except ValidationError as exc:
+        problems = [Problem(f"the imported recipe would be invalid: {'.'.join(str(p) for p in err['loc'])}: "
+                            f"{err['msg']}", file=str(source)) for err in exc.errors(include_url=False)]
+        raise RobotkitError(problems) from None

@@ -1,0 +1,108 @@
+"""What an SDF model holds beside links and joints: sensors and plugins (kept verbatim as
+``<gazebo>`` blocks of the recipe's ``urdf_extras``, which the build carries into model.sdf and
+the URDF: MJCF loses them, stated), ``<frame>``s (a massless link fixed where the frame is),
+model.config's metadata, and every other element the recipe has no place for (stated)."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+
+from robotkit.importer.sdf.frames import pose_of
+from robotkit.importer.sdf.leftovers import joint_leftovers, shape_leftovers
+from robotkit.importer.sdf.model import children
+from robotkit.importer.sdf.tree import origin_of
+from robotkit.urdfxml import is_element
+
+LINK_KEPT = {"pose", "inertial", "visual", "collision", "sensor"}
+LINK_DEFAULTS = {"gravity": "true", "self_collide": "false", "kinematic": "false", "enable_wind": "false",
+                 "must_be_base_link": "false"}
+MODEL_KEPT = {"pose", "static", "link", "joint", "frame", "plugin", "model"}
+
+
+def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
+    extras: list[str] = []
+    for name, link in m.links.items():
+        O = np.linalg.inv(tree.offset(name, link.T))
+        for sensor in children(link.el, "sensor"):
+            extras.append(_block(sensor, O, name))
+            ledger.add(src.where("sensor", sensor.get("name"), name), f"sensor '{sensor.get('name')}' "
+                       f"({sensor.get('type')}) of link '{name}'", "MJCF",
+                       "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
+        _other(src, link.el, name, ledger, surfaces.get(name, []))
+    for plugin in m.plugins:
+        extras.append(_block(plugin, None, None))
+        ledger.add(src.where("plugin", plugin.get("name")), f"plugin '{plugin.get('name')}' "
+                   f"({plugin.get('filename')})", "MJCF",
+                   "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
+    for el in (c for c in src.model if is_element(c) and c.tag not in MODEL_KEPT):
+        if not (el.tag in ("self_collide", "allow_auto_disable", "enable_wind") and (el.text or "").strip() in
+                ("false", "0", "true" if el.tag == "allow_auto_disable" else "-")):
+            ledger.add(src.where(el.tag, el.get("name")), f"model <{el.tag}>", "all", "dropped: no place in the recipe")
+    _frames(src, m, tree, ledger)
+    for name, j in m.joints.items():
+        left = joint_leftovers(j.el)
+        if left and name in tree.joint_map:
+            ledger.add(src.where("joint", name.split("/")[-1]), f"joint '{name}'", "all",
+                       f"dropped (no place in the recipe): {', '.join(left)}")
+    for nested in src.model.iter("model"):
+        for plugin in children(nested, "plugin") if nested is not src.model else ():
+            ledger.add(str(src.path), f"plugin '{plugin.get('name')}' of included model '{nested.get('name')}'",
+                       "all", "dropped (its names are the included model's)")
+    _, P = pose_of(src.model)
+    if not np.allclose(P, np.eye(4), rtol=0, atol=0):
+        ledger.add(src.where("model", m.name), f"model '{m.name}' <pose>", "all", "dropped: where the model stands "
+                   "in a world (the recipe describes the robot; a world places it)")
+    if extras:
+        recipe["urdf_extras"] = extras
+
+
+def _block(el, O, link: str | None) -> str:
+    from lxml import etree  # heavy: only when the model has one
+
+    el = copy.deepcopy(el)
+    if O is not None and not np.allclose(O, np.eye(4)):
+        _, P = pose_of(el)
+        pose = el.find("pose")
+        if pose is None:
+            pose = etree.SubElement(el, "pose")
+        o = origin_of(O @ P) or {}
+        pose.text = " ".join(f"{v:.17g}" for v in list(o.get("xyz", [0, 0, 0])) + list(o.get("rpy", [0, 0, 0])))
+        pose.attrib.pop("relative_to", None)
+    block = etree.Element("gazebo", reference=link) if link else etree.Element("gazebo")
+    block.append(el)
+    etree.indent(block, space="  ")
+    return etree.tostring(block, encoding="unicode").strip()
+
+
+def _other(src, el, name: str, ledger, dropped: list) -> None:
+    """One line per link for what it holds that the recipe has no place for (``dropped``: of its
+    collisions' surfaces)."""
+    dropped = list(dropped) + shape_leftovers(el)
+    for child in el:
+        if not is_element(child) or child.tag in LINK_KEPT:
+            continue
+        value = {"1": "true", "0": "false"}.get((child.text or "").strip().lower(), (child.text or "").strip().lower())
+        if LINK_DEFAULTS.get(child.tag) != value:
+            dropped.insert(0, f"<{child.tag}> {value}".strip())
+    if dropped:
+        ledger.add(src.where("link", name), f"link '{name}'", "all",
+                   f"dropped (no place in the recipe): {', '.join(dropped)}")
+
+
+def _frames(src, m, tree, ledger) -> None:
+    for name, (attached, T) in m.frames.items():
+        base = attached if attached in tree.frame else None
+        if base is None or name in tree.links:
+            ledger.add(src.where("frame", name), f"frame '{name}'", "all", f"dropped: attached to '{attached}', "
+                       "not a link")
+            continue
+        tree.links[name] = {}
+        tree.frame[name] = T
+        joint = {"type": "fixed", "parent": base, "child": name}
+        o = origin_of(np.linalg.inv(tree.frame[base]) @ T)
+        if o:
+            joint["origin"] = o
+        tree.joints[f"{name}_frame"] = joint
+        tree.link_notes[name] = f"SDF <frame> '{name}' (attached to '{attached}'): a massless link fixed there"

@@ -1,0 +1,131 @@
+"""An SDF file, or a Gazebo model folder (``model.config``), read as libsdformat reads it.
+
+``ign sdf -p`` prints libsdformat's reading (SDF 1.9: includes resolved with the model path set
+to the folder's parent, older versions converted).  A file it refuses that the XML still holds
+(ragdoll: libsdformat 12 refuses it, Gazebo 11 loads it) is read from its own XML, stated on the
+ledger; one that is not well-formed XML, or holds no model, is refused (file:line, exit 2)."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from robotkit.errors import Problem, RobotkitError
+from robotkit.urdfxml import MalformedXML, is_element, parse_file, parse_text
+
+ENV_KEYS = ("SDF_PATH", "GAZEBO_MODEL_PATH", "IGN_GAZEBO_RESOURCE_PATH", "GZ_SIM_RESOURCE_PATH")
+
+
+@dataclass
+class Source:
+    path: Path
+    model: object  # the <model> element (lxml)
+    lines: list[str]  # the original file's text, for file:line on the ledger
+    via: str  # "libsdformat" | "xml"
+    refused: str = ""  # libsdformat's words when it refused the file
+    config: dict = field(default_factory=dict)  # model.config: name, version, description, authors
+    model_path: Path | None = None
+    renamed: dict = field(default_factory=dict)  # new joint name -> the file's
+    unknown_scripts: set = field(default_factory=set)  # Gazebo material names without a known colour
+
+    def where(self, kind: str, name: str | None, link: str | None = None) -> str:
+        """``file:line`` of the element ``<kind name="name">`` in the original file (inside link
+        ``link`` when given); the file alone when it is not there (it came from an include)."""
+        name = self.renamed.get(name, name) if kind == "joint" else name
+        start = self.line_of("link", link) if link else 1
+        line = self.line_of(kind, name, start or 1) if name else None
+        return f"{self.path}:{line}" if line else str(self.path)
+
+    def line_of(self, kind: str, name: str | None, start: int = 1) -> int | None:
+        pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name or '')}[\"']")
+        return next((i for i, line in enumerate(self.lines[start - 1:], start) if pattern.search(line)), None)
+
+
+def locate(path: str | os.PathLike) -> tuple[Path, dict]:
+    """(the SDF file, model.config's metadata) of a file or a model folder."""
+    p = Path(path)
+    if not p.is_dir():
+        config = p.parent / "model.config"
+        return p, read_config(config)[1] if config.is_file() else {}
+    config = p / "model.config"
+    if not config.is_file():
+        raise RobotkitError(Problem("a model folder without model.config", file=str(p)))
+    files, meta = read_config(config)
+    for version, name in sorted(files, key=lambda f: _version(f[0]), reverse=True):
+        if (not version or _version(version) > (1, 2)) and (p / name).is_file():
+            return p / name, meta
+    raise RobotkitError(Problem("model.config names no SDF file newer than 1.2 that exists in the folder",
+                                file=str(config)))
+
+
+def _version(text: str) -> tuple[int, ...]:
+    return tuple(int(x) for x in re.findall(r"\d+", text or "0")) or (0,)
+
+
+def read_config(config: Path) -> tuple[list[tuple[str, str]], dict]:
+    """([(SDF version, file)], metadata: name, version, description, authors) of a model.config."""
+    try:
+        root = parse_file(config).getroot()
+    except MalformedXML as exc:
+        raise RobotkitError(Problem(f"not well-formed XML: {exc}", file=str(config), line=exc.line)) from None
+    files = [(el.get("version", ""), (el.text or "").strip()) for el in root.findall("sdf")]
+    text = lambda tag: " ".join((root.findtext(tag) or "").split())  # noqa: E731
+    authors = [{"name": " ".join((a.findtext("name") or "").split()),
+                **({"email": a.findtext("email").strip()} if (a.findtext("email") or "").strip() else {})}
+               for a in root.findall("author") if (a.findtext("name") or "").strip()]
+    meta = {"name": text("name"), "version": text("version"), "description": text("description"),
+            "authors": authors}
+    return files, meta
+
+
+def printed(file: Path, model_path: Path | None) -> subprocess.CompletedProcess:
+    """``ign sdf -p FILE`` with ``model_path`` on every model path libsdformat reads."""
+    if shutil.which("ign") is None:
+        return subprocess.CompletedProcess(["ign"], 127, "", "Error: ign (libsdformat's command) is not installed")
+    env = dict(os.environ)
+    if model_path is not None:
+        for key in ENV_KEYS:
+            env[key] = os.pathsep.join(filter(None, [str(model_path), env.get(key, "")]))
+    return subprocess.run(["ign", "sdf", "-p", str(Path(file).absolute())], capture_output=True, text=True, env=env)
+
+
+def read(path: str | os.PathLike) -> Source:
+    """The SDF (or model folder) ``path`` through libsdformat; its own XML when libsdformat refuses it."""
+    file, config = locate(path)
+    if not file.is_file():
+        raise RobotkitError(Problem("no such file", file=str(file)))
+    original = file.read_text(encoding="utf-8", errors="replace")
+    model_path = file.absolute().parent.parent
+    result = printed(file, model_path)
+    refused = "" if result.returncode == 0 and "<model" in result.stdout else _words(result.stderr)
+    try:
+        tree = parse_text(result.stdout) if not refused else parse_file(file)
+    except MalformedXML as exc:
+        raise RobotkitError(Problem(f"not well-formed XML: {exc.expat or exc}", file=str(file),
+                                    line=exc.expat_line or exc.line)) from None
+    model = _model(tree.getroot())
+    if model is None:
+        raise RobotkitError(Problem(refused or "holds no <model>", file=str(file)))
+    return Source(file.absolute(), model, original.splitlines(), "xml" if refused else "libsdformat", refused,
+                  config, model_path)
+
+
+def _model(root):
+    if root.tag == "model":
+        return root
+    found = [el for el in root if is_element(el) and el.tag == "model"]
+    if not found:
+        found = [el for w in root.findall("world") for el in w.findall("model")]
+    return found[0] if found else None
+
+
+def _words(stderr: str) -> str:
+    """libsdformat's first error, on one line."""
+    stderr = re.sub(r"\x1b\[[0-9;]*m", "", stderr)
+    lines = [ln.strip() for ln in stderr.splitlines() if ln.strip() and "libignition-tools-backward" not in ln]
+    errors = [ln for ln in lines if "rror" in ln] or lines
+    return " ".join(errors[0].split()) if errors else "libsdformat refused the file"
