@@ -3,6 +3,7 @@ conversion stated on the ledger and proved against the rebuilt model.sdf (throug
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -159,21 +160,22 @@ def synthetic(tmp_path_factory):
     def build(recipe, folder):
         path = build_sdf(recipe, folder)
         built["sdf"] = path.read_text()
+        built["report"] = json.loads((path.parent / "report.json").read_text())
         return path
 
     result = import_sdf(tmp / "bench.sdf", tmp / "bench.yaml", build=build)
-    return result, yaml.safe_load(result.recipe_path.read_text()), built["sdf"]
+    return result, yaml.safe_load(result.recipe_path.read_text()), built["sdf"], built["report"]
 
 
 def test_static_model_is_fixed_to_world(synthetic):
-    result, recipe, _ = synthetic
+    result, recipe, _ = synthetic[:3]
     assert result.verdict.ok, result.verdict.lines()
     assert "base" not in recipe or recipe.get("base") != "free"
     assert _joints(recipe)["base_fixed"]["parent"] == "world"
 
 
 def test_joint_off_its_child_moves_the_link_frame_limits_dynamics(synthetic):
-    _, recipe, _ = synthetic
+    _, recipe, _ = synthetic[:3]
     hinge = _joints(recipe)["hinge"]
     assert hinge["origin"]["xyz"] == [0.3, 0.1, 0]
     assert hinge["axis"] == [0, 1, 0]
@@ -183,7 +185,7 @@ def test_joint_off_its_child_moves_the_link_frame_limits_dynamics(synthetic):
 
 
 def test_capsule_is_a_cylinder_and_two_spheres_with_its_colour(synthetic):
-    _, recipe, _ = synthetic
+    _, recipe, _ = synthetic[:3]
     visual = recipe["links"]["base"]["visual"]
     assert [next(k for k in ("cylinder", "sphere") if k in s) for s in visual] == ["cylinder", "sphere", "sphere"]
     assert [s.get("origin", {}).get("xyz") for s in visual[1:]] == [[0, 0, -0.2], [0, 0, 0.2]]
@@ -193,15 +195,21 @@ def test_capsule_is_a_cylinder_and_two_spheres_with_its_colour(synthetic):
 
 
 def test_frame_is_a_massless_link_fixed_where_it_is(synthetic):
-    _, recipe, _ = synthetic
+    _, recipe, _ = synthetic[:3]
     assert recipe["links"]["tool"] == {} or "inertial" not in recipe["links"]["tool"]
     joint = _joints(recipe)["tool_frame"]
     assert (joint["type"], joint["parent"], joint["child"]) == ("fixed", "arm", "tool")
     assert joint["origin"]["xyz"] == pytest.approx([0.1, -0.1, 0], abs=1e-15)
 
 
+def test_the_ledger_is_in_the_recipe_and_the_builds_report_json(synthetic):
+    result, recipe, _, report = synthetic
+    assert result.ledger and recipe["metadata"]["ledger"] == result.ledger
+    assert report["ledger"] == result.ledger
+
+
 def test_sensor_and_plugin_carried_verbatim_into_model_sdf(synthetic):
-    result, recipe, rebuilt = synthetic
+    result, recipe, rebuilt = synthetic[:3]
     assert any(e.startswith('<gazebo reference="base">\n  <sensor name="imu" type="imu">') for e in recipe["urdf_extras"])
     assert '<sensor name="imu" type="imu">' in rebuilt.replace("'", '"') and 'filename="libp.so"' in rebuilt
     assert any("sensor 'imu' (imu) of link 'base': MJCF: dropped (kept verbatim" in line for line in result.ledger)
@@ -220,7 +228,7 @@ def test_included_model_found_on_the_model_path_with_scoped_names(tmp_path):
 
 
 def test_what_the_recipe_cannot_hold_is_named_on_the_ledger(synthetic):
-    result, _, _ = synthetic
+    result, _, _ = synthetic[:3]
     where = str(Path(result.inputs[0]))
     assert f"{where}:5: link 'base': all: dropped (no place in the recipe): visual 'v' <transparency>" in result.ledger
     assert (f"{where}:19: joint 'hinge': all: dropped (no place in the recipe): <axis><dynamics><spring_stiffness> 3"

@@ -78,6 +78,8 @@ def convert(path, out: Path):
     if tree.base == "free":
         recipe["base"] = "free"
     add_extras(src, m, tree, recipe, ledger, surfaces)
+    if len(ledger):  # the build copies it into report.json
+        recipe.setdefault("metadata", {})["ledger"] = ledger.lines()
     if materials:
         recipe["materials"] = materials
     recipe["links"], recipe["joints"] = tree.links, tree.joints
