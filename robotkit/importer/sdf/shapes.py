@@ -25,7 +25,7 @@ GAZEBO_COLOURS = {"Gazebo/White": "1 1 1", "Gazebo/Grey": "0.7 0.7 0.7", "Gazebo
                   "Gazebo/FlatBlack": "0.1 0.1 0.1", "Gazebo/Black": "0 0 0", "Gazebo/Red": "1 0 0",
                   "Gazebo/Green": "0 1 0", "Gazebo/Blue": "0 0 1", "Gazebo/Yellow": "1 1 0", "Gazebo/Purple": "1 0 1",
                   "Gazebo/Turquoise": "0 1 1", "Gazebo/Orange": "1 0.5088 0.0468"}
-"""The diffuse colour of Gazebo classic's standard materials (media/materials/scripts/gazebo.material),
+"""The diffuse colour of Gazebo classic's standard materials (gazebo-classic's media/materials/scripts/gazebo.material: the values checked against that file),
 for a visual that names one and gives no colour: the other formats' colour."""
 
 
