@@ -114,7 +114,7 @@ def started(cmds: list[list[str]]):
     pool = ThreadPoolExecutor(max_workers=1 if batch else max(1, len(keys)), thread_name_prefix="robotkit-program")
     with _lock:
         mine = [k for k in keys if k not in _started]
-        if batch:
+        if batch and mine:
             futures = {k: Future() for k in mine}
             _started.update(futures)
             pool.submit(_batch, mine, futures, library)

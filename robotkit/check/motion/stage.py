@@ -335,7 +335,9 @@ class MotionRun:
     work; :meth:`finish` waits for them and gives (findings, results)."""
 
     def __init__(self, mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path],
-                 simulators: tuple[str, ...] = SIMULATORS):
+                 simulators: tuple[str, ...] = SIMULATORS, cached=None):
+        """``cached``: a :class:`robotkit.check.cache.StageCache` of the build folder the files are
+        in (each simulator's runs taken from it when there, stored in it when computed)."""
         import multiprocessing
 
         self.t0 = time.perf_counter()
@@ -343,12 +345,21 @@ class MotionRun:
         self.simulators = [s for s in simulators if s == "mujoco" or urdf is not None]
         self.skipped = [s for s in simulators if s not in self.simulators]
         self.futures: dict[str, Future] = {}
+        self.cached, self.pool, self.missed = cached, None, {}
         if not self.plan.steps:
-            self.pool = None
             return
-        context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
-        self.pool = ProcessPoolExecutor(max_workers=len(self.simulators), mp_context=context)
-        self.futures = {s: self.pool.submit(run_simulator, s, self.plan) for s in self.simulators}
+        hits = {s: cached.get(f"{STAGE} {s}") if cached else None for s in self.simulators}
+        for s, hit in hits.items():
+            if hit is not None:
+                self.futures[s] = Future()
+                self.futures[s].set_result(hit)
+        missed = [s for s in self.simulators if hits[s] is None]
+        if missed:
+            context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+            self.pool = ProcessPoolExecutor(max_workers=len(missed), mp_context=context)
+            self.missed = {s: self.pool.submit(run_simulator, s, self.plan) for s in missed}
+            self.futures.update(self.missed)
+            self.futures = {s: self.futures[s] for s in self.simulators}  # in the simulators' order
 
     def finish(self) -> tuple[list[Finding], dict]:
         runs = {}
@@ -357,6 +368,9 @@ class MotionRun:
                 runs[s] = future.result()
             except Exception as exc:  # the worker itself failed (a crash in the program)
                 runs[s] = {"runs": [], "hold": {}, "error": f"{type(exc).__name__}: {exc}"}
+            else:
+                if self.cached and s in self.missed and not runs[s].get("error"):
+                    self.cached.put(f"{STAGE} {s}", runs[s])  # computed and whole: kept for the same files
         if self.pool is not None:
             self.pool.shutdown()
         results = assemble(self.plan, runs, self.skipped)
