@@ -8,9 +8,11 @@ which, and building a recipe first, is ``robotkit.commands.check``'s job.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
 import shutil
+import subprocess
 import tempfile
 import time
 from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor
@@ -230,7 +232,7 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
     build = Build(name, robot_dir, urdf, sdf, None if lost else mjcf, _base(layout, lost))
     consumers_started = time.perf_counter()
     cached = stage_cache(robot_dir)
-    with programs.started(_sdformat_runs(build)):  # libsdformat's runs first, beside the imports
+    with _libsdformat(build, cached):  # libsdformat's runs first, beside the imports
         # once, here: the workers forked below inherit them (not needed when their results are cached)
         preload(mujoco=not lost, programs=not (cached and all(map(cached.has, PROGRAM_STAGES))))
         workers, collider = _fork_pool(), _fork_pool()
@@ -239,10 +241,35 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
             started = None if lost else start_motion(mjcf, urdf, {name: robot_dir}, cached)  # beside the others
             collisions = None if lost else _cached_or(cached, "self-collision", collider, _interference,
                                                       robot_dir, subject)
-            return _rest(build, clock, declared_mass, own, started, collisions, motion, consumers_started)
+            return _rest(build, clock, declared_mass, own, started, collisions, motion, consumers_started, cached)
         finally:
             workers.shutdown(wait=False, cancel_futures=True)
             collider.shutdown(wait=False, cancel_futures=True)
+
+
+@contextlib.contextmanager
+def _libsdformat(build: Build, cached: StageCache | None):
+    """libsdformat's runs (:func:`_sdformat_runs`) started for the block, or their results taken
+    from the cache; stored there once they are done."""
+    runs = _sdformat_runs(build)
+    rows = cached.get("libsdformat") if cached and runs else None
+    known = ({tuple(c): subprocess.CompletedProcess(c, *row) for c, row in zip(runs, rows)}
+             if rows and len(rows) == len(runs) else {})
+    with programs.started(runs, known):
+        yield
+        if cached and runs and not known:
+            cached.put("libsdformat", [[r.returncode, r.stdout, r.stderr] for r in map(programs.run, runs)])
+
+
+def _cached(cached: StageCache | None, stage: str, run) -> list[Finding]:
+    """``run()``'s findings, or the stage's from the cache (:mod:`robotkit.check.cache`)."""
+    found = cached.get(stage) if cached else None
+    if found is not None:
+        return from_json(found)
+    found = run()
+    if cached and kept(found):
+        cached.put(stage, to_json(found))
+    return found
 
 
 PROGRAM_STAGES = ("consumers", "motion pybullet", "motion drake")
@@ -268,10 +295,10 @@ def _cached_or(cached: StageCache | None, stage: str, pool, run, *args) -> Futur
 
 
 def _rest(build: Build, clock: Clock, declared_mass: float | None, own: Future, started, collisions,
-          motion: dict | None, consumers_started: float) -> list[Finding]:
+          motion: dict | None, consumers_started: float, cached: StageCache | None) -> list[Finding]:
     """The main process's stages, then the workers' findings gathered in the stages' order."""
     subject, lost = f"robot '{build.name}'", build.mjcf is None
-    findings, gazebo = _main_stages(build, clock, declared_mass)
+    findings, gazebo = _main_stages(build, clock, declared_mass, cached)
     findings += _merged_consumers(gazebo, own, subject)
     clock.add("consumers", time.perf_counter() - consumers_started)
     if lost:
@@ -298,7 +325,8 @@ def _base(layout, lost: bool) -> str:
     return "free" if consumers.get("MuJoCo (MJCF)", {}).get("base") == "free joint" else "fixed"
 
 
-def _main_stages(build: Build, clock: Clock, declared_mass: float | None) -> tuple[list[Finding], list[Finding]]:
+def _main_stages(build: Build, clock: Clock, declared_mass: float | None,
+                 cached: StageCache | None = None) -> tuple[list[Finding], list[Finding]]:
     """The lints, the validators, the equivalence and Gazebo's view, with libsdformat's runs
     and check_urdf started first beside them: (their findings, Gazebo's findings)."""
     subject, sdf, mjcf = f"robot '{build.name}'", build.sdf, build.mjcf
@@ -318,8 +346,10 @@ def _main_stages(build: Build, clock: Clock, declared_mass: float | None) -> tup
             return [Finding("error", "equivalence", subject, f"{what}: {d}")
                     for what, diffs in equivalence(build.dir).items() for d in diffs]
 
-        findings += clock.timed("equivalence", lambda: _stage("equivalence", subject, equivalent))
-        gazebo = _stage("consumers", subject, lambda: consumer_findings(build, GAZEBO)[0])
+        findings += clock.timed("equivalence", lambda: _cached(cached, "equivalence", lambda: _stage(
+            "equivalence", subject, equivalent)))
+        gazebo = _cached(cached, "consumers gazebo", lambda: _stage("consumers", subject,
+                                                                    lambda: consumer_findings(build, GAZEBO)[0]))
     return findings, gazebo
 
 

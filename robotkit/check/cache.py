@@ -1,12 +1,13 @@
 """The results of a build folder's pure check stages, cached by content.
 
-The consumers read in Python (Drake, Pinocchio, PyBullet, MuJoCo), self-collision and each
-simulator's motion runs read nothing but the build folder's files, with libraries whose versions
-are known: the same files, the same robotkit and the same libraries give the same result.  Such a
+The consumers (Drake, Pinocchio, PyBullet, MuJoCo; Gazebo's view through libsdformat), the
+equivalence, self-collision and each simulator's motion runs read nothing but the build folder's
+files, with libraries and programs whose versions are known: the same files, the same robotkit and the same libraries give the same result.  Such a
 result is kept in robotkit's content-addressed cache (:mod:`robotkit.mesh.cache`, the build's own:
 ``$ROBOTKIT_CACHE``...) under a key made of the stage, every file of the folder (its relative
 path and bytes; not the picture report, which no stage reads), the folder's absolute path (the
-results name files in it), robotkit's own files under ``robotkit/`` and the libraries' versions.
+results name files in it), robotkit's own files under ``robotkit/``, the libraries' versions and
+the outside programs' files (libsdformat's reading feeds the equivalence stage and Gazebo's view).
 A later check of the same folder takes the result from there: no worker process, no import of
 the library.  Stored as JSON (findings as their fields): a cache shared with others holds no
 pickles.  ``ROBOTKIT_CHECK_CACHE=0`` turns it off (every stage computed, nothing stored)."""
@@ -18,6 +19,7 @@ import functools
 import hashlib
 import json
 import os
+import shutil
 from pathlib import Path
 
 from robotkit.check.findings import Finding
@@ -44,6 +46,30 @@ def code_digest() -> str:
     return h.hexdigest()
 
 
+@functools.lru_cache(maxsize=None)
+def programs() -> str:
+    """The outside programs and library the stages run (check_urdf, ``ign``, libsdformat), each
+    as where it is, its size and its time of change: an upgrade of one is a miss."""
+    import subprocess
+
+    from robotkit.check.programs import LIBRARY
+
+    found = [shutil.which("check_urdf"), shutil.which("ign")]
+    try:
+        listed = subprocess.run(["ldconfig", "-p"], capture_output=True, text=True).stdout
+    except OSError:
+        listed = ""
+    found += sorted({line.split("=>")[-1].strip() for line in listed.splitlines() if f"lib{LIBRARY}." in line})
+    out = []
+    for path in found:
+        try:
+            st = os.stat(path) if path else None
+        except OSError:
+            st = None
+        out.append(f"{path}:{st.st_size}:{st.st_mtime_ns}" if st else f"{path}:missing")
+    return "\n".join(out)
+
+
 def folder_digest(folder: Path) -> str:
     """sha256 of every file of ``folder`` (relative path and bytes) but :data:`SKIPPED`'s."""
     h = hashlib.sha256()
@@ -62,7 +88,7 @@ class StageCache:
         from robotkit.mesh.cache import Cache, library_versions
 
         self.cache = Cache(versions=library_versions(LIBRARIES))
-        self.inputs = [str(Path(folder).resolve()), folder_digest(Path(folder)), code_digest()]
+        self.inputs = [str(Path(folder).resolve()), folder_digest(Path(folder)), code_digest(), programs()]
 
     def key(self, stage: str) -> str:
         return self.cache.key(OP, {"stage": stage}, self.inputs)
