@@ -30,7 +30,7 @@ from robotkit.check.findings import Finding
 from robotkit.check.kinematics import read_mjcf, read_sdf
 from robotkit.check.lints import LinkFacts, lint, lint_link, read_urdf_facts
 from robotkit.check.locate import locate
-from robotkit.check.motion.stage import MotionRun, has_actuators
+from robotkit.check.motion.stage import MotionRun, compiled
 from robotkit.check.simulation import smoke_test
 from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
 from robotkit.emit.layout import robot_layout
@@ -394,7 +394,8 @@ def start_motion(mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path],
     """The motion stage started (None when the MJCF has no actuator; the exception if it cannot
     start); each simulator's runs taken from ``cached`` when they are there."""
     try:
-        return MotionRun(mjcf, urdf, package_dirs, cached=cached) if has_actuators(mjcf) else None
+        model = compiled(mjcf)  # compiled once: whether it has actuators, then the plan
+        return MotionRun(mjcf, urdf, package_dirs, cached=cached, model=model) if model.nu > 0 else None
     except Exception as exc:  # reported by finish_motion, as _stage reports a stage's failure
         return exc
 

@@ -72,10 +72,11 @@ def drives_from_mjcf(path: Path) -> tuple[list[Drive], dict[str, dict[str, float
     return plan.drives, plan.poses, plan.integrator, plan.timestep
 
 
-def read_plan(path: Path, urdf: Path | None = None, package_dirs: dict | None = None) -> Plan:
+def read_plan(path: Path, urdf: Path | None = None, package_dirs: dict | None = None, model=None) -> Plan:
+    """The plan of the stage on the MJCF ``path`` (``model``: it compiled already, if it is)."""
     mujoco = mj.load()
 
-    model = mujoco.MjModel.from_xml_path(str(path))
+    model = mujoco.MjModel.from_xml_path(str(path)) if model is None else model
     kinds = {int(mujoco.mjtJoint.mjJNT_HINGE): "hinge", int(mujoco.mjtJoint.mjJNT_SLIDE): "slide"}
     drives, kind_of, not_checked = [], {}, []
     for a in range(model.nu):
@@ -335,13 +336,14 @@ class MotionRun:
     work; :meth:`finish` waits for them and gives (findings, results)."""
 
     def __init__(self, mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path],
-                 simulators: tuple[str, ...] = SIMULATORS, cached=None):
+                 simulators: tuple[str, ...] = SIMULATORS, cached=None, model=None):
         """``cached``: a :class:`robotkit.check.cache.StageCache` of the build folder the files are
-        in (each simulator's runs taken from it when there, stored in it when computed)."""
+        in (each simulator's runs taken from it when there, stored in it when computed);
+        ``model``: the MJCF compiled already, if it is."""
         import multiprocessing
 
         self.t0 = time.perf_counter()
-        self.plan = read_plan(Path(mjcf), urdf, package_dirs)
+        self.plan = read_plan(Path(mjcf), urdf, package_dirs, model)
         self.simulators = [s for s in simulators if s == "mujoco" or urdf is not None]
         self.skipped = [s for s in simulators if s not in self.simulators]
         self.futures: dict[str, Future] = {}
@@ -386,9 +388,12 @@ def motion_stage(mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path],
 
 def has_actuators(mjcf: Path) -> bool:
     """Whether the MJCF declares an actuator (the stage runs only then)."""
-    mujoco = mj.load()
+    return compiled(mjcf).nu > 0
 
-    return mujoco.MjModel.from_xml_path(str(mjcf)).nu > 0
+
+def compiled(mjcf: Path):
+    """The MJCF compiled by MuJoCo (its MjModel)."""
+    return mj.load().MjModel.from_xml_path(str(mjcf))
 
 
 def assemble(plan: Plan, runs: dict[str, dict], skipped: list[str]) -> dict:
