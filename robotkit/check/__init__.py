@@ -233,14 +233,16 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
     consumers_started = time.perf_counter()
     cached = stage_cache(robot_dir)
     with _libsdformat(build, cached):  # libsdformat's runs first, beside the imports
-        # once, here: the workers forked below inherit them (not needed when their results are cached)
-        preload(mujoco=not lost, programs=not (cached and all(map(cached.has, PROGRAM_STAGES))))
+        # imported once, here: the workers forked below inherit them; self-collision (MuJoCo only)
+        # forked before Drake's import, which it does not need, runs beside it
+        preload(mujoco=not lost, programs=False)
         workers, collider = _fork_pool(), _fork_pool()
         try:
-            own = _cached_or(cached, "consumers", workers, _own_consumers, build)
-            started = None if lost else start_motion(mjcf, urdf, {name: robot_dir}, cached)  # beside the others
             collisions = None if lost else _cached_or(cached, "self-collision", collider, _interference,
                                                       robot_dir, subject)
+            preload(mujoco=False, programs=not (cached and all(map(cached.has, PROGRAM_STAGES))))
+            own = _cached_or(cached, "consumers", workers, _own_consumers, build)
+            started = None if lost else start_motion(mjcf, urdf, {name: robot_dir}, cached)  # beside the others
             return _rest(build, clock, declared_mass, own, started, collisions, motion, consumers_started, cached)
         finally:
             workers.shutdown(wait=False, cancel_futures=True)
