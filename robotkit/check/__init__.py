@@ -286,7 +286,8 @@ def _cached_or(cached: StageCache | None, stage: str, pool, run, *args) -> Futur
         done: Future = Future()
         done.set_result((from_json(found), 0.0))
         return done
-    future = pool.submit(run, *args)
+    with programs.SPAWN:  # the worker forked while no program is being started (programs.SPAWN)
+        future = pool.submit(run, *args)
     if cached:
         def store(f: Future) -> None:
             if not f.cancelled() and f.exception() is None and kept(f.result()[0]):

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from robotkit import mj
+from robotkit.check import programs
 from robotkit.check.findings import Finding
 from robotkit.check.motion.law import Drive, Step
 from robotkit.check.motion.metrics import metrics
@@ -359,7 +360,8 @@ class MotionRun:
         if missed:
             context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
             self.pool = ProcessPoolExecutor(max_workers=len(missed), mp_context=context)
-            self.missed = {s: self.pool.submit(run_simulator, s, self.plan) for s in missed}
+            with programs.SPAWN:  # forked while no program is being started (robotkit.check.programs.SPAWN)
+                self.missed = {s: self.pool.submit(run_simulator, s, self.plan) for s in missed}
             self.futures.update(self.missed)
             self.futures = {s: self.futures[s] for s in self.simulators}  # in the simulators' order
 
