@@ -23,7 +23,7 @@ from pathlib import Path
 from robotkit import urdfxml
 from robotkit.check import programs
 from robotkit.check.cache import StageCache, from_json, kept, stage_cache, to_json
-from robotkit.check.consumers import CONSUMERS, Build, consumer_findings, preload
+from robotkit.check.consumers import CONSUMERS, Build, consumer_findings
 from robotkit.check.equivalence import equivalence
 from robotkit.check.selfcollision import interference, mjcf_interference
 from robotkit.check.findings import Finding
@@ -232,17 +232,14 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
     build = Build(name, robot_dir, urdf, sdf, None if lost else mjcf, _base(layout, lost))
     consumers_started = time.perf_counter()
     cached = stage_cache(robot_dir)
-    with _libsdformat(build, cached):  # libsdformat's runs first, beside the imports
-        # imported once, here: the workers forked below inherit them; self-collision (MuJoCo only)
-        # forked before Drake's import, which it does not need, runs beside it
-        preload(mujoco=not lost, programs=False)
+    with _libsdformat(build, cached):  # libsdformat's runs first, beside the workers' imports
         workers, collider = _fork_pool(), _fork_pool()
-        try:
-            collisions = None if lost else _cached_or(cached, "self-collision", collider, _interference,
-                                                      robot_dir, subject)
-            preload(mujoco=False, programs=not (cached and all(map(cached.has, PROGRAM_STAGES))))
+        try:  # each worker imports its own libraries, beside the others (measured: importing them here
+            # first, for the workers to inherit, saved no CPU and lengthened the main process's path)
             own = _cached_or(cached, "consumers", workers, _own_consumers, build)
             started = None if lost else start_motion(mjcf, urdf, {name: robot_dir}, cached)  # beside the others
+            collisions = None if lost else _cached_or(cached, "self-collision", collider, _interference,
+                                                      robot_dir, subject)  # forked with MuJoCo imported
             return _rest(build, clock, declared_mass, own, started, collisions, motion, consumers_started, cached)
         finally:
             workers.shutdown(wait=False, cancel_futures=True)
@@ -272,10 +269,6 @@ def _cached(cached: StageCache | None, stage: str, run) -> list[Finding]:
     if cached and kept(found):
         cached.put(stage, to_json(found))
     return found
-
-
-PROGRAM_STAGES = ("consumers", "motion pybullet", "motion drake")
-"""The cached stages whose workers import Drake and PyBullet (robotkit.check.consumers.preload)."""
 
 
 def _cached_or(cached: StageCache | None, stage: str, pool, run, *args) -> Future:

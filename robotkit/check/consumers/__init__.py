@@ -42,34 +42,6 @@ CONSUMERS = {
 REL_TOL = 1e-9
 
 
-HEAVY = ("pydrake.multibody.parsing", "pydrake.multibody.plant", "pydrake.multibody.tree", "pydrake.systems.framework",
-         "pydrake.systems.analysis", "pydrake.systems.controllers", "pydrake.systems.primitives")
-"""The libraries that two worker processes each imported on their own (with PyBullet's and MuJoCo):
-Drake's (about 0.45 s of CPU), read by the consumers' worker and stepped by the motion stage's
-Drake worker.  Pinocchio, read by one worker only, is left to it."""
-
-
-def preload(mujoco: bool = True, programs: bool = True) -> None:
-    """Import MuJoCo (with ``mujoco``) and the programs' libraries (with ``programs``) in this
-    process, once, so that the worker processes forked from it afterwards inherit them.  One that
-    is not installed, or fails to import, is left to the stage that needs it (it says so, as
-    without this)."""
-    from robotkit import mj
-    from robotkit.ioutil import quiet
-
-    for name in ("mujoco",) * mujoco + (HEAVY + ("pybullet",)) * programs:
-        try:
-            if name == "mujoco":
-                mj.load()
-            elif name == "pybullet":
-                with quiet():  # it prints its build banner
-                    importlib.import_module(name)
-            else:
-                importlib.import_module(name)
-        except Exception:  # noqa: BLE001  (ImportError, or a library that fails at import: its stage says)
-            continue
-
-
 class Refused(Exception):
     """The program refused to load the robot (its own message)."""
 
