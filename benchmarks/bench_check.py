@@ -89,12 +89,14 @@ def watch(proc: subprocess.Popen) -> dict[int, float]:
 
 def check_once(folder: Path, cache: Path) -> dict:
     cpu, t0 = children_cpu(), time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-m", "robotkit", "check", str(folder), "--format", "json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env={**os.environ, "ROBOTKIT_CACHE": str(cache)})
-    seen = watch(proc) if os.path.isdir("/proc") else {}
-    stdout, stderr = proc.communicate()
-    wall = time.perf_counter() - t0
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:  # not pipes: nothing reads
+        # them while the process is watched, and a JSON larger than a pipe holds would block it
+        proc = subprocess.Popen([sys.executable, "-m", "robotkit", "check", str(folder), "--format", "json"],
+                                stdout=out, stderr=err, env={**os.environ, "ROBOTKIT_CACHE": str(cache)})
+        seen = watch(proc) if os.path.isdir("/proc") else {}
+        proc.wait()
+        wall = time.perf_counter() - t0
+        stdout, stderr = (f.seek(0) or f.read().decode("utf-8", "replace") for f in (out, err))
     wait_orphans()
     cpu = children_cpu() - cpu
     if proc.returncode not in (0, 1):
@@ -113,7 +115,7 @@ def main() -> int:
     args = ap.parse_args()
     reap_orphans()
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the start; "
-          f"medians of {args.repeat} checks, seconds")
+          f"medians of {args.repeat} checks, seconds", flush=True)
     with tempfile.TemporaryDirectory(prefix="bench_check.") as tmp:
         out = Path(args.out or tmp)
         for robot in args.robots:
@@ -126,11 +128,11 @@ def main() -> int:
                 runs.setdefault((robot, "first"), []).append(check_once(out / robot, cache))
                 runs.setdefault((robot, "again"), []).append(check_once(out / robot, cache))
         columns = [(r, way) for r in args.robots for way in ("first", "again")]
-        print(f"{'':<18}" + "".join(f"{f'{r} {way}':>16}" for r, way in columns))
+        print(f"{'':<18}" + "".join(f"{f'{r} {way}':>18}" for r, way in columns))
 
         def med(column, get):
             values = [v for v in (get(run) for run in runs[column]) if v is not None]
-            return f"{statistics.median(values):>16.3f}" if values else f"{'-':>16}"
+            return f"{statistics.median(values):>18.3f}" if values else f"{'-':>18}"
 
         for stage in ORDER:
             print(f"{stage:<18}" + "".join(med(c, lambda run, s=stage: run["stages"].get(s)) for c in columns))
