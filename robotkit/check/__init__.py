@@ -8,9 +8,11 @@ which, and building a recipe first, is ``robotkit.commands.check``'s job.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import re
 import shutil
+import subprocess
 import tempfile
 import time
 from concurrent.futures import Future, ProcessPoolExecutor, ThreadPoolExecutor
@@ -20,6 +22,7 @@ from pathlib import Path
 
 from robotkit import urdfxml
 from robotkit.check import programs
+from robotkit.check.cache import StageCache, from_json, kept, stage_cache, to_json
 from robotkit.check.consumers import CONSUMERS, Build, consumer_findings
 from robotkit.check.equivalence import equivalence
 from robotkit.check.selfcollision import interference, mjcf_interference
@@ -27,7 +30,7 @@ from robotkit.check.findings import Finding
 from robotkit.check.kinematics import read_mjcf, read_sdf
 from robotkit.check.lints import LinkFacts, lint, lint_link, read_urdf_facts
 from robotkit.check.locate import locate
-from robotkit.check.motion.stage import MotionRun, has_actuators
+from robotkit.check.motion.stage import MotionRun, compiled
 from robotkit.check.simulation import smoke_test
 from robotkit.check.validators import validate_mjcf, validate_sdf, validate_urdf
 from robotkit.emit.layout import robot_layout
@@ -228,24 +231,80 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
     clock, subject = Clock(timings), f"robot '{name}'"
     build = Build(name, robot_dir, urdf, sdf, None if lost else mjcf, _base(layout, lost))
     consumers_started = time.perf_counter()
-    workers, collider = _fork_pool(), _fork_pool()  # forked first, from one thread
-    try:
-        own = workers.submit(_own_consumers, build)
-        started = None if lost else start_motion(mjcf, urdf, {name: robot_dir})  # beside the other stages
-        collisions = None if lost else collider.submit(_interference, robot_dir, subject)  # forked with MuJoCo
-        findings, gazebo = _main_stages(build, clock, declared_mass)
-        findings += _merged_consumers(gazebo, own, subject)
-        clock.add("consumers", time.perf_counter() - consumers_started)
-        if lost:
-            return findings
-        findings += clock.timed("simulation", lambda: _stage("simulation", subject, lambda: _simulate(scene, subject)))
-        found, seconds = _stage_outcome("self-collision", subject, collisions)
-        clock.add("self-collision", seconds)
-        findings += found
-    finally:
-        workers.shutdown(wait=False, cancel_futures=True)
-        collider.shutdown(wait=False, cancel_futures=True)
-    return findings + unreported_missing(findings, finish_motion(started, subject, name, motion, clock))
+    cached = stage_cache(robot_dir)
+    with _libsdformat(build, cached):  # libsdformat's runs first, beside the workers' imports
+        workers, collider = _fork_pool(), _fork_pool()
+        try:  # each worker imports its own libraries, beside the others (measured: importing them here
+            # first, for the workers to inherit, saved no CPU and lengthened the main process's path)
+            own = _cached_or(cached, "consumers", workers, _own_consumers, build)
+            started = None if lost else start_motion(mjcf, urdf, {name: robot_dir}, cached)  # beside the others
+            collisions = None if lost else _cached_or(cached, "self-collision", collider, _interference,
+                                                      robot_dir, subject)  # forked with MuJoCo imported
+            return _rest(build, clock, declared_mass, own, started, collisions, motion, consumers_started, cached)
+        finally:
+            workers.shutdown(wait=False, cancel_futures=True)
+            collider.shutdown(wait=False, cancel_futures=True)
+
+
+@contextlib.contextmanager
+def _libsdformat(build: Build, cached: StageCache | None):
+    """libsdformat's runs (:func:`_sdformat_runs`) started for the block, or their results taken
+    from the cache; stored there once they are done."""
+    runs = _sdformat_runs(build)
+    rows = cached.get("libsdformat") if cached and runs else None
+    known = ({tuple(c): subprocess.CompletedProcess(c, *row) for c, row in zip(runs, rows)}
+             if rows and len(rows) == len(runs) else {})
+    with programs.started(runs, known):
+        yield
+        if cached and runs and not known:
+            cached.put("libsdformat", [[r.returncode, r.stdout, r.stderr] for r in map(programs.run, runs)])
+
+
+def _cached(cached: StageCache | None, stage: str, run) -> list[Finding]:
+    """``run()``'s findings, or the stage's from the cache (:mod:`robotkit.check.cache`)."""
+    found = cached.get(stage) if cached else None
+    if found is not None:
+        return from_json(found)
+    found = run()
+    if cached and kept(found):
+        cached.put(stage, to_json(found))
+    return found
+
+
+def _cached_or(cached: StageCache | None, stage: str, pool, run, *args) -> Future:
+    """The stage's (findings, seconds): from the cache (:mod:`robotkit.check.cache`), or ``run(*args)``
+    in ``pool``'s worker, its findings stored once it is done."""
+    found = cached.get(stage) if cached else None
+    if found is not None:
+        done: Future = Future()
+        done.set_result((from_json(found), 0.0))
+        return done
+    with programs.SPAWN:  # the worker forked while no program is being started (programs.SPAWN)
+        future = pool.submit(run, *args)
+    if cached:
+        def store(f: Future) -> None:
+            if not f.cancelled() and f.exception() is None and kept(f.result()[0]):
+                cached.put(stage, to_json(f.result()[0]))
+
+        future.add_done_callback(store)
+    return future
+
+
+def _rest(build: Build, clock: Clock, declared_mass: float | None, own: Future, started, collisions,
+          motion: dict | None, consumers_started: float, cached: StageCache | None) -> list[Finding]:
+    """The main process's stages, then the workers' findings gathered in the stages' order."""
+    subject, lost = f"robot '{build.name}'", build.mjcf is None
+    findings, gazebo = _main_stages(build, clock, declared_mass, cached)
+    findings += _merged_consumers(gazebo, own, subject)
+    clock.add("consumers", time.perf_counter() - consumers_started)
+    if lost:
+        return findings
+    scene = robot_layout(build.dir).scene
+    findings += clock.timed("simulation", lambda: _stage("simulation", subject, lambda: _simulate(scene, subject)))
+    found, seconds = _stage_outcome("self-collision", subject, collisions)
+    clock.add("self-collision", seconds)
+    findings += found
+    return findings + unreported_missing(findings, finish_motion(started, subject, build.name, motion, clock))
 
 
 def _interference(robot_dir: Path, subject: str) -> tuple[list[Finding], float]:
@@ -262,14 +321,13 @@ def _base(layout, lost: bool) -> str:
     return "free" if consumers.get("MuJoCo (MJCF)", {}).get("base") == "free joint" else "fixed"
 
 
-def _main_stages(build: Build, clock: Clock, declared_mass: float | None) -> tuple[list[Finding], list[Finding]]:
+def _main_stages(build: Build, clock: Clock, declared_mass: float | None,
+                 cached: StageCache | None = None) -> tuple[list[Finding], list[Finding]]:
     """The lints, the validators, the equivalence and Gazebo's view, with libsdformat's runs
     and check_urdf started first beside them: (their findings, Gazebo's findings)."""
     subject, sdf, mjcf = f"robot '{build.name}'", build.sdf, build.mjcf
     scene = robot_layout(build.dir).scene
-    sdformat = ([["ign", "sdf", "-k", str(sdf)]] + [["ign", "sdf", "-p", str(p)] for p in (build.urdf, sdf)]
-                if shutil.which("ign") else [])
-    with programs.started(sdformat), ThreadPoolExecutor(max_workers=2) as threads:
+    with ThreadPoolExecutor(max_workers=2) as threads:  # libsdformat's runs started by the caller
         validators = {"check_urdf": threads.submit(_timed, validate_urdf, build.urdf),
                       "ign sdf -k": threads.submit(_timed, validate_sdf, sdf)}
         findings = clock.timed("lints", lambda: _lints(build.urdf, {build.name: str(build.dir)}, declared_mass))
@@ -284,12 +342,22 @@ def _main_stages(build: Build, clock: Clock, declared_mass: float | None) -> tup
             return [Finding("error", "equivalence", subject, f"{what}: {d}")
                     for what, diffs in equivalence(build.dir).items() for d in diffs]
 
-        findings += clock.timed("equivalence", lambda: _stage("equivalence", subject, equivalent))
-        gazebo = _stage("consumers", subject, lambda: consumer_findings(build, GAZEBO)[0])
+        findings += clock.timed("equivalence", lambda: _cached(cached, "equivalence", lambda: _stage(
+            "equivalence", subject, equivalent)))
+        gazebo = _cached(cached, "consumers gazebo", lambda: _stage("consumers", subject,
+                                                                    lambda: consumer_findings(build, GAZEBO)[0]))
     return findings, gazebo
 
 
 GAZEBO = [c for c in CONSUMERS if c.startswith("Gazebo")]
+
+
+def _sdformat_runs(build: Build) -> list[list[str]]:
+    """libsdformat's runs a build folder's check makes: ``ign sdf -k`` of model.sdf (its validator),
+    ``ign sdf -p`` of the URDF and of model.sdf (the equivalence stage and Gazebo's view)."""
+    if not shutil.which("ign"):
+        return []
+    return [["ign", "sdf", "-k", str(build.sdf)]] + [["ign", "sdf", "-p", str(p)] for p in (build.urdf, build.sdf)]
 
 
 def _lints(urdf: Path, package_paths: dict[str, str], declared_mass: float | None) -> list[Finding]:
@@ -317,10 +385,13 @@ def unreported_missing(findings: list[Finding], more: list[Finding]) -> list[Fin
     return [f for f in more if not ("not checked" in f.message and f.message.split(":")[0].lower() in said)]
 
 
-def start_motion(mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path]) -> MotionRun | Exception | None:
-    """The motion stage started (None when the MJCF has no actuator; the exception if it cannot start)."""
+def start_motion(mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path],
+                 cached: StageCache | None = None) -> MotionRun | Exception | None:
+    """The motion stage started (None when the MJCF has no actuator; the exception if it cannot
+    start); each simulator's runs taken from ``cached`` when they are there."""
     try:
-        return MotionRun(mjcf, urdf, package_dirs) if has_actuators(mjcf) else None
+        model = compiled(mjcf)  # compiled once: whether it has actuators, then the plan
+        return MotionRun(mjcf, urdf, package_dirs, cached=cached, model=model) if model.nu > 0 else None
     except Exception as exc:  # reported by finish_motion, as _stage reports a stage's failure
         return exc
 

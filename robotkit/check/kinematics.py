@@ -517,6 +517,7 @@ def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: i
                 j.mimic = a.joints[name].mimic
     rng = np.random.default_rng(seed)
     names = sorted(ma)
+    shared = sorted(la & lb)
     root_a, root_b = a.root(), b.root()
     for k in range(configs):
         q = {}
@@ -526,9 +527,24 @@ def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: i
             q[n] = float(rng.uniform(lo, hi)) if k else 0.0
         Ta, Tb = a.fk(q), b.fk(q)
         ra, rb = np.linalg.inv(Ta[root_a]), np.linalg.inv(Tb[root_a if root_a in Tb else root_b])
-        for name in sorted(la & lb):
+        name = first_pose_difference(ra, Ta, rb, Tb, shared, tol if pose_tol is None else pose_tol)
+        if name is not None:
             differs = pose_difference(ra @ Ta[name], rb @ Tb[name], tol if pose_tol is None else pose_tol)
-            if differs:
-                diffs.append(f"link '{name}': pose differs at configuration {q}: {differs}")
-                return diffs
+            diffs.append(f"link '{name}': pose differs at configuration {q}: {differs}")
+            return diffs
     return diffs
+
+
+def first_pose_difference(ra: np.ndarray, Ta: dict, rb: np.ndarray, Tb: dict, names: list[str],
+                          tol: float) -> str | None:
+    """The first of ``names`` whose frame ``ra @ Ta[name]`` differs from ``rb @ Tb[name]`` as
+    :func:`pose_difference` tells (None: every one agrees); all links at once, in numpy."""
+    if not names:
+        return None
+    A = np.stack([ra @ Ta[n] for n in names])
+    B = np.stack([rb @ Tb[n] for n in names])
+    size = np.maximum(1.0, np.abs(A[:, :3, 3]).max(axis=1))
+    position = (np.abs(A[:, :3, 3] - B[:, :3, 3]) <= (tol * np.maximum(size, 1e-300))[:, None]).all(axis=1)
+    orientation = (np.abs(A[:, :3, :3] - B[:, :3, :3]) <= tol * max(1.0, 1e-300)).all(axis=(1, 2))
+    bad = np.flatnonzero(~(position & orientation))
+    return names[int(bad[0])] if len(bad) else None

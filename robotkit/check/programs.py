@@ -49,9 +49,34 @@ with open(sys.argv[2], "w") as results:
 """
 
 
+SPAWN = threading.Lock()
+"""Held while a program is started (its fork and exec: :func:`popen`) and while the check forks a
+worker process.  A process forked while another thread starts a program keeps the pipe through
+which ``subprocess`` learns that the program's exec succeeded, and the start then waits until
+that worker process exits: a check that never ends (seen when libsdformat's helper was started
+beside the forks)."""
+
+
+def _fresh_spawn_lock() -> None:  # a worker forked under the lock starts with it free
+    global SPAWN
+    SPAWN = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_fresh_spawn_lock)
+
+
+def popen(cmd: list[str], **options) -> subprocess.Popen:
+    """``subprocess.Popen(cmd, **options)``, started under :data:`SPAWN`."""
+    with SPAWN:
+        return subprocess.Popen(cmd, **options)
+
+
 def capture(cmd: tuple[str, ...]) -> subprocess.CompletedProcess:
     """The command's exit status, stdout and stderr (text)."""
-    return subprocess.run(list(cmd), capture_output=True, text=True)
+    proc = popen(list(cmd), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    out, err = proc.communicate()
+    return subprocess.CompletedProcess(list(cmd), proc.returncode, out, err)
 
 
 def run(cmd: list[str]) -> subprocess.CompletedProcess:
@@ -79,7 +104,7 @@ def _in_one_process(keys: list[tuple[str, ...]], library: str) -> dict[tuple[str
         for k, key in enumerate(keys):
             argv += [FUNCTIONS[key[2]], os.path.abspath(key[3]), os.path.join(tmp, f"{k}.out"),
                      os.path.join(tmp, f"{k}.err")]
-        subprocess.run(argv, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        popen(argv, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).wait()
         try:
             with open(os.path.join(tmp, "rc"), encoding="utf-8") as f:
                 codes = [int(line) for line in f.read().split()]
@@ -106,15 +131,23 @@ def _batch(keys: list[tuple[str, ...]], futures: dict[tuple[str, ...], Future], 
 
 
 @contextlib.contextmanager
-def started(cmds: list[list[str]]):
-    """Within the block, each of ``cmds`` (``ign sdf -k|-p FILE``) runs once, started now."""
+def started(cmds: list[list[str]], known: dict[tuple[str, ...], subprocess.CompletedProcess] | None = None):
+    """Within the block, each of ``cmds`` (``ign sdf -k|-p FILE``) runs once, started now; the
+    ones in ``known`` are not run: their results are those (an earlier run's, cached)."""
     keys = [k for k in dict.fromkeys(tuple(c) for c in cmds)]
-    library = ctypes.util.find_library(LIBRARY)
+    known = {k: v for k, v in (known or {}).items() if k in keys}
+    with _lock:
+        given = [k for k in known if k not in _started]
+        for k in given:
+            _started[k] = Future()
+            _started[k].set_result(known[k])
+    keys = [k for k in keys if k not in known]
+    library = ctypes.util.find_library(LIBRARY) if keys else None
     batch = library is not None and all(len(k) == 4 and k[:2] == ("ign", "sdf") and k[2] in FUNCTIONS for k in keys)
     pool = ThreadPoolExecutor(max_workers=1 if batch else max(1, len(keys)), thread_name_prefix="robotkit-program")
     with _lock:
         mine = [k for k in keys if k not in _started]
-        if batch:
+        if batch and mine:
             futures = {k: Future() for k in mine}
             _started.update(futures)
             pool.submit(_batch, mine, futures, library)
@@ -124,6 +157,6 @@ def started(cmds: list[list[str]]):
         yield
     finally:
         with _lock:
-            for key in mine:
+            for key in mine + given:
                 _started.pop(key, None)
         pool.shutdown(wait=True)

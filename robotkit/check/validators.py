@@ -26,10 +26,12 @@ def _limit_output():  # in the child: writing past MAX_OUTPUT to its output file
 def _run(cmd: list[str]) -> tuple[int, str]:
     """Run a validator with bounded output and time: (exit status, its output without noise)."""
     with tempfile.TemporaryFile() as f:
+        proc = programs.popen(cmd, stdout=f, stderr=subprocess.STDOUT, preexec_fn=_limit_output)
         try:
-            proc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, timeout=TIMEOUT, preexec_fn=_limit_output)
-            rc = proc.returncode
+            rc = proc.wait(timeout=TIMEOUT)
         except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
             rc = -1
         f.seek(0)
         text = f.read(MAX_OUTPUT).decode("utf-8", "replace")

@@ -170,10 +170,11 @@ def test_check_of_a_600_deep_chain_skips_what_needs_the_mjcf(deep600):
     assert {s["stage"]: s.get("why") for s in out["stages"] if s["verdict"] == "skipped"} == {
         "mujoco": REAL, "simulation": REAL, "self-collision": REAL, "motion": REAL}
     assert [verdicts[s] for s in ("check_urdf", "ign sdf -k", "lints", "equivalence")] == ["ok"] * 4
-    refused = {f["message"].split(" refuses the robot: ")[0] for f in out["findings"]}
-    assert all(f["check"] == "consumer" and " refuses the robot: " in f["message"] for f in out["findings"])
-    assert refused <= {"PyBullet (URDF)", "Pinocchio (URDF)"} and "MuJoCo" not in proc.stdout.replace(REAL, "")
-    assert proc.returncode == (1 if out["findings"] else 0), proc.stderr
+    limited = {f["message"].split(": not checked, a limit of the program: ")[0] for f in out["findings"]}
+    assert all(f["check"] == "consumer" and f["severity"] == "warning" and ": not checked, a limit of the program: "
+               in f["message"] for f in out["findings"])
+    assert limited <= {"PyBullet (URDF)", "Pinocchio (URDF)"} and "MuJoCo" not in proc.stdout.replace(REAL, "")
+    assert proc.returncode == 0, proc.stderr  # the programs' own limits are warnings, not the robot's errors
 
 
 @pytest.mark.slow

@@ -52,6 +52,12 @@ class Unreadable(Refused):
     description, so a warning (robotkit's builds write every collision mesh as OBJ)."""
 
 
+class Limit(Refused):
+    """The program cannot hold the robot for a limit of its own (PyBullet's links in one body, the
+    memory Pinocchio's data needs): the program's loss, not a defect of the robot, so a warning
+    (as the build states a format's own limit), never an error of the robot."""
+
+
 class Missing(Exception):
     """The program is not installed (the message says how to install it)."""
 
@@ -208,6 +214,11 @@ def consumer_findings(build: Build, consumers=None, configs: int = 20) -> tuple[
             # a plain install has MuJoCo but not Drake, Pinocchio, PyBullet: say what was skipped
             findings.append(Finding("warning", "consumer", subject, f"{consumer}: not checked: {exc}"))
             summary[consumer] = {"loaded": None, "reason": str(exc)}
+            continue
+        except Limit as exc:
+            findings.append(Finding("warning", "consumer", subject, f"{consumer}: not checked, a limit of the "
+                                    f"program: {exc}", "a limit of the program, not a defect of the robot"))
+            summary[consumer] = {"loaded": False, "reason": str(exc), "limit": True}
             continue
         except Unreadable as exc:
             findings.append(Finding("warning", "consumer", subject, f"{consumer} refuses the robot: {exc}",

@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from robotkit.check.consumers import Missing, Refused, View
+from robotkit.check.consumers import Limit, Missing, Refused, View
 
 # pin.Data holds per-joint matrices as wide as the model: measured with pin 4.1 on serial chains,
 # 66 MB at 99 DoF, 505 MB at 199, 1683 MB at 299, 3965 MB at 399 (~65 bytes x DoF^3)
@@ -35,7 +35,7 @@ def from_urdf(build) -> View:
         raise Refused(" ".join(str(exc).split())[:400]) from None
     need = DATA_BYTES_PER_DOF3 * model.nv ** 3
     if need > _available_memory() / 2:
-        raise Refused(f"Pinocchio's model data for {model.nv} degrees of freedom needs about {need / 1e9:.3g} GB "
+        raise Limit(f"Pinocchio's model data for {model.nv} degrees of freedom needs about {need / 1e9:.3g} GB "
                       "(it grows with the cube of the count), more than half of this machine's free memory")
     data = model.createData()
     bodies = [(i, f) for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY]

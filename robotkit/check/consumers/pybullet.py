@@ -8,7 +8,7 @@ import numpy as np
 
 from robotkit import urdfxml
 from robotkit.ioutil import quiet
-from robotkit.check.consumers import Missing, Refused, View, listed, with_mesh_paths
+from robotkit.check.consumers import Limit, Missing, Refused, View, listed, with_mesh_paths
 
 
 MAX_LINKS = 128
@@ -57,7 +57,7 @@ def from_urdf(build) -> View:
         p.getBasePositionAndOrientation(body, physicsClientId=client)
     except p.error:  # measured with 3.2.7: a body of 128 links works, one of 129 does not
         p.disconnect(client)
-        raise Refused(f"loadURDF made a body of {n + 1} links that PyBullet cannot place "
+        raise Limit(f"loadURDF made a body of {n + 1} links that PyBullet cannot place "
                       f"(one PyBullet body holds at most {MAX_LINKS} links)") from None
     base = p.getBodyInfo(body, physicsClientId=client)[0].decode()
     info = [p.getJointInfo(body, i, physicsClientId=client) for i in range(n)]

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from robotkit import mj
+from robotkit.check import programs
 from robotkit.check.findings import Finding
 from robotkit.check.motion.law import Drive, Step
 from robotkit.check.motion.metrics import metrics
@@ -72,10 +73,11 @@ def drives_from_mjcf(path: Path) -> tuple[list[Drive], dict[str, dict[str, float
     return plan.drives, plan.poses, plan.integrator, plan.timestep
 
 
-def read_plan(path: Path, urdf: Path | None = None, package_dirs: dict | None = None) -> Plan:
+def read_plan(path: Path, urdf: Path | None = None, package_dirs: dict | None = None, model=None) -> Plan:
+    """The plan of the stage on the MJCF ``path`` (``model``: it compiled already, if it is)."""
     mujoco = mj.load()
 
-    model = mujoco.MjModel.from_xml_path(str(path))
+    model = mujoco.MjModel.from_xml_path(str(path)) if model is None else model
     kinds = {int(mujoco.mjtJoint.mjJNT_HINGE): "hinge", int(mujoco.mjtJoint.mjJNT_SLIDE): "slide"}
     drives, kind_of, not_checked = [], {}, []
     for a in range(model.nu):
@@ -335,20 +337,33 @@ class MotionRun:
     work; :meth:`finish` waits for them and gives (findings, results)."""
 
     def __init__(self, mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path],
-                 simulators: tuple[str, ...] = SIMULATORS):
+                 simulators: tuple[str, ...] = SIMULATORS, cached=None, model=None):
+        """``cached``: a :class:`robotkit.check.cache.StageCache` of the build folder the files are
+        in (each simulator's runs taken from it when there, stored in it when computed);
+        ``model``: the MJCF compiled already, if it is."""
         import multiprocessing
 
         self.t0 = time.perf_counter()
-        self.plan = read_plan(Path(mjcf), urdf, package_dirs)
+        self.plan = read_plan(Path(mjcf), urdf, package_dirs, model)
         self.simulators = [s for s in simulators if s == "mujoco" or urdf is not None]
         self.skipped = [s for s in simulators if s not in self.simulators]
         self.futures: dict[str, Future] = {}
+        self.cached, self.pool, self.missed = cached, None, {}
         if not self.plan.steps:
-            self.pool = None
             return
-        context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
-        self.pool = ProcessPoolExecutor(max_workers=len(self.simulators), mp_context=context)
-        self.futures = {s: self.pool.submit(run_simulator, s, self.plan) for s in self.simulators}
+        hits = {s: cached.get(f"{STAGE} {s}") if cached else None for s in self.simulators}
+        for s, hit in hits.items():
+            if hit is not None:
+                self.futures[s] = Future()
+                self.futures[s].set_result(hit)
+        missed = [s for s in self.simulators if hits[s] is None]
+        if missed:
+            context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+            self.pool = ProcessPoolExecutor(max_workers=len(missed), mp_context=context)
+            with programs.SPAWN:  # forked while no program is being started (robotkit.check.programs.SPAWN)
+                self.missed = {s: self.pool.submit(run_simulator, s, self.plan) for s in missed}
+            self.futures.update(self.missed)
+            self.futures = {s: self.futures[s] for s in self.simulators}  # in the simulators' order
 
     def finish(self) -> tuple[list[Finding], dict]:
         runs = {}
@@ -357,6 +372,9 @@ class MotionRun:
                 runs[s] = future.result()
             except Exception as exc:  # the worker itself failed (a crash in the program)
                 runs[s] = {"runs": [], "hold": {}, "error": f"{type(exc).__name__}: {exc}"}
+            else:
+                if self.cached and s in self.missed and not runs[s].get("error"):
+                    self.cached.put(f"{STAGE} {s}", runs[s])  # computed and whole: kept for the same files
         if self.pool is not None:
             self.pool.shutdown()
         results = assemble(self.plan, runs, self.skipped)
@@ -372,9 +390,12 @@ def motion_stage(mjcf: Path, urdf: Path | None, package_dirs: dict[str, Path],
 
 def has_actuators(mjcf: Path) -> bool:
     """Whether the MJCF declares an actuator (the stage runs only then)."""
-    mujoco = mj.load()
+    return compiled(mjcf).nu > 0
 
-    return mujoco.MjModel.from_xml_path(str(mjcf)).nu > 0
+
+def compiled(mjcf: Path):
+    """The MJCF compiled by MuJoCo (its MjModel)."""
+    return mj.load().MjModel.from_xml_path(str(mjcf))
 
 
 def assemble(plan: Plan, runs: dict[str, dict], skipped: list[str]) -> dict:
