@@ -87,7 +87,8 @@ def reclassify(summary: dict, out: Path) -> dict:
     report = out / summary["robot"] / "check.json"
     if report.is_file():
         errors = [f for f in json.loads(report.read_text(encoding="utf-8"))["findings"] if f["severity"] == "error"]
-        summary["own"] = [o for o in summary["own"] if not o.startswith("check: ")]
+        stage = ("check: traceback", "check: timed out", "check: exit")  # the check process's own, kept
+        summary["own"] = [o for o in summary["own"] if not o.startswith("check: ") or o.startswith(stage)]
         summary["own"] += [f"check: {f['check']}: {f['subject']}: {f['message']}" for f in errors if own_finding(f)]
         log = out / summary["robot"] / "import.log"
         said = log.read_text(encoding="utf-8") if log.is_file() else ""
