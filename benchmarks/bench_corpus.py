@@ -24,7 +24,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from tests.corpus.corpus import own_finding, robots, run  # noqa: E402
+from tests.corpus.corpus import own_finding, reported, robots, run  # noqa: E402
 
 
 def figures(results: list[dict]) -> list[str]:
@@ -50,6 +50,10 @@ def figures(results: list[dict]) -> list[str]:
                 owners[rule] = "robotkit"
     lines += [f"| {rule} | {owners.get(rule, 'original')} | {a} | {b} |"
               for rule, (a, b) in sorted(rules.items(), key=lambda kv: (-kv[1][0], kv[0]))]
+    unreported = {r["robot"]: r["unreported"] for r in results if r.get("unreported")}
+    if unreported:
+        lines += ["", "Errors of the original's that the import did not report: "
+                  + "; ".join(f"{robot}: {', '.join(found)}" for robot, found in sorted(unreported.items()))]
     refusals: dict[tuple[str, str], list[str]] = {}
     for r in results:
         if r["reached"].startswith("refused"):
@@ -78,13 +82,31 @@ def cause(lines: list[str]) -> str:
 
 
 def reclassify(summary: dict, out: Path) -> dict:
-    """``summary`` with its check errors classified by today's own_finding (from OUT/<robot>/check.json)."""
+    """``summary`` with its check errors classified by today's own_finding (from OUT/<robot>/check.json),
+    and ``unreported``: the original's errors no line of the import's output names (import.log)."""
     report = out / summary["robot"] / "check.json"
     if report.is_file():
         errors = [f for f in json.loads(report.read_text(encoding="utf-8"))["findings"] if f["severity"] == "error"]
-        summary["own"] = [o for o in summary["own"] if not o.startswith("check: ")]
+        stage = ("check: traceback", "check: timed out", "check: exit")  # the check process's own, kept
+        summary["own"] = [o for o in summary["own"] if not o.startswith("check: ") or o.startswith(stage)]
         summary["own"] += [f"check: {f['check']}: {f['subject']}: {f['message']}" for f in errors if own_finding(f)]
+        log = out / summary["robot"] / "import.log"
+        said = log.read_text(encoding="utf-8") if log.is_file() else ""
+        summary["unreported"] = [f"{f['check']} {f['subject']}" for f in errors
+                                 if not own_finding(f) and not reported(f, said)]
     return summary
+
+
+def read_results(outs: list[Path]) -> list[dict]:
+    """Each robot's last result in OUT/results.jsonl of ``outs``, a later folder's over an earlier's."""
+    last = {}
+    for out in outs:
+        for line in open(out / "results.jsonl", encoding="utf-8"):
+            summary = reclassify(json.loads(line), out)
+            if summary["reached"].startswith("refused") and not summary["refusal"]:  # before refusal() said why
+                summary["refusal"] = [o for o in summary["own"] if "timed out" in o]
+            last[summary["robot"]] = summary
+    return list(last.values())
 
 
 def main() -> None:
@@ -96,17 +118,15 @@ def main() -> None:
     parser.add_argument("--resume", action="store_true", help="skip the robots OUT/results.jsonl already holds")
     parser.add_argument("--figures", action="store_true",
                         help="only print the figures of OUT/results.jsonl (each robot's last result)")
+    parser.add_argument("--earlier", nargs="*", type=Path, default=[],
+                        help="with --figures: earlier runs' folders, for the robots OUT has not rerun")
     a = parser.parse_args()
     out = a.out or Path(tempfile.mkdtemp(prefix="corpus-"))
     out.mkdir(parents=True, exist_ok=True)
     if a.figures:
-        last = {}
-        for line in open(out / "results.jsonl", encoding="utf-8"):
-            summary = reclassify(json.loads(line), out)
-            if summary["reached"].startswith("refused") and not summary["refusal"]:  # before refusal() said why
-                summary["refusal"] = [o for o in summary["own"] if "timed out" in o]
-            last[summary["robot"]] = summary
-        print("\n".join(figures(list(last.values()))))
+        results = read_results([*a.earlier, out])
+        print(f"{len(results)} robots\n")
+        print("\n".join(figures(results)))
         return
     corpus = robots()
     names = [n for n in a.only if n in corpus] if a.only is not None else list(corpus)

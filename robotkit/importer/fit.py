@@ -124,6 +124,17 @@ def _too_heavy(mass: float, volume: float | None) -> str | None:
             f"above {DENSITY_RANGE[1]:g} ({cause})")
 
 
+def _check_volume(link) -> float | None:
+    """The volume check judges a link's density on: its visual geometry's when closed, else its
+    collision geometry's when closed (ANYmal B's base: a placeholder 1e-6 kg on an open mesh and
+    closed boxes), else None."""
+    for geoms in (link.visuals, link.collisions):
+        closed = _closed(list(geoms)) if geoms else None
+        if closed:
+            return closed[0]
+    return None
+
+
 def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
     """(link -> (policy, why) for the tensors, given or repaired, that do not fit and the masses no
     solid part of that volume has, when ``recompute``; link -> why for those kept otherwise), judged
@@ -134,22 +145,25 @@ def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str
     overrides, kept = {}, {}
     for link in robot.links:
         given = explicit.get(link.name)
-        found = link_fit(link) if given is not None else None
-        if found is None:
-            continue
-        fit, volume = found
-        heavy = _too_heavy(given["mass"], volume)
+        spec = link.inertial_spec
+        if given is None or not (spec.mode == "explicit" or (spec.mode in ("mass", "estimate") and spec.mass == given["mass"])):
+            continue  # no given mass, or one the recipe no longer keeps (computed at its density)
+        found = link_fit(link)  # None when the link's inertial is no longer explicit (repaired, estimated)
+        volume = found[1] if found else None
+        judged = volume or _check_volume(link)
+        heavy = _too_heavy(given["mass"], judged)
         if heavy:  # a placeholder mass on a marker, or a part drawn smaller than it is: no one reading
             kept[link.name] = f"{heavy}: kept (check reports it)"
-        light = _too_light(given["mass"], volume)
-        if light and recompute and MESHLAB in light:  # the one obvious reading: MeshLab's volume as the mass
+        light = _too_light(given["mass"], judged)
+        if light and recompute and volume and MESHLAB in light:  # the one obvious reading: MeshLab's volume as the mass
             overrides[link.name] = ("density", light)
             continue
         if light:  # else the geometry may be what is wrong (simple_humanoid's 4 m^3 body of 27 kg)
             kept[link.name] = (f"{light}; compute it from the geometry at the recipe's density (no inertial "
                                "on the link in the recipe)" if MESHLAB in light else f"{light}: kept (check reports it)")
-        if fit.severity != "error":
+        if found is None or found[0].severity != "error":
             continue
+        fit = found[0]
         t = given["inertia"]
         tensor = np.array([[t["ixx"], t["ixy"], t["ixz"]], [t["ixy"], t["iyy"], t["iyz"]],
                            [t["ixz"], t["iyz"], t["izz"]]])

@@ -143,7 +143,7 @@ def give_moving_links_mass(links: dict[str, dict], joints: dict[str, dict], out)
     _moving_without_mass(tree, refused)
     _massless_roots(tree, refused)
     _massless_inside(tree, refused)
-    _give_mass(links, refused, out)
+    _give_mass(links, refused, out, tree)
 
 
 class _Tree:
@@ -228,7 +228,40 @@ def _massless_inside(tree: _Tree, refused: dict[str, str]) -> None:
                                      "conversion drops it and everything below it, even welded to a link with mass")
 
 
-def _give_mass(links: dict[str, dict], refused: dict[str, str], out) -> None:
+GIMBAL_SHARE = 1e-2
+"""A link between two moving joints with neither mass nor geometry (one of the frames a ball joint
+is split into: the 36-DoF human's ``left_upperarm_virtual``) gets this share of the least principal
+moment of the links it carries: near the hinges' gimbal lock, the joint-space inertia of the
+hinges above and below it is that link's own, and the smallest a repair leaves (6e-11 kg m^2 on
+the human) lets MuJoCo's simulation explode (5.8e3 rad/s after 2 s; stable from about 1e-7)."""
+
+
+def _least_moment_below(tree: _Tree, name: str, explicit: dict) -> float | None:
+    """The least principal moment of the given tensors of the links below ``name`` (None: none)."""
+    least, todo, seen = None, [j["child"] for j in tree.children.get(name, [])], {name}
+    while todo:
+        n = todo.pop()
+        if n in seen:
+            continue
+        seen.add(n)
+        todo += [j["child"] for j in tree.children.get(n, [])]
+        if n in explicit and explicit[n]["mass"] > 0:
+            moment = float(np.linalg.eigvalsh(_tensor(explicit[n]["inertia"])).min())
+            least = moment if moment > 0 and (least is None or moment < least) else least
+    return least
+
+
+def _gimbal_moment(tree: _Tree, name: str, explicit: dict) -> float | None:
+    """GIMBAL_SHARE of the least moment below ``name`` when a moving joint moves it and another
+    moves below it, else None."""
+    above = tree.parent_joint.get(name)
+    if above is None or above["type"] not in MOVING or not any(j["type"] in MOVING for j in tree.children.get(name, [])):
+        return None
+    least = _least_moment_below(tree, name, explicit)
+    return float(f"{GIMBAL_SHARE * least:.3g}") if least is not None else None
+
+
+def _give_mass(links: dict[str, dict], refused: dict[str, str], out, tree: _Tree) -> None:
     """Each refused link's mass: from its geometry at the recipe's density, else a point mass."""
     given = [g["mass"] for g in out.explicit.values() if g["mass"] > 0]
     point = 1e-3 * min(given) if given else 1e-3
@@ -246,9 +279,13 @@ def _give_mass(links: dict[str, dict], refused: dict[str, str], out) -> None:
             out.repairs[name] = f"{why}; computed from its collision geometry at the recipe's density"
         else:
             floor = inertia_policy.moment_floor(point)
-            link["inertial"] = {"mass": point, "inertia": {"ixx": floor, "iyy": floor, "izz": floor}}
-            out.repairs[name] = (f"{why}; it has no geometry: a point mass of {fmt(point)} kg ({why_point}) "
-                                 "with the smallest inertia a repair leaves")
+            gimbal = _gimbal_moment(tree, name, out.explicit)
+            moment = max(floor, gimbal or 0.0)
+            link["inertial"] = {"mass": point, "inertia": {"ixx": moment, "iyy": moment, "izz": moment}}
+            inertia = ("with the smallest inertia a repair leaves" if moment == floor else
+                       f"with moments of {moment:.3g} kg m^2, a hundredth of the least of the links it carries "
+                       "(the joints above and below it are a gimbal, which a smaller inertia leaves ill-conditioned)")
+            out.repairs[name] = f"{why}; it has no geometry: a point mass of {fmt(point)} kg ({why_point}) {inertia}"
 
 
 def _tensor(t: dict):

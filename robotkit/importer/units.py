@@ -13,7 +13,7 @@ import os
 from dataclasses import dataclass, replace
 
 from robotkit.errors import MeshError
-from robotkit.importer.meshes import MeshUse
+from robotkit.importer.meshes import MeshUse, mesh_is_closed
 from robotkit.mesh.inertia import mesh_mass_properties
 from robotkit.mesh.io import load_mesh, volume_mesh
 from robotkit.model.plausible import DENSITY_RANGE, PART_SIZE_RANGE
@@ -40,6 +40,8 @@ def mesh_extent(source: str) -> float:
 
 def mesh_volume(source: str) -> float | None:
     """The volume of a mesh file at scale 1, None when it is not closed."""
+    if not mesh_is_closed(source, (1.0, 1.0, 1.0)):
+        return None
     m = load_mesh(source, (1.0, 1.0, 1.0))
     try:
         vol = volume_mesh(m, "error", os.path.basename(source))[0]

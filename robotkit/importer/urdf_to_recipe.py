@@ -42,7 +42,7 @@ from robotkit.importer.parsing import (Problems, fmt_list, shown, local_name, or
                                        read_origin)
 from robotkit.importer.recipe_writer import fmt
 from robotkit.geometry import rpy_matrix
-from robotkit.recipe.schema import JOINT_TYPES, MAX_LENGTH, MIN_MASS, UNITS
+from robotkit.recipe.schema import JOINT_TYPES, MAX_LENGTH, MAX_VALUE, MIN_MASS, UNITS
 
 GREY = [0.5, 0.5, 0.5, 1.0]
 CONTACT_KEYS = ("mu1", "mu2", "kp", "kd")
@@ -949,7 +949,8 @@ def _map_gazebo_materials(gazebo_links, link_visual_materials, materials, remove
 def _map_contacts(gazebo_links, link_has_collision, links, remove):
     """Move mu1, mu2, kp, kd of ``<gazebo reference="L">`` into L's ``contact`` when the
     emitter writes exactly those values back (it writes them only for links with collisions,
-    and mu2 = mu1 when mu2 is not given)."""
+    and mu2 = mu1 when mu2 is not given) and the recipe takes them (at most MAX_VALUE: TIAGo
+    Pro's kp of 1e13 stays in its block, carried through verbatim)."""
     for link, blocks in gazebo_links.items():
         if not link_has_collision.get(link):
             continue
@@ -968,7 +969,7 @@ def _map_contacts(gazebo_links, link_has_collision, links, remove):
                 v = float(text) if text is not None else None
             except ValueError:
                 v = None
-            if v is None or not math.isfinite(v) or v < 0 or (key == "kp" and v == 0):
+            if v is None or not math.isfinite(v) or v < 0 or v > MAX_VALUE or (key == "kp" and v == 0):
                 ok = False
                 break
             values[key] = v + 0.0

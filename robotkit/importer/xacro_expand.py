@@ -205,6 +205,7 @@ class _State:
     unsafe: tuple[str, str] | None = None  # (expression, reason)
     blocked: str | None = None  # a read or an environment variable the sandbox refused
     location: tuple[str, int] | None = None  # (file, line) of the element being expanded
+    repairs: list[str] = field(default_factory=list)  # warnings: what the expansion read otherwise than xacro 2
 
 
 class _Blocked(Exception):
@@ -238,6 +239,34 @@ def _parse_with_lines(source, file: str):
     if isinstance(source, str):
         return builder.parseString(source)
     return builder.parseFile(source)
+
+
+LEGACY_TAGS = ("arg", "property", "include", "if", "unless", "insert_block", "macro")
+"""The tags ROS 1 xacro (before Noetic) read without the ``xacro:`` prefix, with a deprecation
+warning and a sed command that adds it; xacro 2 passes them through as URDF, so such a property is
+never defined (KUKA KR210's ``<property name="deg" .../>``)."""
+
+
+def prefix_legacy_tags(doc, file: str) -> list[str]:
+    """Give the ``xacro:`` prefix to LEGACY_TAGS without one, in place, in a file that declares
+    the xacro namespace (one obvious reading: ROS 1 xacro's); one warning per tag name, with the
+    line of its first use and how many."""
+    root = doc.documentElement
+    uri = root.getAttribute("xmlns:xacro") if root is not None else ""
+    if not uri:
+        return []
+    found: dict[str, list[int]] = {}
+    for node in list(root.getElementsByTagName("*")):
+        if node.prefix is None and node.tagName in LEGACY_TAGS:
+            loc = node.getUserData(_LOC)
+            found.setdefault(node.tagName, []).append(loc[1] if loc else 0)
+            doc.renameNode(node, uri, "xacro:" + node.tagName)
+    out = []
+    for tag, lines in found.items():
+        times = f" ({len(lines)} tags)" if len(lines) > 1 else ""
+        out.append(f"{_show(file)}:{lines[0]}: xacro: <{tag}> without the xacro: prefix{times} read as "
+                   f"<xacro:{tag}>, as ROS 1 xacro read it (xacro 2 leaves it unexpanded)")
+    return out
 
 
 def _node_location(node) -> tuple[str, int] | None:
@@ -296,8 +325,9 @@ def expand(path: str | os.PathLike, package_paths: dict[str, str], args: dict[st
         with contextlib.redirect_stderr(stderr):
             doc = sandbox.process()
         includes = sorted({os.path.abspath(f) for f in xacro.all_includes})
-    warnings = [f"{_show(path)}: xacro: {line.strip()}" for line in stderr.getvalue().splitlines()
-                if line.strip() and not line.startswith(" ") and "when processing file" not in line]
+    warnings = sandbox.state.repairs + [
+        f"{_show(path)}: xacro: {line.strip()}" for line in stderr.getvalue().splitlines()
+        if line.strip() and not line.startswith(" ") and "when processing file" not in line]
     return Expanded(_document_text(doc), includes, warnings)
 
 
@@ -369,7 +399,9 @@ class _Sandbox:
                 xacro.filestack.pop()
                 raise xacro.XacroException(f"{e.strerror}: {e.filename}", exc=e) from None
             with f:
-                return _parse_with_lines(f, full)
+                doc = _parse_with_lines(f, full)
+            self.state.repairs += prefix_legacy_tags(doc, full)
+            return doc
         if isinstance(inp, str):
             return _parse_with_lines(inp, xacro.filestack[-1] if xacro.filestack else str(self.path))
         return self.original_parse(inp, filename)

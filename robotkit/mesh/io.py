@@ -75,11 +75,38 @@ def _dae_in_metres(path: str):
     import trimesh
 
     scene = trimesh.load(path, force="scene", process=False)
+    if not scene.geometry:
+        scene = _dae_unbound(path) or scene
     units = getattr(scene, "units", None)
     if units and units not in ("meters", "m", "meter"):
         scene = scene.convert_units("meters", guess=False)
     geometry = scene.to_geometry() if hasattr(scene, "to_geometry") else scene.dump(concatenate=True)
     return geometry
+
+
+def _dae_unbound(path: str):
+    """A COLLADA file read without its ``<bind_material>`` elements (None when it does not parse):
+    pycollada drops a whole node whose binding names a material the file lacks (ANYmal B's
+    anymal_foot.dae, a Blender export whose texture's effect is broken, read as no triangles),
+    where Assimp (RViz, Gazebo) draws its geometry with a default material."""
+    import io
+
+    import trimesh
+
+    from robotkit.urdfxml import MalformedXML, parse_file
+
+    try:
+        tree = parse_file(path)
+    except (MalformedXML, OSError):
+        return None
+    bindings = list(tree.getroot().iter("{*}bind_material"))
+    if not bindings:
+        return None
+    for element in bindings:
+        element.getparent().remove(element)
+    from lxml import etree  # loaded already by parse_file
+
+    return trimesh.load(io.BytesIO(etree.tostring(tree)), file_type="dae", force="scene", process=False)
 
 
 def companions(path: str) -> list[str]:

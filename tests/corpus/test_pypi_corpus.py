@@ -41,6 +41,7 @@ SAMPLE = {  # robot: the shape it stands for
     "qut_panda_arm_hand": "xacro arm and hand: mimic finger, fixed flange and hand",
     "allegro_right_hand": "hand: many small links, inertias that do not fit",
     "solo12": "quadruped, floating base",
+    "kuka_kr210l150": "industrial arm (xacro 1): unprefixed <property> and <macro> tags, read as ROS 1 xacro did",
 }
 
 # what main does today that the issue asks otherwise, one line per (test, robot); each goes when
