@@ -241,9 +241,10 @@ def check_build_dir(robot_dir: Path, declared_mass: float | None = None, motion:
             collisions = None if lost else _cached_or(cached, "self-collision", collider, _interference,
                                                       robot_dir, subject)  # forked with MuJoCo imported
             return _rest(build, clock, declared_mass, own, started, collisions, motion, consumers_started, cached)
-        finally:
-            workers.shutdown(wait=False, cancel_futures=True)
-            collider.shutdown(wait=False, cancel_futures=True)
+        finally:  # waited for: a pool left behind (wait=False) can raise at the interpreter's exit, after
+            # the report is written (OSError: Bad file descriptor, seen on interbotix_px150's check)
+            workers.shutdown(wait=True, cancel_futures=True)
+            collider.shutdown(wait=True, cancel_futures=True)
 
 
 @contextlib.contextmanager
