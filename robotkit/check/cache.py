@@ -25,6 +25,7 @@ from pathlib import Path
 
 from robotkit.check.findings import Finding
 from robotkit.emit.layout import PICTURES
+from robotkit.mesh.cache import code_digest
 
 LIBRARIES = ("mujoco", "pybullet", "drake", "pin", "numpy", "scipy")
 """The libraries whose versions a cached stage's result depends on (``pin`` is Pinocchio)."""
@@ -35,16 +36,6 @@ OP = "check-stage/1"
 
 def enabled() -> bool:
     return os.environ.get("ROBOTKIT_CHECK_CACHE", "1") != "0"
-
-
-@functools.lru_cache(maxsize=None)
-def code_digest() -> str:
-    """sha256 of robotkit's own files: a result cached by another robotkit is never reused."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts):
-        h.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
-    return h.hexdigest()
 
 
 @functools.lru_cache(maxsize=None)

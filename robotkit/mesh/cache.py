@@ -111,6 +111,17 @@ def mesh_digest(mesh) -> str:
     return h.hexdigest()
 
 
+@functools.lru_cache(maxsize=None)
+def code_digest() -> str:
+    """sha256 of robotkit's own files (code, presets, templates shipped in the package): a result
+    cached by an earlier robotkit (a build task's, a check stage's) is never reused by another."""
+    root = Path(robotkit.__file__).resolve().parent
+    h = hashlib.sha256()
+    for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts):
+        h.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
 def canonical_json(value) -> str:
     """Deterministic JSON: sorted keys, no spaces, numpy values and tuples as plain JSON, no NaN."""
     return json.dumps(plain(value), sort_keys=True, separators=(",", ":"), allow_nan=False)

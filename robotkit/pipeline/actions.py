@@ -25,7 +25,7 @@ from robotkit.emit.registry import FORMATS
 from robotkit.emit.layout import robot_layout
 from robotkit.errors import ConsumerError, Problem, RendererUnavailable, RobotkitError, display_path
 from robotkit.ioutil import write_if_changed
-from robotkit.mesh.cache import Cache, Files, canonical_json, library_versions, plain
+from robotkit.mesh.cache import Cache, Files, canonical_json, code_digest, library_versions, plain
 from robotkit.mesh.export import obj_bytes, stl_bytes
 from robotkit.mesh.inertia import hull_points, mesh_mass_properties
 from robotkit.mesh.io import load_mesh, read_vertices, volume_mesh
@@ -401,17 +401,6 @@ def pictures_drawn(record: str) -> bool:
 
 
 # --- task results cached by content -----------------------------------------------------------
-
-@functools.lru_cache(maxsize=None)
-def code_digest() -> str:
-    """sha256 of robotkit's own files (code, presets, templates shipped in the package): a result
-    cached by an earlier robotkit is never reused by another."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts):
-        h.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
-    return h.hexdigest()
-
 
 def _keyed(value, out: str):
     """``value`` as plain JSON for a cache key: paths below the output folder ``out`` relative to
