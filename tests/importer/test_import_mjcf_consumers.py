@@ -81,3 +81,35 @@ def test_gazebo_keeps_the_massless_link_of_a_joint_chain(tmp_path):
     findings, summary = consumer_findings(robot, ["Gazebo (URDF)"])
     assert [f.message for f in findings] == []
     assert summary["Gazebo (URDF)"]["mass"] == pytest.approx(0.2, rel=1e-3)
+
+
+# an effort drive beside a position drive (Menagerie's TIAGo with motor actuators on its arm)
+TWO_DRIVES = """<?xml version="1.0"?>
+<robot name="two">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>
+  </inertial></link>
+  <link name="a"><inertial><mass value="1"/><inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/>
+  </inertial></link>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/>
+  </inertial></link>
+  <joint name="a" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="100" velocity="10"/></joint>
+  <joint name="b" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0 0 0.2"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="100" velocity="10"/></joint>
+</robot>
+"""
+
+
+@pytest.mark.consumers
+def test_drake_steps_a_position_drive_beside_an_effort_drive(tmp_path):
+    """Drake's desired-state port holds every actuator of the model (2 x 2 here), the effort
+    drive's entries ignored: the motion stage gave it the controlled ones only and Drake refused
+    ("expected ... size=4 ... but the actual type was ... size=2")."""
+    from robotkit.check.motion import SIMULATORS, Drive, Step, metrics
+
+    urdf = tmp_path / "two.urdf"
+    urdf.write_text(TWO_DRIVES)
+    drives = [Drive("a", "effort", 0.0, 0.0), Drive("b", "position", kp=2.0, kd=0.4, effort=100.0)]
+    trace = SIMULATORS["drake"](urdf, drives, Step("b", {}, 0.5), package_dirs={})
+    assert trace.diverged is None
+    assert metrics(trace, 0.0, 0.5, "position", effort=100.0)["final_error"] < 1e-2
