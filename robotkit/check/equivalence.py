@@ -7,6 +7,7 @@ from pathlib import Path
 from robotkit.check import kinematics as k
 from robotkit.check.findings import EQUIVALENCE_CONFIGS
 from robotkit.emit.layout import robot_layout
+from robotkit.emit.sdf import names_apart
 
 
 def equivalence(robot_dir: str | Path, tol: float = 1e-9, configs: int = EQUIVALENCE_CONFIGS,
@@ -17,7 +18,7 @@ def equivalence(robot_dir: str | Path, tol: float = 1e-9, configs: int = EQUIVAL
     ``notes`` is kept for comparisons that cannot be made (none today)."""
     layout = robot_layout(robot_dir)
     u = k.read_urdf(layout.urdf)
-    s = k.read_sdf(layout.sdf)
+    s = _urdf_names(k.read_sdf(layout.sdf), u)
     g = k.read_urdf_via_libsdformat(layout.urdf)
     result = {}
     if "mjcf" not in layout.left_out():
@@ -29,3 +30,13 @@ def equivalence(robot_dir: str | Path, tol: float = 1e-9, configs: int = EQUIVAL
     result["URDF (libsdformat) vs URDF lumped as Gazebo does"] = k.compare(
         k.lump(u, u.kept), g, tol, configs, ignore=("mimic",), pose_tol=max(tol, k.LIBSDFORMAT_PRECISION))
     return result
+
+
+def _urdf_names(sdf: k.KModel, urdf: k.KModel) -> k.KModel:
+    """``sdf`` with each joint under its URDF name: model.sdf renames a joint named like a link
+    (robotkit.emit.sdf.joint_names), which is the same joint."""
+    back = {new: old for old, new in names_apart(list(urdf.links), list(urdf.joints)).items()}
+    for joint in sdf.joints.values():
+        joint.name = back.get(joint.name, joint.name)
+    sdf.joints = {back.get(name, name): joint for name, joint in sdf.joints.items()}
+    return sdf

@@ -18,12 +18,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import RECIPES
+from conftest import ASSETS, RECIPES
 from validators import require
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 EXAMPLES = ["turret_bot", "lidar_mast", "rover", "turtlebot3_burger", "ur5"]
+# a Menagerie model imported from MJCF (robotkit import), built into the same workspace
+IMPORTED = {"so_arm100": ASSETS / "menagerie" / "trs_so_arm100" / "so_arm100.xml"}
+ROBOTS = EXAMPLES + list(IMPORTED)
 PROBE = Path(__file__).resolve().parents[1] / "ros1_probe.py"
 # Debian's ROS 1 (docs/libraries.md, section 10): these three, and /usr/bin before any pyenv python3
 ROS_ENV = {"ROS_VERSION": "1", "ROS_DISTRO": "Debian", "ROS_PYTHON_VERSION": "3"}
@@ -44,13 +47,33 @@ def _sourced(ws: Path, command: str, *argv: str) -> subprocess.CompletedProcess:
 
 
 @pytest.fixture(scope="session")
-def ros1_packages(tmp_path_factory) -> Path:
+def recipes(tmp_path_factory) -> dict[str, Path]:
+    """Each robot's recipe: the examples', and the imported models' (written by robotkit import)."""
+    from robotkit.importer import import_mjcf
+
+    out = {name: RECIPES / f"{name}.yaml" for name in EXAMPLES}
+    folder = tmp_path_factory.mktemp("ros1-imported")
+    for name, mjcf in IMPORTED.items():
+        if not mjcf.is_file():
+            pytest.fail(f"test assets not found at {mjcf} (CI clones the repository next to shared/)")
+        recipe = folder / f"{name}.yaml"
+        import_mjcf(mjcf, recipe)
+        # an MJCF names no maintainer, which catkin requires (the build warns): given as a user would
+        with recipe.open("a", encoding="utf-8") as f:
+            f.write("metadata:\n  license: Apache-2.0\n"
+                    "  maintainers: [{name: robotkit tests, email: robotkit-tests@example.com}]\n")
+        out[name] = recipe
+    return out
+
+
+@pytest.fixture(scope="session")
+def ros1_packages(recipes, tmp_path_factory) -> Path:
     from robotkit.pipeline.runner import build
 
     out = tmp_path_factory.mktemp("ros1-build")
     # one process: a doit worker forked from the test process, which holds other libraries'
     # threads (Drake, rendering), could deadlock; the session's mesh cache makes this quick
-    build([RECIPES / f"{name}.yaml" for name in EXAMPLES], out, ros="ros1")
+    build([recipes[name] for name in ROBOTS], out, ros="ros1")
     return out
 
 
@@ -59,7 +82,7 @@ def catkin_ws(ros1_packages, tmp_path_factory) -> Path:
     for tool in ("catkin_make", "roslaunch", "rviz", "Xvfb"):
         require(tool)
     ws = tmp_path_factory.mktemp("catkin_ws")
-    for name in EXAMPLES:
+    for name in ROBOTS:
         shutil.copytree(ros1_packages / name, ws / "src" / name)
     proc = subprocess.run(["catkin_make", "-C", str(ws), "install"], cwd=ws, capture_output=True, text=True, env=_env())
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
@@ -188,7 +211,7 @@ def run(catkin_ws, display, tmp_path_factory):
 
 
 def test_install_space_holds_the_packages(catkin_ws):
-    for name in EXAMPLES:
+    for name in ROBOTS:
         share = catkin_ws / "install" / "share" / name
         for rel in ("package.xml", f"urdf/{name}.urdf", "model.sdf", "model.config", f"mjcf/{name}.xml",
                     "launch/display.launch", "launch/gazebo.launch", f"rviz/{name}.rviz", "meshes"):
@@ -203,8 +226,8 @@ def test_install_space_holds_the_packages(catkin_ws):
     assert model_path.split(":").count(str(catkin_ws / "install" / "share")) == 1
 
 
-@pytest.mark.parametrize("name", EXAMPLES)
-def test_display_launch(run, name):
+@pytest.mark.parametrize("name", ROBOTS)
+def test_display_launch(run, recipes, name):
     from robotkit.emit.ros import link_poses
     from robotkit.model.resolve import resolve
     from robotkit.recipe.load import load_recipe
@@ -219,7 +242,7 @@ def test_display_launch(run, name):
     # robot_state_publisher's transforms are robotkit's kinematics, at the published joint values
     from scipy.spatial.transform import Rotation
 
-    robot = resolve(load_recipe(RECIPES / f"{name}.yaml"), "ros1")
+    robot = resolve(load_recipe(recipes[name]), "ros1")
     # joint_state_publisher starts at the recipe's home pose (its private ~zeros), the other joints at 0
     home = dict(robot.home().values) if robot.home() is not None else {}
     for joint in movable:

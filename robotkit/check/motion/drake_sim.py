@@ -155,14 +155,16 @@ def log_every(builder, port, period: float):
 
 
 def fix_desired(plant, model, context, drives: list[Drive], step: Step) -> None:
-    """The PD controllers' desired state: the step's targets."""
-    controlled = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(model)
-                  if plant.get_joint_actuator(i).has_controller()]
-    desired = np.zeros(2 * len(controlled))
-    for k, a in enumerate(controlled):
-        d = next(d for d in drives if d.joint == a.joint().name())
-        desired[k], desired[len(controlled) + k] = targets(d, step)
-    if controlled:
+    """The PD controllers' desired state: the step's targets.  The port has a position and a
+    velocity for every actuator of the model, controlled or not (Drake ignores the others':
+    effort drives beside position drives, Menagerie's TIAGo with motor actuators)."""
+    every = [plant.get_joint_actuator(i) for i in plant.GetJointActuatorIndices(model)]
+    desired = np.zeros(2 * len(every))
+    for k, a in enumerate(every):
+        if a.has_controller():
+            d = next(d for d in drives if d.joint == a.joint().name())
+            desired[k], desired[len(every) + k] = targets(d, step)
+    if any(a.has_controller() for a in every):
         plant.get_desired_state_input_port(model).FixValue(context, desired)
 
 
