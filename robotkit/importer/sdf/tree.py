@@ -22,6 +22,11 @@ from robotkit.importer.mjcf.tree import CHAIN_MASS, UNLIMITED_SLIDE, WORLD
 HUGE = 1e10
 """A revolute joint's limit beyond this (SDF's default is ±1e16) means none: continuous."""
 CHAINS = {"ball": 3, "universal": 2, "revolute2": 2}
+CHAIN_FLOOR = 1e-5
+"""The least mass (kg) of a joint chain's massless link: libsdformat's URDF reader drops a link of
+1e-6 kg or less with everything below it (gz::math::equal's tolerance; sdformat #199), so Gazebo,
+reading the rebuilt URDF, would lose the joint's child (the MJCF import's millionth of the lightest
+body is below it on any model lighter than 1 kg)."""
 
 
 @dataclass
@@ -69,7 +74,7 @@ def build_tree(src, m, ledger) -> Tree:
             ledger.add(src.where("link", name), f"link '{name}'", "all", f"a second free body: joined to "
                        f"'{roots[0]}' by a floating joint (the recipe is one tree)")
     for name, j in parent_of.items():
-        _joint(src, tree, j, lightest * CHAIN_MASS, ledger)
+        _joint(src, tree, j, max(lightest * CHAIN_MASS, CHAIN_FLOOR), ledger)
     return tree
 
 
