@@ -258,6 +258,8 @@ def test_joint_to_world_roots_the_recipe_in_world(tmp_path):
     assert result.verdict.ok and result.verdict.configurations == 11, result.verdict.lines()
     assert "base" not in recipe or recipe.get("base") != "free"
     assert recipe["joints"]["fix"] == {"type": "fixed", "parent": "world", "child": "base", "origin": {"xyz": [0, 0, 1]}}
-    # SDF's defaults where the inertial gives no tensor: unit moments; no effort or velocity limit: 0
+    # SDF's defaults where the inertial gives no tensor: unit moments; no effort or velocity limit
+    # (-1, unlimited): a stated 1e9, not 0 (a passive joint, which Gazebo cannot drive), said above it
     assert recipe["links"]["arm"]["inertial"] == {"mass": 2, "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}
-    assert _joints(recipe)["j"]["limit"] == {"lower": 0, "upper": 0.5, "effort": 0, "velocity": 0}
+    assert _joints(recipe)["j"]["limit"] == {"lower": 0, "upper": 0.5, "effort": 1e9, "velocity": 1e9}
+    assert "  # no effort or velocity limit in the SDF (unlimited): 1e+09\n  j:" in result.recipe_path.read_text()

@@ -21,7 +21,16 @@ from robotkit.importer.mjcf.tree import CHAIN_MASS, UNLIMITED_SLIDE, WORLD
 
 HUGE = 1e10
 """A revolute joint's limit beyond this (SDF's default is ±1e16) means none: continuous."""
+UNLIMITED = 1e9
+"""An effort or velocity limit the SDF leaves unlimited (none given, SDF's default -1, or beyond
+:data:`HUGE`): a stated value no motor reaches.  The recipe has no unlimited form, and 0 would be
+a passive joint: robotkit's rules read it so, and Gazebo clamps a commanded force to 0."""
 CHAINS = {"ball": 3, "universal": 2, "revolute2": 2}
+CHAIN_FLOOR = 1e-5
+"""The least mass (kg) of a joint chain's massless link: libsdformat's URDF reader drops a link of
+1e-6 kg or less with everything below it (gz::math::equal's tolerance; sdformat #199), so Gazebo,
+reading the rebuilt URDF, would lose the joint's child (the MJCF import's millionth of the lightest
+body is below it on any model lighter than 1 kg)."""
 
 
 @dataclass
@@ -69,7 +78,7 @@ def build_tree(src, m, ledger) -> Tree:
             ledger.add(src.where("link", name), f"link '{name}'", "all", f"a second free body: joined to "
                        f"'{roots[0]}' by a floating joint (the recipe is one tree)")
     for name, j in parent_of.items():
-        _joint(src, tree, j, lightest * CHAIN_MASS, ledger)
+        _joint(src, tree, j, max(lightest * CHAIN_MASS, CHAIN_FLOOR), ledger)
     return tree
 
 
@@ -144,7 +153,7 @@ def _joint(src, tree: Tree, j, chain_mass: float, ledger) -> None:
             tree.links[child] = {"inertial": {"mass": chain_mass, "inertia": {"ixx": i, "iyy": i, "izz": i}}}
             tree.frame[child] = j.T
         out = _fixed(tree, parent, child)
-        out.update(_motion(src, tree, j, axis, k, ledger))
+        out.update(_motion(src, tree, j, axis, k, ledger, name))
         tree.joints[name] = out
         parent = child
     tree.joint_map[j.name] = names
@@ -156,7 +165,7 @@ def _locked(j) -> bool:
     return j.type in ("revolute", "prismatic") and lo is not None and hi is not None and float(lo) == float(hi)
 
 
-def _motion(src, tree: Tree, j, axis, k: int, ledger) -> dict:
+def _motion(src, tree: Tree, j, axis, k: int, ledger, name: str) -> dict:
     """type, axis, limit, dynamics of one revolute/prismatic stage of SDF joint ``j``."""
     el = j.el.find("axis2" if k == 1 and j.type in ("universal", "revolute2") else "axis")
     lim = el.find("limit") if el is not None else None
@@ -178,10 +187,15 @@ def _motion(src, tree: Tree, j, axis, k: int, ledger) -> dict:
         ledger.add(src.where("joint", j.name), f"joint '{j.name}' (prismatic)", "all", f"unlimited: written with "
                    f"limits -{UNLIMITED_SLIDE:g} to {UNLIMITED_SLIDE:g} m (a prismatic joint has limits)")
     limit = {"lower": lo, "upper": hi} if out["type"] != "continuous" else {}
-    effort, velocity = num(lim, "effort"), num(lim, "velocity")
-    # SDF's -1 (no limit) has no recipe form: 0, as the MJCF import writes a limit MuJoCo lacks
-    limit["effort"] = effort if effort is not None and 0 <= effort < HUGE else 0.0
-    limit["velocity"] = velocity if velocity is not None and 0 <= velocity < HUGE else 0.0
+    unbounded = []
+    for key in ("effort", "velocity"):
+        value = num(lim, key)
+        limit[key] = value if value is not None and 0 <= value < HUGE else UNLIMITED
+        if limit[key] == UNLIMITED:
+            unbounded.append(key)
+    if unbounded:
+        said = f"no {' or '.join(unbounded)} limit in the SDF (unlimited): {UNLIMITED:g}"
+        tree.notes[name] = f"{tree.notes[name]}; {said}" if name in tree.notes else said
     out["limit"] = limit
     dyn = el.find("dynamics") if el is not None else None
     values = {"damping": num(dyn, "damping") or 0.0, "friction": num(dyn, "friction") or 0.0}
