@@ -69,6 +69,11 @@ def test_joint_types_urdf_lacks_are_approximated_or_dropped(tmp_path):
     assert "joint 'ball_demo' (ball): all: approximated: three revolute joints" in text
     assert "joint 'universal_demo' (universal): all: approximated: two revolute joints" in text
     assert "(screw): all: approximated: a revolute joint" in text
+    scripts = [line for line in result.ledger if "material script <uri>" in line]  # one line, not one per visual
+    assert len(scripts) == 1 and scripts[0].split(": ", 1)[1].startswith(
+        "material script <uri> model://demo_joint_types/materials/scripts, model://demo_joint_types/materials/"
+        "textures: all: dropped from 18 visuals (heavy_base_visual, revolute_base_visual, ")
+    assert len(result.ledger) <= 20
 
 
 def test_file_libsdformat_refuses_is_read_from_its_xml(tmp_path):

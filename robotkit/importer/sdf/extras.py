@@ -10,7 +10,7 @@ import copy
 import numpy as np
 
 from robotkit.importer.sdf.frames import pose_of
-from robotkit.importer.sdf.leftovers import joint_leftovers, shape_leftovers
+from robotkit.importer.sdf.leftovers import joint_leftovers, script_uris, shape_leftovers
 from robotkit.importer.sdf.model import children
 from robotkit.importer.sdf.tree import origin_of
 from robotkit.urdfxml import is_element
@@ -31,6 +31,7 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
                        f"({sensor.get('type')}) of link '{name}'", "MJCF",
                        "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
         _other(src, link.el, name, ledger, surfaces.get(name, []))
+    _scripts(src, m, ledger)
     for plugin in m.plugins:
         extras.append(_block(plugin, None, None))
         ledger.add(src.where("plugin", plugin.get("name")), f"plugin '{plugin.get('name')}' "
@@ -89,6 +90,20 @@ def _other(src, el, name: str, ledger, dropped: list) -> None:
     if dropped:
         ledger.add(src.where("link", name), f"link '{name}'", "all",
                    f"dropped (no place in the recipe): {', '.join(dropped)}")
+
+
+def _scripts(src, m, ledger) -> None:
+    """One line per set of material script <uri>s the recipe drops (the visuals' own scripts, not
+    Gazebo's standard materials), naming the visuals that use it."""
+    users: dict[tuple[str, ...], list[tuple[str, str]]] = {}
+    for name, link in m.links.items():
+        for visual, uris in script_uris(link.el):
+            users.setdefault(uris, []).append((name, visual))
+    for uris, where in users.items():
+        link, visual = where[0]
+        ledger.add(src.where("visual", visual, link), f"material script <uri> {', '.join(uris)}", "all",
+                   f"dropped from {len(where)} visual{'s' if len(where) > 1 else ''} "
+                   f"({', '.join(v for _, v in where)}): only Gazebo's standard materials are read")
 
 
 def _frames(src, m, tree, ledger) -> None:

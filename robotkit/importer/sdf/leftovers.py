@@ -42,12 +42,20 @@ def shape_leftovers(link_el) -> list[str]:
             continue
         out += [f"visual '{v.get('name')}' material <{c.tag}>" for c in mat if isinstance(c.tag, str)
                 and c.tag not in MATERIAL_KEPT and not same(c.text, MATERIAL.get(c.tag, ""))]
-        uris = [(u.text or "").strip() for u in mat.findall("script/uri")]
-        if any(u not in (STANDARD_SCRIPTS, "__default__") for u in uris):  # __default__: libsdformat's, for none
-            out.append(f"visual '{v.get('name')}' material script <uri> (Gazebo's standard materials are read)")
     for c in children(link_el, "collision"):
         out += [f"collision '{c.get('name')}' <{x.tag}>" for x in c if isinstance(x.tag, str)
                 and x.tag not in COLLISION_KEPT]
+    return out
+
+
+def script_uris(link_el) -> list[tuple[str, tuple[str, ...]]]:
+    """(visual name, its material script's <uri>s) of each visual of the link whose script is not
+    Gazebo's standard materials (which the import reads: robotkit.importer.sdf.shapes)."""
+    out = []
+    for v in children(link_el, "visual"):
+        uris = tuple((u.text or "").strip() for u in v.findall("material/script/uri"))
+        if any(u not in (STANDARD_SCRIPTS, "__default__") for u in uris):  # __default__: libsdformat's, for none
+            out.append((v.get("name"), uris))
     return out
 
 
