@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from robotkit.importer.inertials import POINT_MASS_FLOOR
 from robotkit.importer.mjcf.frames import clean, origin
 from robotkit.importer.mjcf.tree import CHAIN_MASS, UNLIMITED_SLIDE, WORLD
 
@@ -26,7 +27,7 @@ UNLIMITED = 1e9
 :data:`HUGE`): a stated value no motor reaches.  The recipe has no unlimited form, and 0 would be
 a passive joint: robotkit's rules read it so, and Gazebo clamps a commanded force to 0."""
 CHAINS = {"ball": 3, "universal": 2, "revolute2": 2}
-CHAIN_FLOOR = 1e-5
+CHAIN_FLOOR = POINT_MASS_FLOOR
 """The least mass (kg) of a joint chain's massless link: libsdformat's URDF reader drops a link of
 1e-6 kg or less with everything below it (gz::math::equal's tolerance; sdformat #199), so Gazebo,
 reading the rebuilt URDF, would lose the joint's child (the MJCF import's millionth of the lightest
