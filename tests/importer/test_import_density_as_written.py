@@ -8,7 +8,6 @@ when check errors, with the same numbers."""
 
 from __future__ import annotations
 
-import numpy as np
 import trimesh
 
 from robotkit.check.lints import lint_link, read_urdf_facts
