@@ -20,7 +20,7 @@ from robotkit.check.findings import Finding
 from robotkit.check.kinematics import NEGLIGIBLE
 from robotkit.errors import Problem, RobotkitError
 from robotkit.geometry import rpy_matrix
-from robotkit.mesh.inertia import mesh_mass_properties
+from robotkit.mesh.inertia import closed_and_wound, density_volume, solid_as_written  # noqa: F401 (tests read closed_and_wound here)
 from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
 from robotkit.model.inertia_policy import equivalent_box
@@ -190,10 +190,7 @@ def mesh_facts(path: Path, scale: np.ndarray):
         except (RobotkitError, ValueError, OSError):
             return None, None, 0
         V, F = np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
-    props = mesh_mass_properties(V, F) if closed_and_wound(F) else None
-    if props is not None and not (props.volume > 0 and np.isfinite(props.com).all()):
-        props = None  # trimesh's is_volume: watertight, consistently wound, finite centre, positive volume
-    return V, props, len(F)
+    return V, solid_as_written(V, F), len(F)
 
 
 PLAIN_MESH_BYTES = 64 * 2**20
@@ -269,22 +266,6 @@ def _plain_obj(data: bytes):
     if any(len(line.split()) != 3 for line in f) or any(len(line.split()) != 3 for line in v) or not len(F):
         return None, None
     return V, F
-
-
-def closed_and_wound(F: np.ndarray) -> bool:
-    """trimesh's is_watertight and is_winding_consistent: every edge (sorted pair of vertices) in
-    exactly two faces, and there in opposite directions."""
-    E = np.asarray(F, dtype=np.int64)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    if not len(E):
-        return False
-    lo, hi = E.min(axis=1), E.max(axis=1)
-    order = np.lexsort((hi, lo))
-    lo, hi, E = lo[order], hi[order], E[order]
-    if len(E) % 2 or not ((lo[0::2] == lo[1::2]) & (hi[0::2] == hi[1::2])).all():
-        return False
-    if len(E) > 2 and ((lo[2::2] == lo[1:-1:2]) & (hi[2::2] == hi[1:-1:2])).any():
-        return False  # an edge in four faces or more
-    return bool((E[0::2, 1] == E[1::2, 0]).all())
 
 
 def read_urdf_facts(path: Path, package_paths: dict[str, str] | None = None,
@@ -470,8 +451,9 @@ def _volume(geoms: list[GeomFacts]) -> float | None:
 
 
 def link_volume(link: LinkFacts) -> float | None:
-    """The volume of the link's closed geometry (visual, else collision), None when open or unknown."""
-    return _volume(link.shape("visual")) or _volume(link.shape("collision"))
+    """The volume of the link's closed geometry (visual, else collision), None when open or unknown
+    (robotkit.mesh.inertia.density_volume: the rule the import's density warning follows too)."""
+    return density_volume([g.volume for g in link.shape("visual")], [g.volume for g in link.shape("collision")])
 
 
 def _geometry_points(link: LinkFacts) -> np.ndarray | None:

@@ -16,6 +16,7 @@ import numpy as np
 from robotkit.importer.inertials import geometry_facts
 from robotkit.importer.meshes import mesh_is_closed
 from robotkit.importer.recipe_writer import fmt
+from robotkit.mesh.inertia import density_volume, solid_as_written
 from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
 from robotkit.model import massprops
@@ -124,15 +125,36 @@ def _too_heavy(mass: float, volume: float | None) -> str | None:
             f"above {DENSITY_RANGE[1]:g} ({cause})")
 
 
+_WRITTEN: dict[tuple, tuple[float | None, float]] = {}
+
+
+def _as_written(geom) -> tuple[float | None, float]:
+    """(volume when closed as written, else None; largest side) of a geometry, as check reads the
+    built file (robotkit.mesh.inertia.solid_as_written: no repair); a primitive's volume always."""
+    s = geom.shape
+    if s.kind != "mesh":
+        return geom_mass_props(geom, {})[0], float(np.ptp(_points(geom), axis=0).max())
+    st = os.stat(s.mesh.source)
+    key = (s.mesh.source, tuple(s.mesh.scale), st.st_mtime_ns, st.st_size)
+    if key not in _WRITTEN:
+        mesh = load_mesh(s.mesh.source, s.mesh.scale)
+        V, F = np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
+        props = solid_as_written(V, F)
+        _WRITTEN[key] = (props.volume if props else None, float(np.ptp(V, axis=0).max()) if len(V) else 0.0)
+    return _WRITTEN[key]
+
+
 def _check_volume(link) -> float | None:
-    """The volume check judges a link's density on: its visual geometry's when closed, else its
-    collision geometry's when closed (ANYmal B's base: a placeholder 1e-6 kg on an open mesh and
-    closed boxes), else None."""
+    """The volume check judges a link's density on (robotkit.mesh.inertia.density_volume, check's
+    rule): its visual geometry's when closed as written, else its collision geometry's when so
+    (ANYmal B's base: a placeholder 1e-6 kg on an open mesh and closed boxes; G1's ankle roll links:
+    a visual mesh that robotkit's repair would close, open as written), else None.  A role whose
+    geometry is no larger than a marker shows no part."""
+    shown = []
     for geoms in (link.visuals, link.collisions):
-        closed = _closed(list(geoms)) if geoms else None
-        if closed:
-            return closed[0]
-    return None
+        parts = [_as_written(g) for g in geoms]
+        shown.append([v for v, _ in parts] if parts and max(size for _, size in parts) > MARKER else [])
+    return density_volume(*shown)
 
 
 def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
@@ -150,7 +172,7 @@ def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str
             continue  # no given mass, or one the recipe no longer keeps (computed at its density)
         found = link_fit(link)  # None when the link's inertial is no longer explicit (repaired, estimated)
         volume = found[1] if found else None
-        judged = volume or _check_volume(link)
+        judged = _check_volume(link)  # check's volume, which may differ from the repaired geometry's
         heavy = _too_heavy(given["mass"], judged)
         if heavy:  # a placeholder mass on a marker, or a part drawn smaller than it is: no one reading
             kept[link.name] = f"{heavy}: kept (check reports it)"

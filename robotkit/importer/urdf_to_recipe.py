@@ -117,7 +117,7 @@ def urdf_to_recipe(text: str, source: str | os.PathLike, recipe_path: str | os.P
     """
     source = Path(source).absolute()
     recipe_dir = Path(recipe_path).absolute().parent
-    root = _robot_element(text, source)
+    root = _robot_element(text, source, lines)
     children = [el for el in root if is_element(el)]
     r = _Reading(Problems(str(source)), [], MeshResolver(source, recipe_dir, dict(package_paths or {}), copy_meshes),
                  Converted(recipe={}), recompute_inertials, density, inertia_policy, lines, dict(overrides or {}))
@@ -168,8 +168,9 @@ def _note_renamed(renamed: dict[str, tuple[str, str]], r: _Reading) -> None:
             r.warnings.append(f"link '{new}': {note}")
 
 
-def _robot_element(text: str, source: Path):
-    """The <robot> element of the URDF ``text`` (comments kept: verbatim elements keep theirs)."""
+def _robot_element(text: str, source: Path, lines: bool = False):
+    """The <robot> element of the URDF ``text`` (comments kept: verbatim elements keep theirs);
+    ``lines``: whether its lines are ``source``'s."""
     try:
         root = urdfxml.parse_text(text, comments=True).getroot()
     except urdfxml.MalformedXML as exc:  # in the words of expat, which read it before lxml
@@ -178,6 +179,9 @@ def _robot_element(text: str, source: Path):
     if local_name(root.tag) != "robot":
         raise RobotkitError(Problem(f"the root element is <{local_name(root.tag)}>, not <robot>: not a URDF",
                                     file=str(source)))
+    if not any(local_name(el.tag) == "link" for el in root if isinstance(el.tag, str)):
+        raise RobotkitError(Problem("<robot> defines no <link>: nothing to import", file=str(source),
+                                    line=root.sourceline if lines else None))  # example-robot-data's ur3.urdf: an empty xacro output
     return root
 
 

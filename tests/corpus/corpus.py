@@ -176,7 +176,7 @@ def own_finding(finding: dict) -> bool:
     return finding["check"] in OWN_CHECKS or "stage could not run" in finding["message"]
 
 
-TOPIC = {"inertia-box": "inerti", "inertia": "inerti", "implied-density": "densit", "total-mass": "mass"}
+TOPIC = {"inertia-box": "inerti", "inertia": "inerti", "implied-density": "densit|implies", "total-mass": "mass"}
 
 
 def reported(finding: dict, said: str) -> bool:
@@ -185,7 +185,8 @@ def reported(finding: dict, said: str) -> bool:
     name = finding["subject"].split(" ", 1)[-1]
     rule = finding["check"]
     topic = finding["message"].split()[0] if rule == "joint-limits" else TOPIC.get(rule, rule.split("-")[0])
-    return any(name in line and topic.lower() in line.lower() for line in said.splitlines())
+    topics = topic.lower().split("|")  # implied-density: "implies" in the import's "mass ... implies D kg/m^3"
+    return any(name in line and any(t in line.lower() for t in topics) for line in said.splitlines())
 
 
 def _count(items) -> dict[str, int]:
