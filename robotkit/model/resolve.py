@@ -570,6 +570,8 @@ def _check_explicit(inertial: Inertial, marks, path) -> list[Problem]:
 
 def _check_tree(link_names: list[str], joints: list[Joint], marks) -> list[Problem]:
     problems: list[Problem] = []
+    if not link_names:
+        return [marks.problem(("links",), "no link: a robot needs at least one")]
     known = set(link_names)
     parent_of: dict[str, str] = {}
     for j in joints:

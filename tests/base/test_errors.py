@@ -175,6 +175,13 @@ CASES = {
         """,
         ["robot.yaml:5: joints.j2: joints 'j2', 'j3' form a cycle"],
     ),
+    "no_link": (
+        """
+        robot: arm
+        links: {}
+        """,
+        ["robot.yaml:2: links: no link: a robot needs at least one"],
+    ),
     "two_roots": (
         """
         robot: arm
