@@ -202,7 +202,7 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     assert "#   features.xml:53: tendon 'fingers': all: dropped: the recipe has no tendons" in text
     assert yaml.safe_load(text)["robot"] == "features"
     assert ("  # MJCF ref 0.02: the origin takes the body back to the joint's zero, so joint values (limits,\n"
-            "  # poses) are MuJoCo's\n  extend:\n") in text
+            "  # poses) are MuJoCo's; driven, with no velocity limit in the MJCF (unlimited): 1e+09\n  extend:\n") in text
     assert "  # one of the three revolute joints ball joint 'wrist_ball' becomes (x, y, z of its body)\n" in text
 
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robotkit.importer.mjcf.tree import UNLIMITED
+
 TRN_JOINT = 0
 AFFINE = 1
 
@@ -49,7 +51,7 @@ def add_actuators(src, tree, recipe: dict, ledger) -> None:
         _limits(src, a, joint, interface, efforts, speeds, where, name, ledger)
     if out:
         recipe["actuators"] = out
-    _fill_limits(src, tree, efforts, speeds)
+    _fill_limits(src, tree, efforts, speeds, set(out))
 
 
 def _refusal(m, a: int, tree, out: dict) -> str | None:
@@ -95,9 +97,10 @@ def _limits(src, a: int, joint: str, interface: str, efforts, speeds, where, nam
                        + (f"[{rng[0]:g}, {rng[1]:g}]" if rng else "(none: a continuous joint)"))
 
 
-def _fill_limits(src, tree, efforts: dict, speeds: dict) -> None:
-    """Every joint's effort (force limits, else the joint's ``actuatorfrcrange``, else 0) and
-    velocity (a velocity servo's range, else 0: MuJoCo has no velocity limit)."""
+def _fill_limits(src, tree, efforts: dict, speeds: dict, driven: set) -> None:
+    """Every joint's effort (force limits, else the joint's ``actuatorfrcrange``) and velocity (a
+    velocity servo's range: MuJoCo has no velocity limit); a limit the MJCF does not give is 0 on
+    a joint nothing drives (passive), :data:`UNLIMITED` on a driven one (stated above the joint)."""
     m = src.model
     for j, recipe_names in tree.joint_map.items():
         for name in recipe_names:
@@ -108,5 +111,9 @@ def _fill_limits(src, tree, efforts: dict, speeds: dict) -> None:
             if effort is None and m.jnt_actfrclimited[j]:
                 effort = float(max(abs(v) for v in m.jnt_actfrcrange[j]))
             limit = joint.setdefault("limit", {})
-            limit["effort"] = effort or 0.0
-            limit["velocity"] = speeds.get(name, 0.0)
+            free = UNLIMITED if name in driven else 0.0
+            limit["effort"], limit["velocity"] = effort or free, speeds.get(name) or free
+            unbounded = [k for k in ("effort", "velocity") if name in driven and limit[k] == UNLIMITED]
+            if unbounded:
+                said = f"driven, with no {' or '.join(unbounded)} limit in the MJCF (unlimited): {UNLIMITED:g}"
+                tree.notes[name] = f"{tree.notes[name]}; {said}" if name in tree.notes else said

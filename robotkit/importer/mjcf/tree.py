@@ -22,6 +22,10 @@ from robotkit.model.inertia_policy import MIN_MOMENT
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 WORLD = "world"
 UNLIMITED_SLIDE = 1e3
+UNLIMITED = 1e9
+"""An effort or velocity limit the original leaves unlimited on a driven joint: a stated value no
+motor reaches (the recipe has no unlimited form, and 0 is a passive joint: robotkit's rules read
+it so, and Gazebo clamps a commanded force to 0)."""
 CHAIN_MASS = 1e-6
 """The mass of a chain's massless link, as a fraction of the lightest body's (MuJoCo refuses a
 moving body without mass): a point mass, stated in the recipe."""

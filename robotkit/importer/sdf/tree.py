@@ -18,14 +18,10 @@ import numpy as np
 
 from robotkit.importer.inertials import POINT_MASS_FLOOR
 from robotkit.importer.mjcf.frames import clean, origin
-from robotkit.importer.mjcf.tree import CHAIN_MASS, UNLIMITED_SLIDE, WORLD
+from robotkit.importer.mjcf.tree import CHAIN_MASS, UNLIMITED, UNLIMITED_SLIDE, WORLD
 
 HUGE = 1e10
 """A revolute joint's limit beyond this (SDF's default is ±1e16) means none: continuous."""
-UNLIMITED = 1e9
-"""An effort or velocity limit the SDF leaves unlimited (none given, SDF's default -1, or beyond
-:data:`HUGE`): a stated value no motor reaches.  The recipe has no unlimited form, and 0 would be
-a passive joint: robotkit's rules read it so, and Gazebo clamps a commanded force to 0."""
 CHAINS = {"ball": 3, "universal": 2, "revolute2": 2}
 CHAIN_FLOOR = POINT_MASS_FLOOR
 """The least mass (kg) of a joint chain's massless link: libsdformat's URDF reader drops a link of
