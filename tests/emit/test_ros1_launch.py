@@ -58,10 +58,13 @@ def recipes(tmp_path_factory) -> dict[str, Path]:
             pytest.fail(f"test assets not found at {mjcf} (CI clones the repository next to shared/)")
         recipe = folder / f"{name}.yaml"
         import_mjcf(mjcf, recipe)
-        # an MJCF names no maintainer, which catkin requires (the build warns): given as a user would
-        with recipe.open("a", encoding="utf-8") as f:
-            f.write("metadata:\n  license: Apache-2.0\n"
-                    "  maintainers: [{name: robotkit tests, email: robotkit-tests@example.com}]\n")
+        # an MJCF names no maintainer, which catkin requires (the build warns): given as a user would,
+        # in the recipe's metadata (the import's holds the ledger)
+        given = "  license: Apache-2.0\n  maintainers: [{name: robotkit tests, email: robotkit-tests@example.com}]\n"
+        text = recipe.read_text(encoding="utf-8")
+        text = (text.replace("\nmetadata:\n", "\nmetadata:\n" + given, 1) if "\nmetadata:\n" in text
+                else text + "metadata:\n" + given)
+        recipe.write_text(text, encoding="utf-8")
         out[name] = recipe
     return out
 
