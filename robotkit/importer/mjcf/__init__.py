@@ -16,12 +16,11 @@ import json
 import os
 import re
 import tempfile
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from pydantic import ValidationError
-
-from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.errors import display_path
+from robotkit.importer.checked import resolves, validate_recipe
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.actuators import add_actuators
 from robotkit.importer.mjcf.contacts import add_contacts
@@ -32,10 +31,8 @@ from robotkit.importer.mjcf.ledger import Ledger
 from robotkit.importer.mjcf.source import read
 from robotkit.importer.mjcf.tree import build_tree
 from robotkit.importer.mjcf.verify import Verdict, verify
-from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
-from robotkit.model.load import load_robots
+from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
 from robotkit.paths import recipe_policy, widened
-from robotkit.recipe.schema import Recipe
 
 
 @dataclass
@@ -86,13 +83,13 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
     out = Path(out_recipe).absolute()
     recipe, ledger, src, tree = convert(path, out)
     name_mesh_folders(recipe)
-    _validate(recipe, src.path)
+    validate_recipe(recipe, src.path)
     _factor_defaults(recipe)
     comments = {"links": {n: "a massless link of a body's joint chain (MuJoCo moves a body through its joints in "
                           "order): a point mass of a millionth of the lightest body, as MuJoCo needs"
                           for n in tree.chain_links}, "joints": tree.notes}
     header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (MJCF, "
-              "read through MuJoCo: inertials, shapes and poses as MuJoCo compiled them)"] + _ledger_block(ledger)
+              "read through MuJoCo: inertials, shapes and poses as MuJoCo compiled them)"] + ledger.block()
     files = [str(src.mesh_file(d)) for d in range(src.model.nmesh) if src.mesh_file(d) is not None]
     read = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
     root = display_path(os.path.commonpath(read)) if read else None
@@ -104,7 +101,7 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
         body = dump_recipe(recipe, None, comments)  # once: the verdict joins the header after the build
         with widened(read):  # the original's meshes, where they are
             tmp.write_text(_comments(header) + body, encoding="utf-8")
-            _resolves(tmp, src.path)
+            resolves(tmp, src.path)
             verdict = _verified(src, tree, tmp, build)
         if verdict is not None:
             tmp.write_text(_comments(header + verdict.lines()) + body, encoding="utf-8")
@@ -152,31 +149,3 @@ def _factor_defaults(recipe: dict) -> None:
     link_defaults = recipe.get("defaults", {}).get("link", {})
     if "collision" in link_defaults:
         link_defaults["collision"] = back("collision", link_defaults["collision"])
-
-
-def _resolves(recipe: Path, source: Path) -> None:
-    """Load and resolve the written recipe as the build will; problems name the MJCF file."""
-    try:
-        load_robots([recipe])
-    except RobotkitError as exc:
-        raise RobotkitError([replace(p, file=str(source), line=None) if p.file == str(recipe) else p
-                             for p in exc.problems]) from None
-
-
-def _ledger_block(ledger: Ledger) -> list[str]:
-    if not len(ledger):
-        return ["ledger: nothing of the original is lost"]
-    lines = [f"ledger: {len(ledger)} element{'s' if len(ledger) > 1 else ''} of the original not carried unchanged "
-             "(where: element: formats: what happened)"]
-    for line in ledger.lines():
-        lines.extend("  " + part for part in wrap(line, 110))
-    return lines
-
-
-def _validate(recipe: dict, source: Path) -> None:
-    try:
-        Recipe.model_validate(recipe)
-    except ValidationError as exc:
-        problems = [Problem(f"the imported recipe would be invalid: {'.'.join(str(p) for p in err['loc'])}: "
-                            f"{err['msg']}", file=str(source)) for err in exc.errors(include_url=False)]
-        raise RobotkitError(problems) from None

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from robotkit.importer.recipe_writer import wrap
+
 
 @dataclass(frozen=True)
 class Entry:
@@ -29,3 +31,13 @@ class Ledger:
 
     def __len__(self) -> int:
         return len(self.entries)
+
+    def block(self) -> list[str]:
+        """The ledger as the recipe's header says it (one entry per line, wrapped)."""
+        if not self.entries:
+            return ["ledger: nothing of the original is lost"]
+        lines = [f"ledger: {len(self)} element{'s' if len(self) > 1 else ''} of the original not carried "
+                 "unchanged (where: element: formats: what happened)"]
+        for line in self.lines():
+            lines.extend("  " + part for part in wrap(line, 110))
+        return lines

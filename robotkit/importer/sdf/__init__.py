@@ -15,16 +15,15 @@ from __future__ import annotations
 import os
 import re
 import tempfile
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from pydantic import ValidationError
-
 from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.importer.checked import resolves, validate_recipe
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.ledger import Ledger
 from robotkit.importer.names import joints_apart_from_links
-from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders, wrap
+from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
 from robotkit.importer.sdf.contacts import add_contacts
 from robotkit.importer.sdf.extras import add_extras
 from robotkit.importer.sdf.model import read_model
@@ -32,9 +31,7 @@ from robotkit.importer.sdf.shapes import add_shapes
 from robotkit.importer.sdf.source import read
 from robotkit.importer.sdf.tree import build_tree
 from robotkit.importer.sdf.verify import Verdict, verify
-from robotkit.model.load import load_robots
 from robotkit.paths import recipe_policy, widened
-from robotkit.recipe.schema import Recipe
 from robotkit.urdfxml import is_element
 
 
@@ -108,13 +105,13 @@ def import_sdf(path, out_recipe, build=None) -> SdfImport:
     out = Path(out_recipe).absolute()
     recipe, ledger, src, m, tree, repaired, files = convert(path, out)
     name_mesh_folders(recipe)
-    _validate(recipe, src.path)
+    validate_recipe(recipe, src.path)
     _factor_defaults(recipe)
     comments = {"links": {**{n: "a massless link of a joint the recipe writes as a chain (ball, universal)"
                              for n in tree.chain_links}, **tree.link_notes, **repaired}, "joints": tree.notes}
     how = "read through libsdformat" if src.via == "libsdformat" else "read from its XML (libsdformat refuses it)"
     header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (SDF, {how})"]
-    header += _ledger_block(ledger)
+    header += ledger.block()
     read_dirs = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
     root = display_path(os.path.commonpath(read_dirs)) if read_dirs else None
     notes = [f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: build it "
@@ -124,7 +121,7 @@ def import_sdf(path, out_recipe, build=None) -> SdfImport:
     try:
         with widened(read_dirs):
             tmp.write_text(dump_recipe(recipe, header, comments), encoding="utf-8")
-            _resolves(tmp, src.path)
+            resolves(tmp, src.path)
             verdict = _verified(m, tree, set(repaired), tmp, build)
         if verdict is not None:
             tmp.write_text(dump_recipe(recipe, header + verdict.lines(), comments), encoding="utf-8")
@@ -151,31 +148,3 @@ def _verified(m, tree, repaired: set, recipe: Path, build) -> Verdict | None:
         return None
     with tempfile.TemporaryDirectory(prefix="robotkit-import-") as folder:
         return verify(m, tree, repaired, build(recipe, folder))
-
-
-def _resolves(recipe: Path, source: Path) -> None:
-    """Load and resolve the written recipe as the build will; problems name the SDF file."""
-    try:
-        load_robots([recipe])
-    except RobotkitError as exc:
-        raise RobotkitError([replace(p, file=str(source), line=None) if p.file == str(recipe) else p
-                             for p in exc.problems]) from None
-
-
-def _ledger_block(ledger: Ledger) -> list[str]:
-    if not len(ledger):
-        return ["ledger: nothing of the original is lost"]
-    lines = [f"ledger: {len(ledger)} element{'s' if len(ledger) > 1 else ''} of the original not carried unchanged "
-             "(where: element: formats: what happened)"]
-    for line in ledger.lines():
-        lines.extend("  " + part for part in wrap(line, 110))
-    return lines
-
-
-def _validate(recipe: dict, source: Path) -> None:
-    try:
-        Recipe.model_validate(recipe)
-    except ValidationError as exc:
-        problems = [Problem(f"the imported recipe would be invalid: {'.'.join(str(p) for p in err['loc'])}: "
-                            f"{err['msg']}", file=str(source)) for err in exc.errors(include_url=False)]
-        raise RobotkitError(problems) from None
