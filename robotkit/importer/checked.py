@@ -3,7 +3,7 @@ against the schema, then loaded and resolved as the build will; every problem na
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from pydantic import ValidationError
@@ -11,6 +11,20 @@ from pydantic import ValidationError
 from robotkit.errors import Problem, RobotkitError
 from robotkit.model.load import load_robots
 from robotkit.recipe.schema import Recipe
+
+
+@dataclass
+class Imported:
+    """What an MJCF or SDF import wrote and found."""
+    recipe_path: Path
+    robot: str
+    ledger: list[str] = field(default_factory=list)
+    verdict: object | None = None
+    """The rebuild compared with the original (the importer's ``Verdict``), None without a build."""
+    inputs: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    root: str | None = None
+    """The folder outside the project a build of the recipe reads (``--root``), if any."""
 
 
 def validate_recipe(recipe: dict, source: Path) -> None:

@@ -16,11 +16,10 @@ import json
 import os
 import re
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from robotkit.errors import display_path
-from robotkit.importer.checked import resolves, validate_recipe
+from robotkit.importer.checked import Imported, resolves, validate_recipe
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.actuators import add_actuators
 from robotkit.importer.mjcf.contacts import add_contacts
@@ -33,18 +32,6 @@ from robotkit.importer.mjcf.tree import build_tree
 from robotkit.importer.mjcf.verify import Verdict, verify
 from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
 from robotkit.paths import recipe_policy, widened
-
-
-@dataclass
-class MjcfImport:
-    recipe_path: Path
-    robot: str
-    ledger: list[str] = field(default_factory=list)
-    verdict: Verdict | None = None
-    inputs: list[str] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    root: str | None = None
-    """The folder outside the project a build of the recipe reads (``--root``), if any."""
 
 
 def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, object]:
@@ -77,7 +64,7 @@ def _robot_name(src) -> str:
     return name if re.match(r"[A-Za-z_]", name) else "_" + name
 
 
-def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=None) -> MjcfImport:
+def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=None) -> Imported:
     """Import the MJCF file ``path`` into ``out_recipe``; ``build(recipe, folder)`` builds a
     recipe into a folder and returns the rebuilt MJCF's path (the verification's)."""
     out = Path(out_recipe).absolute()
@@ -109,7 +96,7 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
         tmp.unlink(missing_ok=True)
         raise
     os.replace(tmp, out)
-    return MjcfImport(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
+    return Imported(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
 
 
 def _comments(lines: list[str]) -> str:

@@ -15,11 +15,10 @@ from __future__ import annotations
 import os
 import re
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from robotkit.errors import Problem, RobotkitError, display_path
-from robotkit.importer.checked import resolves, validate_recipe
+from robotkit.importer.checked import Imported, resolves, validate_recipe
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.ledger import Ledger
 from robotkit.importer.names import joints_apart_from_links
@@ -33,17 +32,6 @@ from robotkit.importer.sdf.tree import build_tree
 from robotkit.importer.sdf.verify import Verdict, verify
 from robotkit.paths import recipe_policy, widened
 from robotkit.urdfxml import is_element
-
-
-@dataclass
-class SdfImport:
-    recipe_path: Path
-    robot: str
-    ledger: list[str] = field(default_factory=list)
-    verdict: Verdict | None = None
-    inputs: list[str] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    root: str | None = None
 
 
 def convert(path, out: Path):
@@ -99,7 +87,7 @@ def _metadata(config: dict) -> dict:
     return out
 
 
-def import_sdf(path, out_recipe, build=None) -> SdfImport:
+def import_sdf(path, out_recipe, build=None) -> Imported:
     """Import the SDF file or model folder ``path`` into ``out_recipe``; ``build(recipe, folder)``
     builds a recipe into a folder and returns the rebuilt model.sdf's path (the verification's)."""
     out = Path(out_recipe).absolute()
@@ -129,7 +117,7 @@ def import_sdf(path, out_recipe, build=None) -> SdfImport:
         tmp.unlink(missing_ok=True)
         raise
     os.replace(tmp, out)
-    return SdfImport(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
+    return Imported(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
 
 
 def _factor_defaults(recipe: dict) -> None:
