@@ -27,7 +27,6 @@ equalities), named poses (keyframes) and the body tree all come from the compile
 from __future__ import annotations
 
 import json
-import time
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -71,7 +70,6 @@ class Matrix:
 
     samples: int
     seed: int
-    seconds: float
     pairs: tuple[Pair, ...] = ()
     poses: dict = field(default_factory=dict)  # pose -> [[a, b, depth m], ...]: every pair in contact there
 
@@ -82,8 +80,8 @@ class Matrix:
         return {frozenset((p.a, p.b)) for p in self.pairs if p.disabled}
 
     def to_json(self) -> dict:
-        return {"samples": self.samples, "seed": self.seed, "seconds": round(self.seconds, 3),
-                "clearance": CLEARANCE, "always": ALWAYS, "poses": self.poses,
+        return {"samples": self.samples, "seed": self.seed, "clearance": CLEARANCE, "always": ALWAYS,
+                "poses": self.poses,
                 "pairs": [{k: v for k, v in asdict(p).items() if v not in (None, "") or k == "reason"}
                           for p in self.pairs]}
 
@@ -91,7 +89,7 @@ class Matrix:
     def from_json(cls, data: dict) -> "Matrix":
         pairs = tuple(Pair(p["a"], p["b"], p["reason"], p.get("hits", 0), p.get("closest"), p.get("note", ""))
                       for p in data["pairs"])
-        return cls(data["samples"], data["seed"], data["seconds"], pairs, data.get("poses", {}))
+        return cls(data["samples"], data["seed"], pairs, data.get("poses", {}))
 
     def dumps(self) -> str:
         return json.dumps(self.to_json(), sort_keys=True)
@@ -381,7 +379,6 @@ def adjacent_bodies(model, has_geoms: set[int]) -> set[tuple[int, int]]:
 def classify(sampler: Sampler, settings: Settings) -> Matrix:
     """Sample ``settings.samples`` configurations and classify every pair of links with collision
     geometry (module docstring)."""
-    start = time.perf_counter()
     space, names = sampler.space, sampler.names
     samples = space.random(settings.samples, settings.seed) if len(space.addr) else space.zero()[None, :]
     rows, dist = sampler.sweep(samples)
@@ -417,7 +414,7 @@ def classify(sampler: Sampler, settings: Settings) -> Matrix:
                               allow.get(frozenset(ab)) or ""))
     poses = {name: [[a, b, round(depth, 6)] for (a, b), depth in sorted(sampler.colliding(space.held(q)).items())]
              for name, q in sorted(space.poses.items())}
-    return Matrix(len(samples), settings.seed, time.perf_counter() - start, tuple(pairs), poses)
+    return Matrix(len(samples), settings.seed, tuple(pairs), poses)
 
 
 def _pairs(sampler: Sampler) -> list[tuple[int, int]]:

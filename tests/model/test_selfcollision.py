@@ -72,7 +72,7 @@ def test_every_pair_is_classified_as_moveit_would(arm):
     }
     assert found[("boom", "far")]["note"] == "a cable guard"
     assert found[("base", "boom")]["hits"] > 0 and found[("boom", "far2")]["hits"] == 0
-    assert report["samples"] == 10000 and report["seed"] == 0 and 0 < report["seconds"] < 30
+    assert report["samples"] == 10000 and report["seed"] == 0 and "seconds" not in report
 
 
 @pytest.mark.slow
@@ -216,7 +216,7 @@ def with_matrix(robot, enabled: set):
     pairs = tuple(Pair(a, b, "" if frozenset((a, b)) in enabled else
                        "Adjacent" if frozenset((a, b)) in adjacent else "Never")
                   for i, a in enumerate(names) for b in names[i + 1:])
-    return replace(robot, collision_matrix=Matrix(10000, 0, 0.1, pairs))
+    return replace(robot, collision_matrix=Matrix(10000, 0, pairs))
 
 
 def test_a_matrix_that_16_masks_cannot_express_leaves_the_sdf_without_self_collision(tmp_path):
