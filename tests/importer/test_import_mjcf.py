@@ -37,7 +37,7 @@ def features(tmp_path_factory):
 def test_bodies_are_links_rooted_in_world(features):
     recipe = features[0]
     assert list(recipe["links"]) == ["world", "base", "upper", "fore_elbow", "fore", "wrist_wrist_ball_x",
-                                     "wrist_wrist_ball_y", "wrist", "finger_a", "finger_b"]
+                                     "wrist_wrist_ball_y", "wrist", "finger_a", "finger_b", "tool", "elbow_mark"]
     base = recipe["joints"]["base_fixed"]
     assert base["type"] == "fixed" and base["parent"] == "world"
     assert base["origin"]["xyz"] == [0, 0, 0.1]
@@ -142,20 +142,36 @@ def test_actuators_mimic_pose_and_excludes(features):
 
 def test_ledger_word_for_word(features):
     assert features[1].lines() == [
-        "features.xml:32: geom 'wrist_ellipsoid' (ellipsoid): all: approximated: the box of its half-axes "
+        "features.xml:33: geom 'wrist_ellipsoid' (ellipsoid): all: approximated: the box of its half-axes "
         "0.03 0.02 0.01",
         "features.xml: option integrator: all: Euler dropped: the rebuilt MJCF has implicitfast (the recipe has no "
         "simulation options)",
-        "features.xml:58: actuator 'shoulder_servo': all: ctrlrange [-1.2, 1.2] written as the joint's range "
+        "features.xml:59: actuator 'shoulder_servo': all: ctrlrange [-1.2, 1.2] written as the joint's range "
         "[-1.5708, 1.5708]",
-        "features.xml:60: actuator 'extend_motor': all: gear 2: the recipe's motor takes the joint's force (ctrl x 2)",
-        "features.xml:53: tendon 'fingers': all: dropped: the recipe has no tendons",
-        "features.xml:64: sensor 'shoulder_angle': all: dropped: the recipe has no sensors",
-        "features.xml:21: site 'tool': all: dropped: the recipe has no sites (sites are frames: none in the recipe)",
-        "features.xml:31: joint 'wrist_ball' (ball): all: approximated: three revolute joints about the body's x, y, z "
+        "features.xml:61: actuator 'extend_motor': all: gear 2: the recipe's motor takes the joint's force (ctrl x 2)",
+        "features.xml:21: site 'tool': mjcf: a frame link (a body without mass in the rebuilt MJCF, not a site): its "
+        "sphere of size 0.005 is not drawn",
+        "features.xml:26: site 'elbow_mark': mjcf: a frame link (a body without mass in the rebuilt MJCF, not a "
+        "site): its box of size 0.01 0.02 0.03 is not drawn",
+        "features.xml:54: tendon 'fingers': all: dropped: the recipe has no tendons",
+        "features.xml:65: sensor 'shoulder_angle': all: dropped: the recipe has no sensors",
+        "features.xml:32: joint 'wrist_ball' (ball): all: approximated: three revolute joints about the body's x, y, z "
         "through two massless links; its armature, damping and friction act on each angle, not on the angular "
         "velocity",
     ]
+
+
+def test_sites_are_frame_links_at_their_pose(features):
+    """A site is a link without mass or shape, fixed to its body's link where MuJoCo puts it: on a
+    body whose link frame sits on its hinge's axis (0.02 m off), 0.01 m from that frame."""
+    recipe = features[0]
+    assert recipe["links"]["tool"] == {} and recipe["links"]["elbow_mark"] == {}
+    assert recipe["joints"]["tool_fixed"] == {"type": "fixed", "parent": "base", "child": "tool",
+                                              "origin": {"xyz": [0, 0, 0.2]}}
+    mark = recipe["joints"]["elbow_mark_fixed"]
+    assert (mark["type"], mark["parent"], mark["child"]) == ("fixed", "upper", "elbow_mark")
+    assert mark["origin"]["xyz"] == pytest.approx([0.01, 0, 0.3], abs=1e-15)
+    assert mark["origin"]["rpy"] == pytest.approx([0, math.pi / 2, 0], abs=1e-7)
 
 
 def test_constraint_softness_the_rebuild_lacks_is_on_the_ledger(tmp_path):
@@ -199,7 +215,7 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     assert "# verified in MuJoCo against the original at 22 configurations and 0 rollouts: every quantity agrees" in text
     assert ("#   note: no rollout: ball joint 'wrist_ball' is three revolute joints through massless links in the "
             "rebuild (approximated, on the ledger), whose motion parts from the ball's") in text
-    assert "#   features.xml:53: tendon 'fingers': all: dropped: the recipe has no tendons" in text
+    assert "#   features.xml:54: tendon 'fingers': all: dropped: the recipe has no tendons" in text
     assert yaml.safe_load(text)["robot"] == "features"
     assert ("  # MJCF ref 0.02: the origin takes the body back to the joint's zero, so joint values (limits,\n"
             "  # poses) are MuJoCo's; driven, with no velocity limit in the MJCF (unlimited): 1e+09\n  extend:\n") in text
@@ -214,6 +230,16 @@ def test_verification_catches_a_rebuild_that_differs(rebuilt, features, tmp_path
     assert not verdict.ok
     assert verdict.failures[:2] == ["total mass: mass off by 2.49e-02 (tolerance 1e-09)",
                                     "body 'fore' at keyframe 'home': mass off by 2.00e-01 (tolerance 1e-09)"]
+
+
+def test_verification_compares_each_site_with_its_frame_link(rebuilt, features, tmp_path):
+    _, folder = rebuilt
+    # 1 mm along the frame link's x, which the keyframe turns: 0.76 mm in the largest world coordinate
+    mjcf = _mutated(folder, tmp_path, "mjcf/features.xml", '<body name="elbow_mark" pos="0.01 0 0.3"',
+                    '<body name="elbow_mark" pos="0.011 0 0.3"')
+    verdict = verify(features[2], features[3], mjcf)
+    assert verdict.failures[0] == "site 'elbow_mark' at keyframe 'home': pose off by 7.60e-04 (tolerance 1e-09)"
+    assert all(f.startswith("site 'elbow_mark' at ") for f in verdict.failures)
 
 
 def _mutated(folder: Path, tmp_path: Path, name: str, old: str, new: str) -> Path:
@@ -347,7 +373,8 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     ledger = [line.removeprefix("ledger: ") for line in proc.stderr.splitlines() if line.startswith("ledger: ")]
     assert recipe["metadata"]["ledger"] == ledger  # and the build's report.json carries it
     assert json.loads((tmp_path / "build" / "Skydio_X2" / "report.json").read_text())["ledger"] == ledger
-    assert recipe["base"] == "free" and list(recipe["links"]) == ["x2"]
+    assert recipe["base"] == "free" and list(recipe["links"]) == ["x2", "imu", "thrust1", "thrust2", "thrust3",
+                                                                     "thrust4"]  # its sites as frames
     mesh = next(s for s in recipe["links"]["x2"]["visual"] if "mesh" in s)
     assert mesh["scale"] == 0.01  # set in the default class
 

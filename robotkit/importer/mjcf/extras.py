@@ -1,6 +1,6 @@
 """Keyframes as named poses, ``<contact><exclude>`` as self-collision pairs never checked,
 joint equalities as mimic joints, and the ledger lines of everything the recipe has no key for
-(tendons, other equality constraints, sensors, sites, cameras, lights, flexes, joint springs)."""
+(tendons, other equality constraints, sensors, cameras, lights, flexes, joint springs)."""
 
 from __future__ import annotations
 
@@ -133,13 +133,12 @@ def _one_dof(m, a: int, b: int) -> bool:
 def ledger_rest(src, tree, ledger) -> None:
     """What the recipe has no key for, one line each."""
     spec, m = src.spec, src.model
-    for kind, what in (("tendon", "tendon"), ("sensor", "sensor"), ("site", "site"), ("camera", "camera"),
+    for kind, what in (("tendon", "tendon"), ("sensor", "sensor"), ("camera", "camera"),
                        ("light", "light"), ("flex", "flex"), ("skin", "skin"), ("pair", "contact pair"),
                        ("hfield", "height field"), ("text", "custom text"), ("numeric", "custom numeric")):
         for e in getattr(spec, "flexes" if kind == "flex" else kind + "s", []):
             label = f"{what} '{e.name}'" if e.name else what
-            ledger.add(src.where(e), label, "all", "dropped: the recipe has no " + what + "s"
-                       + (" (sites are frames: none in the recipe)" if kind == "site" else ""))
+            ledger.add(src.where(e), label, "all", "dropped: the recipe has no " + what + "s")
     for j in range(m.njnt):
         softness = _softness(m, j)
         if softness:

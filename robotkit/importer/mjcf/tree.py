@@ -43,6 +43,7 @@ class Tree:
     notes: dict = field(default_factory=dict)  # joint name -> comment above it
     actuated: dict = field(default_factory=dict)  # MuJoCo actuator id -> the recipe joint it drives (kept ones)
     mimics: dict = field(default_factory=dict)  # MuJoCo equality id -> (mimic joint, leader) (kept ones)
+    sites: dict = field(default_factory=dict)  # MuJoCo site id -> its frame link (robotkit.importer.mjcf.sites)
     ledger: list = field(default_factory=list)
 
 

@@ -4,17 +4,17 @@ At the original's keyframes, its zero configuration and :data:`SAMPLES` seeded r
 (joints within their ranges, unlimited hinges within a turn, free and ball joints at random
 orientations), each configuration set on both models (a ball joint as its three angles), and
 compared: every original body's mass, centre of mass, inertia tensor (world axes) and frame
-pose; the total mass (the point masses of joint chains' links apart); the joint-space mass
-matrix (``mj_fullM``, armature apart) and the bias forces at rest (gravity), the rebuilt ones
-mapped to the original's velocities, and the bias forces at random joint velocities (Coriolis
-and centrifugal forces too); the same mass matrix and gravity forces from the rebuilt URDF in
-Pinocchio (:mod:`robotkit.importer.mjcf.pinocchio_mass`: joints matched by name); each hinge's
-and slide's armature; each kept actuator's types, gain, bias and gear, and the actuator count;
-each joint equality kept as a mimic joint, and the equality count; and a rollout of 0.5 s from
-each keyframe under one control sequence (:mod:`robotkit.importer.mjcf.rollout`; none for a
-model with a ball joint, which says so).  Sites are not compared: the recipe has none (each is
-on the ledger).  Tolerances (:data:`TOL`): relative to the largest value of the same kind, plus
-an absolute floor for lengths."""
+pose, and every site's pose (its frame link's: :mod:`robotkit.importer.mjcf.sites`); the total
+mass (the point masses of joint chains' links apart); the joint-space mass matrix (``mj_fullM``,
+armature apart) and the bias forces at rest (gravity), the rebuilt ones mapped to the original's
+velocities, and the bias forces at random joint velocities (Coriolis and centrifugal forces
+too); the same mass matrix and gravity forces from the rebuilt URDF in Pinocchio
+(:mod:`robotkit.importer.mjcf.pinocchio_mass`: joints matched by name); each hinge's and slide's
+armature; each kept actuator's types, gain, bias and gear, and the actuator count; each joint
+equality kept as a mimic joint, and the equality count; and a rollout of 0.5 s from each
+keyframe under one control sequence (:mod:`robotkit.importer.mjcf.rollout`; none for a model
+with a ball joint, which says so).  Tolerances (:data:`TOL`): relative to the largest value of
+the same kind, plus an absolute floor for lengths."""
 
 from __future__ import annotations
 
@@ -75,6 +75,7 @@ def verify(src, tree, rebuilt_path) -> Verdict:
     for label, q in configs:
         T = _at(mujoco, om, od, rm, rd, tree, q)
         _bodies(verdict, om, od, rm, rd, tree, label)
+        _sites(verdict, od, rm, rd, tree, label)
         _dynamics(verdict, mujoco, om, od, rm, rd, T, label)
         if pin is not None:
             _in_pinocchio(verdict, pin, om, od, rm, rd, T, label)
@@ -238,6 +239,14 @@ def _bodies(verdict, om, od, rm, rd, tree, label: str) -> None:
         if mo:
             Io, Ir = (_world_inertia(m.body_inertia[i], d.ximat[i]) for m, d, i in ((om, od, b), (rm, rd, r)))
             _check(verdict, "inertia", float(np.abs(Io - Ir).max() / max(np.abs(Io).max(), 1e-300)), where)
+
+
+def _sites(verdict, od, rm, rd, tree, label: str) -> None:
+    """Each site's pose against its frame link's (a body without mass in the rebuilt MJCF)."""
+    for s, name in tree.sites.items():
+        r = rm.body(name).id
+        pose = max(np.abs(od.site_xpos[s] - rd.xpos[r]).max(), np.abs(od.site_xmat[s] - rd.xmat[r]).max())
+        _check(verdict, "pose", float(pose), f"site '{name}' at {label}")
 
 
 def _world_inertia(moments, ximat) -> np.ndarray:

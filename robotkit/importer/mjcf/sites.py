@@ -1,0 +1,54 @@
+"""MuJoCo sites as the recipe's frames: each site a link of its own without mass or shape, fixed
+to its body's link at the site's pose (a ``<frame>`` in model.sdf, a link in the URDF, a body
+without mass in the rebuilt MJCF).  ROS reads them as tf frames (a gripper's pinch point, an IMU's
+mounting).  What a site draws (its type, size, colour) is on the ledger."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robotkit.importer.mjcf.frames import origin, quat_matrix
+from robotkit.importer.names import valid_frame_name
+
+SHAPES = {2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box"}
+"""MuJoCo's site types by number (mjtGeom)."""
+
+
+def add_sites(src, tree, ledger) -> None:
+    """One frame link per site of a body that is a link (``tree.sites``: site id -> link name)."""
+    m, specs = src.model, list(src.spec.sites)
+    for s in range(m.nsite):
+        b = int(m.site_bodyid[s])
+        site = m.site(s).name
+        where = src.where(specs[s]) if s < len(specs) and specs[s].name == site else src.where_named("site", site)
+        label = f"site '{site}'" if site else f"site #{s}"
+        if b not in tree.link_of:  # the world's, when the robot is its own root (base: free)
+            ledger.add(where, label, "all", "dropped: a site of the world, and the robot has no world link")
+            continue
+        name = _free(tree, site if valid_frame_name(site) else f"site{s}")
+        parent = tree.link_of[b]
+        joint = {"type": "fixed", "parent": parent, "child": name}
+        o = origin(np.asarray(m.site_pos[s], float) - tree.offset[b], quat_matrix(m.site_quat[s]))
+        if o:
+            joint["origin"] = o
+        tree.links[name] = {}
+        tree.joints[_free(tree, f"{name}_fixed", tree.joints)] = joint
+        tree.sites[s] = name
+        renamed = f" '{name}'" if name != site else ""
+        ledger.add(where, label, "mjcf", f"a frame link{renamed} (a body without mass in the rebuilt MJCF, not a "
+                   f"site): its {_shape(m, s)} is not drawn")
+
+
+def _shape(m, s: int) -> str:
+    kind = SHAPES.get(int(m.site_type[s]), "shape")
+    used = {"sphere": 1, "capsule": 2, "cylinder": 2}.get(kind, 3)
+    return f"{kind} of size " + " ".join(f"{float(v):g}" for v in m.site_size[s][:used])
+
+
+def _free(tree, base: str, taken: dict | None = None) -> str:
+    """``base``, or ``base_2``, ``base_3``... the first not taken (by a link, or in ``taken``)."""
+    taken = tree.links if taken is None else taken
+    name, n = base, 2
+    while name in taken or (taken is tree.links and name in tree.joints):
+        name, n = f"{base}_{n}", n + 1
+    return name
