@@ -76,7 +76,8 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
     _factor_defaults(recipe)
     comments = {"links": {n: "a massless link of a body's joint chain (MuJoCo moves a body through its joints in "
                           "order): a point mass of a millionth of the lightest body, as MuJoCo needs"
-                          for n in tree.chain_links}, "joints": tree.notes}
+                          for n in tree.chain_links} | {n: "an MJCF site: a frame (no mass, no shape)"
+                                                       for n in tree.sites.values()}, "joints": tree.notes}
     header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (MJCF, "
               "read through MuJoCo: inertials, shapes and poses as MuJoCo compiled them)"] + ledger.block()
     files = [str(src.mesh_file(d)) for d in range(src.model.nmesh) if src.mesh_file(d) is not None]
