@@ -154,7 +154,7 @@ def test_ledger_word_for_word(features):
         "features.xml:26: site 'elbow_mark': mjcf: a frame link (a body without mass in the rebuilt MJCF, not a "
         "site): its box of size 0.01 0.02 0.03 is not drawn",
         "features.xml:54: tendon 'fingers': all: dropped: the recipe has no tendons",
-        "features.xml:65: sensor 'shoulder_angle': all: dropped: the recipe has no sensors",
+        "features.xml:65: sensor 'shoulder_angle': all: dropped: the recipe has no jointpos sensors",
         "features.xml:32: joint 'wrist_ball' (ball): all: approximated: three revolute joints about the body's x, y, z "
         "through two massless links; its armature, damping and friction act on each angle, not on the angular "
         "velocity",
@@ -373,8 +373,15 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     ledger = [line.removeprefix("ledger: ") for line in proc.stderr.splitlines() if line.startswith("ledger: ")]
     assert recipe["metadata"]["ledger"] == ledger  # and the build's report.json carries it
     assert json.loads((tmp_path / "build" / "Skydio_X2" / "report.json").read_text())["ledger"] == ledger
-    assert recipe["base"] == "free" and list(recipe["links"]) == ["x2", "imu", "thrust1", "thrust2", "thrust3",
+    assert recipe["base"] == "free" and list(recipe["links"]) == ["x2", "thrust1", "thrust2", "thrust3",
                                                                      "thrust4"]  # its sites as frames
+    # its gyro and accelerometer on site 'imu': the recipe's imu sensor, whose frame is the site
+    assert recipe["sensors"] == {"imu": {"type": "imu", "parent": "x2", "frame": "imu",
+                                         "origin": {"xyz": [0, 0, 0.02]}}}
+    assert ("ledger: x2.xml:63: sensor 'body_gyro' (gyro): mjcf: the recipe's imu sensor 'imu': written as "
+            "'imu_gyro' on site 'imu_site'") in proc.stderr.splitlines()
+    mjcf = (tmp_path / "build" / "Skydio_X2" / "mjcf" / "Skydio_X2.xml").read_text()
+    assert '<gyro name="imu_gyro" site="imu_site"/>' in mjcf
     mesh = next(s for s in recipe["links"]["x2"]["visual"] if "mesh" in s)
     assert mesh["scale"] == 0.01  # set in the default class
 

@@ -28,6 +28,7 @@ from robotkit.importer.mjcf.geoms import add_geoms
 from robotkit.importer.mjcf.inertials import add_inertials
 from robotkit.importer.mjcf.ledger import Ledger
 from robotkit.importer.mjcf.source import read
+from robotkit.importer.mjcf.sensors import add_imus
 from robotkit.importer.mjcf.sites import add_sites
 from robotkit.importer.mjcf.tree import build_tree
 from robotkit.importer.mjcf.verify import Verdict, verify
@@ -51,6 +52,7 @@ def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, o
     add_equalities(src, tree, recipe, ledger)
     add_poses(src, tree, recipe, ledger)
     add_excludes(src, tree, recipe, ledger)
+    add_imus(src, tree, recipe, ledger)
     add_sites(src, tree, ledger)
     ledger_rest(src, tree, ledger)
     if len(ledger):  # the build copies it into report.json

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from robotkit import mj
 from robotkit.importer.mjcf.frames import quat_matrix
 from robotkit.importer.names import valid_name
 
@@ -126,6 +127,11 @@ def add_equalities(src, tree, recipe: dict, ledger) -> None:
                    "dropped: the recipe has no loop closures or couplings of this kind")
 
 
+def _sensor_type(m, i: int) -> str:
+    """A sensor's type as its MJCF tag names it (``jointpos``, ``framequat``...)."""
+    return mj.load().mjtSensor(int(m.sensor_type[i])).name.removeprefix("mjSENS_").lower()
+
+
 def _one_dof(m, a: int, b: int) -> bool:
     return all(int(m.jnt_type[j]) in (HINGE, SLIDE) for j in (a, b))
 
@@ -136,9 +142,12 @@ def ledger_rest(src, tree, ledger) -> None:
     for kind, what in (("tendon", "tendon"), ("sensor", "sensor"), ("camera", "camera"),
                        ("light", "light"), ("flex", "flex"), ("skin", "skin"), ("pair", "contact pair"),
                        ("hfield", "height field"), ("text", "custom text"), ("numeric", "custom numeric")):
-        for e in getattr(spec, "flexes" if kind == "flex" else kind + "s", []):
+        for i, e in enumerate(getattr(spec, "flexes" if kind == "flex" else kind + "s", [])):
+            if kind == "sensor" and i in tree.kept_sensors:
+                continue
             label = f"{what} '{e.name}'" if e.name else what
-            ledger.add(src.where(e), label, "all", "dropped: the recipe has no " + what + "s")
+            ledger.add(src.where(e), label, "all", "dropped: the recipe has no "
+                       + (f"{_sensor_type(m, i)} sensors" if kind == "sensor" else what + "s"))
     for j in range(m.njnt):
         softness = _softness(m, j)
         if softness:

@@ -15,28 +15,37 @@ SHAPES = {2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box"}
 
 
 def add_sites(src, tree, ledger) -> None:
-    """One frame link per site of a body that is a link (``tree.sites``: site id -> link name)."""
+    """One frame link per site of a body that is a link (``tree.sites``: site id -> link name), but
+    an IMU's, whose sensor makes its frame."""
     m, specs = src.model, list(src.spec.sites)
     for s in range(m.nsite):
         b = int(m.site_bodyid[s])
         site = m.site(s).name
         where = src.where(specs[s]) if s < len(specs) and specs[s].name == site else src.where_named("site", site)
         label = f"site '{site}'" if site else f"site #{s}"
+        if s in tree.sites:  # an IMU's (robotkit.importer.mjcf.sensors): its sensor's frame
+            continue
         if b not in tree.link_of:  # the world's, when the robot is its own root (base: free)
             ledger.add(where, label, "all", "dropped: a site of the world, and the robot has no world link")
             continue
-        name = _free(tree, site if valid_frame_name(site) else f"site{s}")
+        name = free_name(tree, site if valid_frame_name(site) else f"site{s}")
         parent = tree.link_of[b]
         joint = {"type": "fixed", "parent": parent, "child": name}
-        o = origin(np.asarray(m.site_pos[s], float) - tree.offset[b], quat_matrix(m.site_quat[s]))
+        o = site_origin(m, tree, s)
         if o:
             joint["origin"] = o
         tree.links[name] = {}
-        tree.joints[_free(tree, f"{name}_fixed", tree.joints)] = joint
+        tree.joints[free_name(tree, f"{name}_fixed", tree.joints)] = joint
         tree.sites[s] = name
         renamed = f" '{name}'" if name != site else ""
         ledger.add(where, label, "mjcf", f"a frame link{renamed} (a body without mass in the rebuilt MJCF, not a "
                    f"site): its {_shape(m, s)} is not drawn")
+
+
+def site_origin(m, tree, s: int) -> dict | None:
+    """The recipe ``origin`` of site ``s`` in its body's link frame (None for the identity)."""
+    b = int(m.site_bodyid[s])
+    return origin(np.asarray(m.site_pos[s], float) - tree.offset[b], quat_matrix(m.site_quat[s]))
 
 
 def _shape(m, s: int) -> str:
@@ -45,7 +54,7 @@ def _shape(m, s: int) -> str:
     return f"{kind} of size " + " ".join(f"{float(v):g}" for v in m.site_size[s][:used])
 
 
-def _free(tree, base: str, taken: dict | None = None) -> str:
+def free_name(tree, base: str, taken: dict | None = None) -> str:
     """``base``, or ``base_2``, ``base_3``... the first not taken (by a link, or in ``taken``)."""
     taken = tree.links if taken is None else taken
     name, n = base, 2

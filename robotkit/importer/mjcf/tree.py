@@ -44,6 +44,7 @@ class Tree:
     actuated: dict = field(default_factory=dict)  # MuJoCo actuator id -> the recipe joint it drives (kept ones)
     mimics: dict = field(default_factory=dict)  # MuJoCo equality id -> (mimic joint, leader) (kept ones)
     sites: dict = field(default_factory=dict)  # MuJoCo site id -> its frame link (robotkit.importer.mjcf.sites)
+    kept_sensors: set = field(default_factory=set)  # MuJoCo sensor ids the recipe's sensors hold
     ledger: list = field(default_factory=list)
 
 
