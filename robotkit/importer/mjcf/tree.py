@@ -40,6 +40,8 @@ class Tree:
     joint_map: dict = field(default_factory=dict)  # MuJoCo joint id -> recipe joint names
     base: str = "fixed"
     chain_links: list = field(default_factory=list)
+    chains: dict = field(default_factory=dict)  # body id -> (its chain links, its joint stages: see _stages)
+    moved: dict = field(default_factory=dict)  # chain link -> the body id whose mass it carries (chainmass)
     notes: dict = field(default_factory=dict)  # joint name -> comment above it
     actuated: dict = field(default_factory=dict)  # MuJoCo actuator id -> the recipe joint it drives (kept ones)
     mimics: dict = field(default_factory=dict)  # MuJoCo equality id -> (mimic joint, leader) (kept ones)
@@ -127,6 +129,8 @@ def _body(src, tree: Tree, b: int, bodies, jnames, chain_mass: float) -> None:
         prev_link, prev_anchor = child, anchor
     for jname, *_, j in stages:
         tree.joint_map.setdefault(j, []).append(jname)
+    if len(stages) > 1:
+        tree.chains[b] = (tree.chain_links[-(len(stages) - 1):], stages)
     tree.link_of[b], tree.offset[b] = name, stages[-1][3]
 
 
