@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from robotkit.importer.inertials import POINT_MASS_FLOOR
-from robotkit.importer.mjcf.frames import clean, quat_matrix
+from robotkit.importer.mjcf.frames import clean
 from robotkit.model.inertia_policy import MIN_MOMENT, defects, mujoco_ready
 
 CHAIN_POINT_MASS = POINT_MASS_FLOOR
@@ -86,32 +86,60 @@ def _why_not(stages, k: int, com):
     return p, ""
 
 
-def place_chain_masses(src, tree, ledger, tensor) -> None:
-    """Each chain link's mass taken from its body where it can be (see the module docstring);
-    ``tensor(full)`` is a 3x3 tensor as the recipe writes it."""
+def carve(inertial, points) -> dict | None:
+    """A link's explicit inertial (``mass``, ``com``, ``inertia`` as the recipe writes them) less
+    a chain link's point mass at each of ``points`` (in the link's frame): the rest, as the recipe
+    writes it; None when it is not explicit or the rest would not be a physical body."""
+    if not isinstance(inertial, dict) or set(inertial) - {"mass", "com", "inertia"} or "inertia" not in inertial:
+        return None
+    t = inertial["inertia"]
+    full = np.array([[t["ixx"], t.get("ixy", 0.0), t.get("ixz", 0.0)], [t.get("ixy", 0.0), t["iyy"], t.get("iyz", 0.0)],
+                     [t.get("ixz", 0.0), t.get("iyz", 0.0), t["izz"]]], float)
+    body = (float(inertial["mass"]), np.array(inertial.get("com", (0.0, 0.0, 0.0)), float), full)
+    for p in points:
+        body = take_point_mass(*body, CHAIN_POINT_MASS, p, CHAIN_MOMENT)
+        if body is None:
+            return None
+    rest, c, I = body
+    return {"mass": rest, "com": clean(c), "inertia": recipe_tensor(I)}
+
+
+def recipe_tensor(full) -> dict:
+    """A 3x3 inertia tensor as the recipe writes it (products of inertia that are rounding left out)."""
+    out = {"ixx": full[0, 0], "iyy": full[1, 1], "izz": full[2, 2],
+           "ixy": full[0, 1], "ixz": full[0, 2], "iyz": full[1, 2]}
+    return {k: float(v) for k, v in out.items() if k[1] == k[2] or abs(v) > 1e-15 * abs(full).max()}
+
+
+def point_inertial(at) -> dict:
+    """A chain link's inertial: its point mass at ``at`` (in its frame)."""
+    return {"mass": CHAIN_POINT_MASS, "com": clean(at),
+            "inertia": {"ixx": CHAIN_MOMENT, "iyy": CHAIN_MOMENT, "izz": CHAIN_MOMENT}}
+
+
+def place_chain_masses(src, tree, ledger) -> None:
+    """Each chain link's mass taken from its body where it can be (see the module docstring)."""
     m = src.model
     for b, (links, stages) in tree.chains.items():
-        mass, com = float(m.body_mass[b]), np.array(m.body_ipos[b], float)
-        inertial = tree.links[tree.link_of[b]].get("inertial")
-        body = (mass, com, _full(m, b))
+        com = np.array(m.body_ipos[b], float)
+        child = tree.links[tree.link_of[b]]
         placed, light, why = {}, [], ""
         for k, link in enumerate(links):
             p, reason = _why_not(stages, k, com)
-            rest = take_point_mass(*body, CHAIN_POINT_MASS, p, CHAIN_MOMENT) if p is not None else None
-            if p is not None and rest is None:
-                reason = "the body is too light to give it (what would be left is not a physical body)"
-            if rest is None or not isinstance(inertial, dict):
+            rest = carve(child.get("inertial"), [q - tree.offset[b] for q in [*placed.values(), p]]) \
+                if p is not None else None
+            if rest is None:
                 light.append(link)
-                why = why or reason or "the body has no mass to give it"
+                why = why or reason or ("the body is too light to give it (what would be left is not a physical body)"
+                                        if isinstance(child.get("inertial"), dict) else "the body has no mass to give")
                 continue
-            body, placed[link] = rest, p - stages[k][3]
-        for link, at in placed.items():
-            tree.links[link]["inertial"] = {"mass": CHAIN_POINT_MASS, "com": clean(at), "inertia": {
-                "ixx": CHAIN_MOMENT, "iyy": CHAIN_MOMENT, "izz": CHAIN_MOMENT}}
-            tree.moved[link] = b
+            placed[link] = p
         if placed:
-            rest_mass, c, I = body
-            inertial.update(mass=rest_mass, com=clean(c - tree.offset[b]), inertia=tensor(I))
+            child["inertial"] = carve(child["inertial"], [p - tree.offset[b] for p in placed.values()])
+        for k, link in enumerate(links):
+            if link in placed:
+                tree.links[link]["inertial"] = point_inertial(placed[link] - stages[k][3])
+                tree.moved[link] = b
         if light:
             _ledger(src, tree, ledger, b, light, why)
 
@@ -128,7 +156,3 @@ def _ledger(src, tree, ledger, b: int, light: list[str], why: str) -> None:
                f"{why}{dropped}")
 
 
-def _full(m, b: int) -> np.ndarray:
-    """Body ``b``'s inertia tensor about its centre of mass, in its frame."""
-    R = quat_matrix(m.body_iquat[b])
-    return R @ np.diag(np.asarray(m.body_inertia[b], float)) @ R.T

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robotkit.importer.mjcf.chainmass import place_chain_masses
+from robotkit.importer.mjcf.chainmass import place_chain_masses, recipe_tensor
 from robotkit.importer.mjcf.frames import clean, quat_matrix
 
 
@@ -24,12 +24,5 @@ def add_inertials(src, tree, ledger) -> None:
         R = quat_matrix(m.body_iquat[b])
         full = R @ np.diag(m.body_inertia[b]) @ R.T
         com = clean(np.array(m.body_ipos[b], float) - tree.offset[b])
-        link["inertial"] = {"mass": mass, "com": com, "inertia": tensor(full)}
-    place_chain_masses(src, tree, ledger, tensor)
-
-
-def tensor(full) -> dict:
-    """A 3x3 inertia tensor as the recipe writes it (products of inertia that are rounding left out)."""
-    out = {"ixx": full[0, 0], "iyy": full[1, 1], "izz": full[2, 2],
-           "ixy": full[0, 1], "ixz": full[0, 2], "iyz": full[1, 2]}
-    return {k: float(v) for k, v in out.items() if k[1] == k[2] or abs(v) > 1e-15 * abs(full).max()}
+        link["inertial"] = {"mass": mass, "com": com, "inertia": recipe_tensor(full)}
+    place_chain_masses(src, tree, ledger)

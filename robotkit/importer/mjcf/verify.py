@@ -4,7 +4,8 @@ At the original's keyframes, its zero configuration and :data:`SAMPLES` seeded r
 (joints within their ranges, unlimited hinges within a turn, free and ball joints at random
 orientations), each configuration set on both models (a ball joint as its three angles), and
 compared: every original body's mass, centre of mass, inertia tensor (world axes) and frame
-pose; the total mass (the point masses of joint chains' links apart); the joint-space mass
+pose (with the point masses its chain's links took from it: robotkit.importer.mjcf.chainmass);
+the total mass (the point masses added to chain links apart, on the ledger); the joint-space mass
 matrix (``mj_fullM``, armature apart) and the bias forces at rest (gravity), the rebuilt ones
 mapped to the original's velocities, and the bias forces at random joint velocities (Coriolis
 and centrifugal forces too); the same mass matrix and gravity forces from the rebuilt URDF in
@@ -34,8 +35,9 @@ SEED = 0
 TOL = {"mass": 1e-9, "pose": 1e-9, "inertia": 1e-9, "matrix": 1e-6, "bias": 1e-6, "pinocchio": 1e-6,
        "actuator": 1e-9, "equality": 1e-9, "rollout": 1e-4}
 """Relative tolerances (pose and rollout: metres and rotation-matrix entries, absolute). The
-matrices' are looser: the massless links of joint chains carry a millionth of the lightest
-body's mass; the rollout's, as that millionth and the solver's own tolerance grow over 0.5 s."""
+matrices' are looser: a chain link that cannot take its mass from its body carries an added
+millionth of the lightest body's (on the ledger); the rollout's, as that millionth and the
+solver's own tolerance grow over 0.5 s."""
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 
 
