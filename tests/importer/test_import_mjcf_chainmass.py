@@ -106,3 +106,28 @@ def test_the_rebuild_has_the_original_dynamics_to_rounding(chains):
         assert verdict.worst[kind][0] < 1e-14, (kind, verdict.worst[kind])
     for kind in ("matrix", "bias", "pinocchio"):
         assert verdict.worst[kind][0] < 1e-9, (kind, verdict.worst[kind])
+
+
+def test_a_link_whose_later_hinges_do_not_meet_keeps_an_added_mass(tmp_path):
+    """Three hinges, the last two 2 cm apart: the first chain link has no point both leave fixed
+    (on the ledger); the second takes its mass on the last hinge's axis."""
+    (tmp_path / "skew.xml").write_text("""<mujoco model="skew">
+  <worldbody>
+    <body name="arm" pos="0 0 0.1">
+      <joint name="a" axis="0 0 1"/>
+      <joint name="b" axis="0 1 0"/>
+      <joint name="c" axis="1 0 0" pos="0 0 0.02"/>
+      <geom type="box" size="0.02 0.02 0.1" pos="0 0 0.1" mass="0.2"/>
+    </body>
+  </worldbody>
+</mujoco>
+""")
+    recipe, ledger, _, tree = convert(tmp_path / "skew.xml", tmp_path / "skew.yaml")
+    assert [line for line in ledger.lines() if "joint chain" in line] == [
+        "skew.xml:3: body 'arm' (joint chain): all: approximated: chain link 'arm_a' carries an added point mass of "
+        "2e-07 kg (a millionth of the lightest body), not taken from the body: the axes of the hinges after it do not "
+        "meet, so no point of the link stays fixed in the body; Gazebo (libsdformat's URDF reader) drops a link of "
+        "1e-06 kg or less with everything below it"]
+    assert list(tree.moved) == ["arm_b"]
+    assert recipe["links"]["arm_b"]["inertial"]["com"] == pytest.approx([0, 0, 0.02], abs=1e-15)  # on c's axis
+    assert recipe["links"]["arm"]["inertial"]["mass"] == pytest.approx(0.2 - 1e-5, rel=1e-15)
