@@ -53,6 +53,7 @@ def test_the_point_every_later_hinge_leaves_fixed():
 
 # on a floating base (its translations feel any mass added), a rod on a ball joint at its end
 # (Menagerie Cassie's achilles rods) and a body on two hinges whose axes meet off its centre of mass
+# (each with a ref: the recipe's joint zero is not the file's pose)
 CHAINS = """<mujoco model="chains">
   <worldbody>
     <body name="base" pos="0 0 0.5">
@@ -63,8 +64,8 @@ CHAINS = """<mujoco model="chains">
         <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.005" mass="0.15"/>
       </body>
       <body name="head" pos="-0.1 0 0">
-        <joint name="yaw" axis="0 0 1" pos="0 0.02 0" range="-1 1"/>
-        <joint name="tilt" axis="1 0 0" pos="0 0.02 0" range="-1 1"/>
+        <joint name="yaw" axis="0 0 1" pos="0 0.02 0" range="-60 60" ref="20"/>
+        <joint name="tilt" axis="1 0 0" pos="0 0.02 0" range="-60 60" ref="-30"/>
         <geom type="box" size="0.03 0.03 0.03" pos="0.05 0.07 0.01" mass="0.4"/>
       </body>
     </body>
