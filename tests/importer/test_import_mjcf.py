@@ -144,6 +144,10 @@ def test_ledger_word_for_word(features):
     assert features[1].lines() == [
         "features.xml:33: geom 'wrist_ellipsoid' (ellipsoid): all: approximated: the box of its half-axes "
         "0.03 0.02 0.01",
+        "features.xml:27: body 'fore' (joint chain): all: approximated: chain link 'fore_elbow' carries an added point "
+        "mass of 5e-08 kg (a millionth of the lightest body), not taken from the body: joint 'extend' after it is not "
+        "a hinge, so no point of the link stays fixed in the body; Gazebo (libsdformat's URDF reader) drops a link of "
+        "1e-06 kg or less with everything below it",
         "features.xml: option integrator: all: Euler dropped: the rebuilt MJCF has implicitfast (the recipe has no "
         "simulation options)",
         "features.xml:59: actuator 'shoulder_servo': all: ctrlrange [-1.2, 1.2] written as the joint's range "
@@ -156,8 +160,8 @@ def test_ledger_word_for_word(features):
         "features.xml:54: tendon 'fingers': all: dropped: the recipe has no tendons",
         "features.xml:65: sensor 'shoulder_angle': all: dropped: the recipe has no jointpos sensors",
         "features.xml:32: joint 'wrist_ball' (ball): all: approximated: three revolute joints about the body's x, y, z "
-        "through two massless links; its armature, damping and friction act on each angle, not on the angular "
-        "velocity",
+        "through two links, each a point mass taken from the body at the ball's centre (the dynamics unchanged); its "
+        "armature, damping and friction act on each angle, not on the angular velocity",
     ]
 
 
@@ -213,7 +217,7 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     assert result.verdict.rollouts == 0
     text = (folder / "features.yaml").read_text()
     assert "# verified in MuJoCo against the original at 22 configurations and 0 rollouts: every quantity agrees" in text
-    assert ("#   note: no rollout: ball joint 'wrist_ball' is three revolute joints through massless links in the "
+    assert ("#   note: no rollout: ball joint 'wrist_ball' is three revolute joints through chain links in the "
             "rebuild (approximated, on the ledger), whose motion parts from the ball's") in text
     assert "#   features.xml:54: tendon 'fingers': all: dropped: the recipe has no tendons" in text
     assert yaml.safe_load(text)["robot"] == "features"

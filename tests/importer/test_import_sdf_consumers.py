@@ -44,7 +44,7 @@ def test_universal_joints_chain_link_survives_libsdformats_urdf_reader(tmp_path)
     assert read.returncode == 0, read.stderr
     model = parse_text(read.stdout).getroot().find("model")
     links = {el.get("name"): float(el.findtext("inertial/mass")) for el in model.findall("link")}
-    assert links == {"body": 2.0, "wheel_steer_spin_1_link": 1e-5, "wheel": 0.5}
+    assert links == {"body": 2.0, "wheel_steer_spin_1_link": 1e-5, "wheel": 0.49999}  # taken from the wheel
     assert sorted(el.get("name") for el in model.findall("joint")) == ["steer_spin_1", "steer_spin_2"]
 
 
@@ -91,3 +91,16 @@ def test_wheels_that_never_slip_stand_still_in_mujoco(tmp_path):
         mujoco.mj_step(model, data)
     tilt = 2 * np.degrees(np.arccos(min(1.0, abs(float(np.dot(data.qpos[3:7], start[3:7]))))))
     assert tilt < 0.5 and abs(data.qpos[2] - start[2]) < 1e-3, (tilt, data.qpos[:3], start[:3])
+
+
+def test_a_chain_link_whose_child_has_no_given_inertial_keeps_an_added_mass(tmp_path):
+    """The wheel's tensor breaks the triangle inequality: the build recomputes it from the cylinder,
+    so the import cannot take the chain link's mass from it (the mass is added, on the ledger)."""
+    (tmp_path / "cart.sdf").write_text(UNIVERSAL.replace(
+        "<ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz>", "<ixx>0.01</ixx><iyy>0.01</iyy><izz>0.05</izz>").replace(
+        "<pose>0.3 0 0 0 0 0</pose>", "<pose>0.3 0 0 0 0 0</pose><collision name=\"c\"><geometry><cylinder>"
+        "<radius>0.1</radius><length>0.05</length></cylinder></geometry></collision>"))
+    result = import_sdf(tmp_path / "cart.sdf", tmp_path / "cart.yaml")
+    assert [line.split(": ", 1)[1] for line in result.ledger if "(joint chain)" in line] == [
+        "link 'wheel' (joint chain): all: approximated: chain link 'wheel_steer_spin_1_link' carries an added point "
+        "mass of 1e-05 kg, not taken from the link: its inertial is the build's to compute from its geometry"]

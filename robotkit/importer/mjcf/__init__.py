@@ -22,6 +22,7 @@ from robotkit.errors import display_path
 from robotkit.importer.checked import Imported, resolves, validate_recipe
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.actuators import add_actuators
+from robotkit.importer.mjcf.chainmass import CHAIN_POINT_MASS
 from robotkit.importer.mjcf.contacts import add_contacts
 from robotkit.importer.mjcf.extras import add_equalities, add_excludes, add_poses, ledger_rest
 from robotkit.importer.mjcf.geoms import add_geoms
@@ -43,7 +44,7 @@ def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, o
     tree = build_tree(src, ledger)
     materials: dict = {}
     add_geoms(src, tree, out, ledger, materials)
-    add_inertials(src, tree)
+    add_inertials(src, tree, ledger)
     add_contacts(src, tree, ledger)
     recipe: dict = {"robot": _robot_name(src)}
     if tree.base == "free":
@@ -76,10 +77,8 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
     name_mesh_folders(recipe)
     validate_recipe(recipe, src.path)
     _factor_defaults(recipe)
-    comments = {"links": {n: "a massless link of a body's joint chain (MuJoCo moves a body through its joints in "
-                          "order): a point mass of a millionth of the lightest body, as MuJoCo needs"
-                          for n in tree.chain_links} | {n: "an MJCF site: a frame (no mass, no shape)"
-                                                       for n in tree.sites.values()}, "joints": tree.notes}
+    comments = {"links": {n: _chain_comment(src, tree, n) for n in tree.chain_links}
+                | {n: "an MJCF site: a frame (no mass, no shape)" for n in tree.sites.values()}, "joints": tree.notes}
     header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (MJCF, "
               "read through MuJoCo: inertials, shapes and poses as MuJoCo compiled them)"] + ledger.block()
     files = [str(src.mesh_file(d)) for d in range(src.model.nmesh) if src.mesh_file(d) is not None]
@@ -102,6 +101,15 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
         raise
     os.replace(tmp, out)
     return Imported(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
+
+
+def _chain_comment(src, tree, link: str) -> str:
+    """The comment above a link of a body's joint chain (robotkit.importer.mjcf.chainmass)."""
+    head = "a link of a body's joint chain (MuJoCo moves a body through its joints in order): "
+    if link in tree.moved:
+        return head + (f"a point mass of {CHAIN_POINT_MASS:g} kg taken from body '{tree.link_of[tree.moved[link]]}', "
+                       "where the joints after it leave it fixed in the body (the dynamics unchanged)")
+    return head + "a point mass of a millionth of the lightest body, added (on the ledger)"
 
 
 def _comments(lines: list[str]) -> str:

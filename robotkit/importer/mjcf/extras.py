@@ -159,9 +159,18 @@ def ledger_rest(src, tree, ledger) -> None:
                        f"spring dropped (stiffness {float(m.jnt_stiffness[j]):g}): the recipe has no joint springs")
         if int(m.jnt_type[j]) == BALL:
             ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}' (ball)", "all",
-                       "approximated: three revolute joints about the body's x, y, z through two massless links; "
+                       "approximated: three revolute joints about the body's x, y, z through two "
+                       + _ball_links(tree, int(m.jnt_bodyid[j])) + "; "
                        "its armature, damping and friction act on each angle, not on the angular velocity"
                        + (" (its cone limit as each angle's range)" if m.jnt_limited[j] else ""))
+
+
+def _ball_links(tree, b: int) -> str:
+    """The two links a ball joint's three revolute joints go through (robotkit.importer.mjcf.chainmass)."""
+    links = tree.chains.get(b, ([], []))[0]
+    if links and all(n in tree.moved for n in links):
+        return "links, each a point mass taken from the body at the ball's centre (the dynamics unchanged)"
+    return "massless links"
 
 
 SOLREF, SOLIMP = (0.02, 1.0), (0.9, 0.95, 0.001, 0.5, 2.0)

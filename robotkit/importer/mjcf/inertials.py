@@ -1,15 +1,18 @@
 """Each body's mass properties exactly as MuJoCo computed them (``body_mass``, ``body_ipos``,
 ``body_iquat``, ``body_inertia``: from the file's inertial, or from its geoms when the file
-says so), written as the link's explicit inertial: the full tensor in the link's axes."""
+says so), written as the link's explicit inertial: the full tensor in the link's axes; a body
+moved by several joints gives a point mass to each link of its chain
+(robotkit.importer.mjcf.chainmass)."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from robotkit.importer.mjcf.chainmass import place_chain_masses, recipe_tensor
 from robotkit.importer.mjcf.frames import clean, quat_matrix
 
 
-def add_inertials(src, tree) -> None:
+def add_inertials(src, tree, ledger) -> None:
     m = src.model
     for b in range(1, m.nbody):
         link = tree.links[tree.link_of[b]]
@@ -20,8 +23,6 @@ def add_inertials(src, tree) -> None:
             continue
         R = quat_matrix(m.body_iquat[b])
         full = R @ np.diag(m.body_inertia[b]) @ R.T
-        tensor = {"ixx": full[0, 0], "iyy": full[1, 1], "izz": full[2, 2],
-                  "ixy": full[0, 1], "ixz": full[0, 2], "iyz": full[1, 2]}
-        tensor = {k: float(v) for k, v in tensor.items() if k[1] == k[2] or abs(v) > 1e-15 * abs(full).max()}
         com = clean(np.array(m.body_ipos[b], float) - tree.offset[b])
-        link["inertial"] = {"mass": mass, "com": com, "inertia": tensor}
+        link["inertial"] = {"mass": mass, "com": com, "inertia": recipe_tensor(full)}
+    place_chain_masses(src, tree, ledger)

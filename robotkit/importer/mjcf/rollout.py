@@ -10,7 +10,7 @@ else: the rebuilt model runs with the original's simulation options (timestep, i
 gravity, fluid density...); the original's dropped equality constraints are off (the kept ones
 have the rebuilt's softness), its tendons and joint springs have no stiffness, damping or
 friction, its joints' limits and friction loss have the rebuilt's softness, and its dropped
-actuators no force.  A model with a ball joint has no rollout: the three joints through massless
+actuators no force.  A model with a ball joint has no rollout: the three joints through chain
 links part from the ball (:func:`robotkit.importer.mjcf.verify.verify` says so).  Contacts are off in both: the robot
 alone has no floor, and the contact parameters the recipe cannot hold are on the ledger."""
 

@@ -64,7 +64,7 @@ class Source:
 
     def where_named(self, kind: str, name: str) -> str:
         """``file:line`` of the spec element ``kind`` (body, geom, material...) called ``name``."""
-        for element in getattr(self.spec, kind + "s", []):
+        for element in getattr(self.spec, "bodies" if kind == "body" else kind + "s", []):
             if element.name == name:
                 return self.where(element)
         return self.where()

@@ -1,9 +1,10 @@
 """MuJoCo bodies and joints as recipe links and joints.
 
 A body is a link.  Its joints (hinge, slide) are the recipe's joints; a body with several
-joints becomes a chain through massless links, one per joint but the last, as MuJoCo moves a
-body through its joints in order.  A ball joint is three revolute joints (x, y, z of the body)
-through two massless links.  A free joint is the recipe's ``base: free`` (the only body of the
+joints becomes a chain through links, one per joint but the last, as MuJoCo moves a body through
+its joints in order, each with a point mass taken from the body where that changes nothing
+(robotkit.importer.mjcf.chainmass).  A ball joint is three revolute joints (x, y, z of the body)
+through two such links.  A free joint is the recipe's ``base: free`` (the only body of the
 world) or a floating joint from ``world``; otherwise the recipe is rooted in a ``world`` link
 (the robot stays where the file puts it: a robot rooted elsewhere stands on the floor in the
 rebuilt MJCF).  A hinge about an axis that misses the body's origin
@@ -27,8 +28,9 @@ UNLIMITED = 1e9
 motor reaches (the recipe has no unlimited form, and 0 is a passive joint: robotkit's rules read
 it so, and Gazebo clamps a commanded force to 0)."""
 CHAIN_MASS = 1e-6
-"""The mass of a chain's massless link, as a fraction of the lightest body's (MuJoCo refuses a
-moving body without mass): a point mass, stated in the recipe."""
+"""The mass of a chain's link that cannot take its mass from its body (robotkit.importer.mjcf.chainmass),
+as a fraction of the lightest body's (MuJoCo refuses a moving body without mass): a point mass,
+added, on the ledger."""
 
 
 @dataclass
@@ -40,6 +42,8 @@ class Tree:
     joint_map: dict = field(default_factory=dict)  # MuJoCo joint id -> recipe joint names
     base: str = "fixed"
     chain_links: list = field(default_factory=list)
+    chains: dict = field(default_factory=dict)  # body id -> (its chain links, its joint stages: see _stages)
+    moved: dict = field(default_factory=dict)  # chain link -> the body id whose mass it carries (chainmass)
     notes: dict = field(default_factory=dict)  # joint name -> comment above it
     actuated: dict = field(default_factory=dict)  # MuJoCo actuator id -> the recipe joint it drives (kept ones)
     mimics: dict = field(default_factory=dict)  # MuJoCo equality id -> (mimic joint, leader) (kept ones)
@@ -129,6 +133,8 @@ def _body(src, tree: Tree, b: int, bodies, jnames, chain_mass: float) -> None:
         prev_link, prev_anchor = child, anchor
     for jname, *_, j in stages:
         tree.joint_map.setdefault(j, []).append(jname)
+    if len(stages) > 1:
+        tree.chains[b] = (tree.chain_links[-(len(stages) - 1):], stages)
     tree.link_of[b], tree.offset[b] = name, stages[-1][3]
 
 

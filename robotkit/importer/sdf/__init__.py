@@ -28,7 +28,7 @@ from robotkit.importer.sdf.extras import add_extras
 from robotkit.importer.sdf.model import read_model
 from robotkit.importer.sdf.shapes import add_shapes
 from robotkit.importer.sdf.source import read
-from robotkit.importer.sdf.tree import build_tree
+from robotkit.importer.sdf.tree import build_tree, take_chain_masses
 from robotkit.importer.sdf.verify import Verdict, verify
 from robotkit.paths import recipe_policy, widened
 from robotkit.urdfxml import is_element
@@ -55,6 +55,7 @@ def convert(path, out: Path):
     materials: dict = {}
     repaired: dict = {}
     files = add_shapes(src, m, tree, out, ledger, materials, repaired)
+    take_chain_masses(src, tree, ledger)
     surfaces = add_contacts(m, tree)
     recipe: dict = {"robot": _robot_name(m.name)}
     meta = _metadata(src.config)
@@ -95,8 +96,7 @@ def import_sdf(path, out_recipe, build=None) -> Imported:
     name_mesh_folders(recipe)
     validate_recipe(recipe, src.path)
     _factor_defaults(recipe)
-    comments = {"links": {**{n: "a massless link of a joint the recipe writes as a chain (ball, universal)"
-                             for n in tree.chain_links}, **tree.link_notes, **repaired}, "joints": tree.notes}
+    comments = {"links": {**{n: _chain_comment(tree, n) for n in tree.chain_links}, **tree.link_notes, **repaired}, "joints": tree.notes}
     how = "read through libsdformat" if src.via == "libsdformat" else "read from its XML (libsdformat refuses it)"
     header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (SDF, {how})"]
     header += ledger.block()
@@ -118,6 +118,14 @@ def import_sdf(path, out_recipe, build=None) -> Imported:
         raise
     os.replace(tmp, out)
     return Imported(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
+
+
+def _chain_comment(tree, link: str) -> str:
+    head = "a link of a joint the recipe writes as a chain (ball, universal): "
+    if link in tree.moved:
+        return head + (f"a point mass taken from link '{tree.moved[link]}' at the joint's centre, which every axis "
+                       "of the joint leaves fixed (the dynamics unchanged)")
+    return head + "a point mass, added (on the ledger)"
 
 
 def _factor_defaults(recipe: dict) -> None:

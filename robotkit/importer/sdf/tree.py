@@ -4,8 +4,9 @@ A link is a link.  A link a moving joint moves has its frame on the joint's fram
 joint's axis through its child's origin): when the SDF joint's pose in its child is not the
 identity, the link's contents are written in that frame (``offset``).  revolute, prismatic,
 continuous and fixed joints map one to one (a revolute joint with no limits, or SDF's ±1e16, is
-continuous); a ball joint is three revolute joints (x, y, z of its frame) through two massless
-links, a universal or revolute2 joint two; a screw joint is a revolute joint (its translation is
+continuous); a ball joint is three revolute joints (x, y, z of its frame) through two links, a
+universal or revolute2 joint two, each link with a point mass taken from the joint's child at
+the joint's centre (:func:`take_chain_masses`); a screw joint is a revolute joint (its translation is
 stated); a gearbox joint, or any joint closing a loop, is dropped (stated).  A static model, or
 a joint to ``world``, roots the recipe in a ``world`` link; any other model floats (``base:
 free``)."""
@@ -17,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from robotkit.importer.inertials import POINT_MASS_FLOOR
+from robotkit.importer.mjcf.chainmass import carve, point_inertial
 from robotkit.importer.mjcf.frames import clean, origin
 from robotkit.importer.mjcf.tree import CHAIN_MASS, UNLIMITED, UNLIMITED_SLIDE, WORLD
 
@@ -37,6 +39,8 @@ class Tree:
     frame: dict = field(default_factory=dict)  # SDF link -> its recipe frame in the model frame (4x4)
     joint_map: dict = field(default_factory=dict)  # SDF joint -> recipe joint names
     chain_links: list = field(default_factory=list)
+    chains: dict = field(default_factory=dict)  # SDF link -> the chain links of the joint that moves it
+    moved: dict = field(default_factory=dict)  # chain link -> the SDF link whose mass it carries
     base: str = "fixed"
     notes: dict = field(default_factory=dict)  # joint -> comment above it
     link_notes: dict = field(default_factory=dict)
@@ -154,6 +158,33 @@ def _joint(src, tree: Tree, j, chain_mass: float, ledger) -> None:
         tree.joints[name] = out
         parent = child
     tree.joint_map[j.name] = names
+    if len(names) > 1:
+        tree.chains[j.child] = tree.chain_links[-(len(names) - 1):]
+
+
+def take_chain_masses(src, tree: Tree, ledger) -> None:
+    """Each chain link's point mass taken from the link its joint moves, at the joint's centre
+    (the origin of both frames), where every axis of the joint passes: the dynamics unchanged
+    (robotkit.importer.mjcf.chainmass); a link whose inertial the import repaired or recomputed, or
+    too light to give it, keeps its own and its chain links an added one (on the ledger)."""
+    for child, links in tree.chains.items():
+        inertial = tree.links[child].get("inertial")
+        rest = carve(inertial, [np.zeros(3)] * len(links))
+        if rest is None:
+            mass = tree.links[links[0]]["inertial"]["mass"]
+            named = ", ".join(f"'{n}'" for n in links)
+            why = ("it is too light to give it (what would be left is not a physical body)" if carve(inertial, [])
+                   else "its inertial is the build's to compute from its geometry" if inertial
+                   else "it has no mass to give")
+            ledger.add(src.where("link", child.split("/")[-1]), f"link '{child}' (joint chain)", "all",
+                       f"approximated: chain link{'s' if len(links) > 1 else ''} {named} "
+                       f"carr{'y' if len(links) > 1 else 'ies'} an added point mass of {mass:.3g} kg, not taken from "
+                       f"the link: {why}")
+            continue
+        tree.links[child]["inertial"] = rest
+        for link in links:
+            tree.links[link]["inertial"] = point_inertial(np.zeros(3))
+            tree.moved[link] = child
 
 
 def _locked(j) -> bool:

@@ -148,6 +148,11 @@ def _motion(j, v: float) -> np.ndarray:
 
 
 def _links(verdict, original, rebuilt, tree, repaired, po, pr, label: str) -> None:
+    """Each original link against its rebuilt link with the point masses its joint's chain links
+    took from it (robotkit.importer.sdf.tree.take_chain_masses), all in model axes."""
+    carried: dict[str, list[str]] = {}
+    for link, child in tree.moved.items():
+        carried.setdefault(child, []).append(link)
     for name, lo in original.links.items():
         lr = rebuilt.links.get(name)
         where = f"link '{name}' at {label}"
@@ -156,10 +161,22 @@ def _links(verdict, original, rebuilt, tree, repaired, po, pr, label: str) -> No
             continue
         To, Tr = po[name] @ tree.offset(name, lo.T), pr[name]
         _check(verdict, "pose", float(np.abs(To - Tr).max()), where)
-        _check(verdict, "mass", abs(lo.mass - lr.mass) / max(lo.mass, 1e-300), where)
+        mo, co, Io = _composite([(po[name], lo)])
+        mr, cr, Ir = _composite([(pr[n], rebuilt.links[n]) for n in [name, *carried.get(name, [])] if n in rebuilt.links])
+        _check(verdict, "mass", abs(mo - mr) / max(mo, 1e-300), where)
         if name in repaired:
             continue
-        co, cr = (T[:3, :3] @ lk.com + T[:3, 3] for T, lk in ((po[name], lo), (pr[name], lr)))
         _check(verdict, "pose", float(np.abs(co - cr).max()), where + " centre of mass")
-        Io, Ir = (T[:3, :3] @ lk.inertia @ T[:3, :3].T for T, lk in ((po[name], lo), (pr[name], lr)))
         _check(verdict, "inertia", float(np.abs(Io - Ir).max() / max(np.abs(Io).max(), 1e-300)), where)
+
+
+def _composite(parts) -> tuple[float, np.ndarray, np.ndarray]:
+    """(mass, centre of mass, inertia about it in model axes) of links (pose, link) together."""
+    mass = sum(lk.mass for _, lk in parts)
+    coms = [T[:3, :3] @ lk.com + T[:3, 3] for T, lk in parts]
+    com = sum(lk.mass * c for (_, lk), c in zip(parts, coms)) / mass if len(parts) > 1 else coms[0]
+    inertia = np.zeros((3, 3))
+    for (T, lk), c in zip(parts, coms):
+        d = c - com
+        inertia += T[:3, :3] @ lk.inertia @ T[:3, :3].T + lk.mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
+    return mass, com, inertia
