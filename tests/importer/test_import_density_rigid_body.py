@@ -56,3 +56,38 @@ def test_the_same_link_on_a_revolute_joint_is_reported_as_check_errs(tmp_path):
     assert _warned(result) == [
         "link 'base': the original's mass 1e-06 kg over its geometry's 0.008 m^3 implies 0.000125 kg/m^3, below 10 "
         "(the density or mass is far too low): kept (check reports it)"]
+
+
+def test_the_body_counts_a_mass_the_import_computes_as_the_build_does(tmp_path):
+    """A MeshLab mass (the volume at density 1) on a 10 cm box gets the recipe's density; a 1e-6 kg
+    sensor of 2 cm welded to it is judged on the body with the computed mass, in the import's
+    words and check's alike."""
+    urdf = tmp_path / "anymal.urdf"
+    side, sensor = 0.1, 0.02
+    urdf.write_text(f"""<?xml version="1.0"?>
+<robot name="anymal">
+  <link name="shell">
+    <visual><geometry><box size="{side} {side} {side}"/></geometry></visual>
+    <inertial><mass value="{side ** 3!r}"/><inertia ixx="{side ** 5 / 6!r}" ixy="0" ixz="0" iyy="{side ** 5 / 6!r}"
+      iyz="0" izz="{side ** 5 / 6!r}"/></inertial>
+  </link>
+  <link name="sensor">
+    <visual><geometry><box size="{sensor} {sensor} {sensor}"/></geometry></visual>
+    <inertial><mass value="1e-6"/><inertia ixx="{1e-6 * sensor ** 2 / 6!r}" ixy="0" ixz="0"
+      iyy="{1e-6 * sensor ** 2 / 6!r}" iyz="0" izz="{1e-6 * sensor ** 2 / 6!r}"/></inertial>
+  </link>
+  <joint name="sensor_joint" type="fixed"><parent link="shell"/><child link="sensor"/></joint>
+</robot>
+""", encoding="utf-8")
+    result = import_file(urdf, tmp_path / "recipe" / "robot.yaml")
+    assert list(result.repairs) == ["shell"]  # MeshLab's mass: computed at the recipe's density
+    body = "the rigid body it is welded to (sensor, shell: 1 kg, 0.001008 m^3) is 992.1 kg/m^3"
+    assert [w.split("anymal.urdf:8: ", 1)[-1] for w in result.warnings if "sensor" in w] == [
+        f"link 'sensor': the original's mass 1e-06 kg over its geometry's 8e-06 m^3 implies 0.125 kg/m^3, below 10; "
+        f"{body}: its mass is a share of that body's: kept (check warns of it)"]
+    out = build([result.recipe_path], tmp_path / "build")
+    assert not out.errors, out.errors
+    links, joints, _ = read_urdf_facts(next((tmp_path / "build" / result.robot).rglob("*.urdf")))
+    assert [(f.severity, f.subject, f.message) for f in lint(links, joints) if f.check == "implied-density"] == [
+        ("warning", "link 'sensor'", "implied density 0.125 kg/m^3 (mass 1e-06 kg, volume 8e-06 m^3) is below 10; "
+         f"{body}: its mass is a share of that body's")]
