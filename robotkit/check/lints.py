@@ -444,9 +444,8 @@ def _density_check(link: LinkFacts, body: RigidBody | None, s: str) -> list[Find
     found = implied_density(link.mass, volume, body)
     if found is None:
         return []
-    figure = f"{found.density:.3g}" if found.side == "below" else f"{found.density:.4g}"
     return [Finding(found.severity, "implied-density", s,
-                    f"implied density {figure} kg/m^3 (mass {link.mass:.4g} kg, volume {volume:.4g} m^3) is "
+                    f"implied density {found.figure} kg/m^3 (mass {link.mass:.4g} kg, volume {volume:.4g} m^3) is "
                     f"{found.side} {found.bound:g}{found.welded()}", WELDED_HINT if found.body else found.cause)]
 
 

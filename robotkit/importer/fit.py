@@ -102,8 +102,7 @@ def describe(fit: inertia_policy.BoxFit) -> str:
 
 def _said(found: Implied, mass: float, volume: float) -> str:
     """The import's words for check's implied-density verdict on the original's ``mass``."""
-    figure = f"{found.density:.3g}" if found.side == "below" else f"{found.density:.4g}"
-    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {figure} kg/m^3, "
+    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {found.figure} kg/m^3, "
             f"{found.side} {found.bound:g}" + (found.welded() if found.body else f" ({found.cause})"))
 
 

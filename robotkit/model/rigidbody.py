@@ -110,6 +110,11 @@ class Implied:
     body: RigidBody | None
 
     @property
+    def figure(self) -> str:
+        """The density as the messages print it (3 significant digits below the range, 4 above)."""
+        return f"{self.density:.3g}" if self.side == "below" else f"{self.density:.4g}"
+
+    @property
     def severity(self) -> str:
         return "warning" if self.body is not None else "error"
 
