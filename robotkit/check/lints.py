@@ -25,7 +25,8 @@ from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
 from robotkit.model.inertia_policy import equivalent_box
 from robotkit.model import massprops as mi
-from robotkit.model.plausible import DENSITY_RANGE, PART_SIZE_RANGE
+from robotkit.model.plausible import PART_SIZE_RANGE
+from robotkit.model.rigidbody import WELDED_HINT, Part, RigidBody, implied_density, rigid_bodies
 
 # thresholds (documented in docs/checks.md)
 MIN_MASS = 1e-6  # kg: sdformat drops lighter links (sdformat #199)
@@ -352,8 +353,9 @@ def _drivers(root) -> dict[str, str]:
 
 def lint(links: list[LinkFacts], joints: list[JointFacts], declared_mass: float | None = None) -> list[Finding]:
     out: list[Finding] = []
+    bodies = rigid_bodies_of(links, joints)
     for link in links:
-        out += lint_link(link)
+        out += lint_link(link, bodies.get(link.name))
     out += lint_joints(joints)
     out += lint_massless_moving(links, joints)
     if declared_mass is not None:
@@ -366,7 +368,9 @@ def lint(links: list[LinkFacts], joints: list[JointFacts], declared_mass: float 
     return out
 
 
-def lint_link(link: LinkFacts) -> list[Finding]:
+def lint_link(link: LinkFacts, body: RigidBody | None = None) -> list[Finding]:
+    """The rules on one link; ``body``: the rigid body it is welded to (:func:`rigid_bodies_of`),
+    on which its implied density is judged when its own is out of range (None: the link alone)."""
     out: list[Finding] = []
     s = f"link '{link.name}'"
 
@@ -410,19 +414,7 @@ def lint_link(link: LinkFacts) -> list[Finding]:
             add("error", "triangle-inequality", f"principal moments {a:.4g}, {b:.4g}, {c:.4g} violate "
                 "the triangle inequality (I1 + I2 >= I3): no real body has them", hint)
         return out
-    volume = link_volume(link)
-    if volume:
-        density = link.mass / volume
-        if density < DENSITY_RANGE[0]:
-            cause = ("the mass is the mesh volume at density 1, MeshLab's default"
-                     if abs(density - 1.0) < 0.05 else "the density or mass is far too low")
-            add("error", "implied-density", f"implied density {density:.3g} kg/m^3 (mass {link.mass:.4g} kg, "
-                f"volume {volume:.4g} m^3) is below {DENSITY_RANGE[0]:g}", cause)
-        elif density > DENSITY_RANGE[1]:
-            cause = ("the mass looks like grams written as kilograms" if density / 1000 < DENSITY_RANGE[1]
-                     else "the geometry is far too small for the mass (units?)")
-            add("error", "implied-density", f"implied density {density:.4g} kg/m^3 (mass {link.mass:.4g} kg, "
-                f"volume {volume:.4g} m^3) is above {DENSITY_RANGE[1]:g}", cause)
+    out += _density_check(link, body, s)
     geometry = _geometry_props(link)
     if geometry is not None:
         out += _box_check_geometry(link, geometry, s)
@@ -442,6 +434,28 @@ def lint_link(link: LinkFacts) -> list[Finding]:
         add("warning", "collision-volume", f"collision geometry has {col / vis:.3g}x the visual volume",
             "the collision proxy is far from the visual shape")
     return out
+
+
+def _density_check(link: LinkFacts, body: RigidBody | None, s: str) -> list[Finding]:
+    """The implied-density rule (robotkit.model.rigidbody.implied_density, which the import's
+    density warning follows too): an error when the link's density is out of range, a warning when
+    the rigid body it is welded to is in range."""
+    volume = link_volume(link)
+    found = implied_density(link.mass, volume, body)
+    if found is None:
+        return []
+    return [Finding(found.severity, "implied-density", s,
+                    f"implied density {found.figure} kg/m^3 (mass {link.mass:.4g} kg, volume {volume:.4g} m^3) is "
+                    f"{found.side} {found.bound:g}{found.welded()}", WELDED_HINT if found.body else found.cause)]
+
+
+def rigid_bodies_of(links: list[LinkFacts], joints: list[JointFacts]) -> dict[str, RigidBody]:
+    """The rigid body each link belongs to (robotkit.model.rigidbody.rigid_bodies): the links
+    welded to it by fixed joints, with the volumes :func:`link_volume` reads."""
+    parts = {link.name: Part(link.mass, link_volume(link),
+                             bool(link.unread or link.shape("visual") or link.shape("collision")))
+             for link in links}
+    return rigid_bodies(parts, [(j.parent, j.child) for j in joints if j.type == "fixed"])
 
 
 def _volume(geoms: list[GeomFacts]) -> float | None:

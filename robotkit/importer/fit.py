@@ -20,8 +20,8 @@ from robotkit.mesh.inertia import density_volume, solid_as_written
 from robotkit.mesh.io import load_mesh
 from robotkit.model import inertia_policy
 from robotkit.model import massprops
-from robotkit.model.plausible import DENSITY_RANGE
 from robotkit.model.resolve import geom_mass_props
+from robotkit.model.rigidbody import MESHLAB, Implied, Part, RigidBody, implied_density, rigid_bodies
 
 
 _FACTS: dict[tuple, dict] = {}
@@ -100,29 +100,10 @@ def describe(fit: inertia_policy.BoxFit) -> str:
             f"than {than} ({sides[1]} m), along {fit.axes}")
 
 
-MESHLAB = "the mass is the mesh volume at density 1, MeshLab's default"
-
-
-def _too_light(mass: float, volume: float | None) -> str | None:
-    """Why ``mass`` over the closed ``volume`` is no solid part (check's implied-density rule, below
-    its range), else None."""
-    if not volume or mass / volume >= DENSITY_RANGE[0]:
-        return None
-    density = mass / volume
-    cause = MESHLAB if abs(density - 1.0) < 0.05 else "the density or mass is far too low"
-    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {density:.3g} kg/m^3, "
-            f"below {DENSITY_RANGE[0]:g} ({cause})")
-
-
-def _too_heavy(mass: float, volume: float | None) -> str | None:
-    """Why ``mass`` over the closed ``volume`` is denser than any solid part (check's rule), else None."""
-    if not volume or mass / volume <= DENSITY_RANGE[1]:
-        return None
-    density = mass / volume
-    cause = ("the mass looks like grams written as kilograms" if density / 1000 < DENSITY_RANGE[1]
-             else "the geometry is far too small for the mass (units?)")
-    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {density:.4g} kg/m^3, "
-            f"above {DENSITY_RANGE[1]:g} ({cause})")
+def _said(found: Implied, mass: float, volume: float) -> str:
+    """The import's words for check's implied-density verdict on the original's ``mass``."""
+    return (f"the original's mass {mass:.4g} kg over its geometry's {volume:.4g} m^3 implies {found.figure} kg/m^3, "
+            f"{found.side} {found.bound:g}" + (found.welded() if found.body else f" ({found.cause})"))
 
 
 _WRITTEN: dict[tuple, tuple[float | None, float]] = {}
@@ -144,17 +125,54 @@ def _as_written(geom) -> tuple[float | None, float]:
     return _WRITTEN[key]
 
 
-def _check_volume(link) -> float | None:
-    """The volume check judges a link's density on (robotkit.mesh.inertia.density_volume, check's
-    rule): its visual geometry's when closed as written, else its collision geometry's when so
-    (ANYmal B's base: a placeholder 1e-6 kg on an open mesh and closed boxes; G1's ankle roll links:
-    a visual mesh that robotkit's repair would close, open as written), else None.  A role whose
-    geometry is no larger than a marker shows no part."""
+def _shown(link) -> tuple[list, list]:
+    """The volumes (None: open as written) of the parts the link's visual and collision geometry
+    show, as check reads them; a role whose geometry is no larger than a marker shows no part."""
     shown = []
     for geoms in (link.visuals, link.collisions):
         parts = [_as_written(g) for g in geoms]
         shown.append([v for v, _ in parts] if parts and max(size for _, size in parts) > MARKER else [])
-    return density_volume(*shown)
+    return shown[0], shown[1]
+
+
+def _check_volume(link) -> float | None:
+    """The volume check judges a link's density on (robotkit.mesh.inertia.density_volume, check's
+    rule): its visual geometry's when closed as written, else its collision geometry's when so
+    (ANYmal B's base: a placeholder 1e-6 kg on an open mesh and closed boxes; G1's ankle roll links:
+    a visual mesh that robotkit's repair would close, open as written), else None."""
+    return density_volume(*_shown(link))
+
+
+def _recipe_mass(link) -> float | None:
+    """The mass the build gives a link of the imported recipe (None: no inertial)."""
+    spec = link.inertial_spec
+    if spec.mode == "explicit":
+        return spec.explicit.mass
+    if spec.mode in ("mass", "estimate"):
+        return spec.mass
+    if spec.mode == "density" and link.source_geoms():
+        facts = {g.shape.mesh.key: _facts(g.shape.mesh) for g in link.source_geoms() if g.shape.kind == "mesh"}
+        return spec.density * sum(geom_mass_props(g, facts)[0] for g in link.source_geoms())
+    return None
+
+
+def rigid_bodies_of(robot) -> dict[str, RigidBody]:
+    """The rigid body each link of the recipe belongs to, as check will read the build
+    (robotkit.model.rigidbody.rigid_bodies; check's robotkit.check.lints.rigid_bodies_of)."""
+    parts = {}
+    for link in robot.links:
+        visual, collision = _shown(link)
+        parts[link.name] = Part(_recipe_mass(link), density_volume(visual, collision), bool(visual or collision))
+    return rigid_bodies(parts, [(j.parent, j.child) for j in robot.joints if j.type == "fixed"])
+
+
+def _density(link, mass: float, bodies) -> tuple[Implied, float] | None:
+    """Check's implied-density verdict on the original's ``mass`` with the volume check reads
+    (judged on the link's rigid body, ``bodies()``, when its own is out of range), else None."""
+    judged = _check_volume(link)  # check's volume, which may differ from the repaired geometry's
+    if implied_density(mass, judged) is None:
+        return None
+    return implied_density(mass, judged, bodies()[link.name]), judged
 
 
 def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str, tuple[str, str]], dict[str, str]]:
@@ -165,6 +183,13 @@ def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str
     tensor from the geometry at the recipe's density); another too light or too heavy for its
     volume is kept (the geometry may be what is wrong)."""
     overrides, kept = {}, {}
+    cache: list = []
+
+    def bodies() -> dict[str, RigidBody]:  # read only when a link's own density is out of range
+        if not cache:
+            cache.append(rigid_bodies_of(robot))
+        return cache[0]
+
     for link in robot.links:
         given = explicit.get(link.name)
         spec = link.inertial_spec
@@ -172,17 +197,18 @@ def misfits(robot, explicit: dict[str, dict], recompute: bool) -> tuple[dict[str
             continue  # no given mass, or one the recipe no longer keeps (computed at its density)
         found = link_fit(link)  # None when the link's inertial is no longer explicit (repaired, estimated)
         volume = found[1] if found else None
-        judged = _check_volume(link)  # check's volume, which may differ from the repaired geometry's
-        heavy = _too_heavy(given["mass"], judged)
-        if heavy:  # a placeholder mass on a marker, or a part drawn smaller than it is: no one reading
-            kept[link.name] = f"{heavy}: kept (check reports it)"
-        light = _too_light(given["mass"], judged)
-        if light and recompute and volume and MESHLAB in light:  # the one obvious reading: MeshLab's volume as the mass
-            overrides[link.name] = ("density", light)
-            continue
-        if light:  # else the geometry may be what is wrong (simple_humanoid's 4 m^3 body of 27 kg)
-            kept[link.name] = (f"{light}; compute it from the geometry at the recipe's density (no inertial "
-                               "on the link in the recipe)" if MESHLAB in light else f"{light}: kept (check reports it)")
+        density = _density(link, given["mass"], bodies)
+        if density is not None:
+            verdict, judged = density
+            said = _said(verdict, given["mass"], judged)
+            if recompute and volume and verdict.cause == MESHLAB:  # the one obvious reading: MeshLab's volume as the mass
+                overrides[link.name] = ("density", said)
+                continue
+            # too heavy: a placeholder mass on a marker, or a part drawn smaller than it is; too light:
+            # the geometry may be what is wrong (simple_humanoid's 4 m^3 body of 27 kg); no one reading
+            kept[link.name] = (f"{said}; compute it from the geometry at the recipe's density (no inertial on the "
+                               "link in the recipe)" if verdict.cause == MESHLAB
+                               else f"{said}: kept (check {'warns of' if verdict.body else 'reports'} it)")
         if found is None or found[0].severity != "error":
             continue
         fit = found[0]
