@@ -55,15 +55,16 @@ class MeshResolver:
             return m.group(2)
         return None
 
-    def locate(self, uri: str, link: str, problems: Problems) -> str | None:
-        """Absolute path of the file ``uri`` names, or None with a problem."""
+    def locate(self, uri: str, link: str, problems: Problems, line: int | None = None) -> str | None:
+        """Absolute path of the file ``uri`` names, or None with a problem (at the naming element's
+        ``line``)."""
         path = None
         m = re.match(r"^(package|model):///?([^/]+)/(.+)$", uri)  # package:///PKG/: Pinocchio's reading
         if m:
             pkg, rest = m.group(2), m.group(3)
             if pkg not in self.packages:
                 problems.add(f"link '{link}': mesh '{uri}': package '{pkg}' not found; "
-                             f"give --package-path {pkg}=DIR")
+                             f"give --package-path {pkg}=DIR", line)
                 return None
             path = os.path.join(self.packages[pkg], rest)
         elif uri.startswith("file://"):
@@ -72,16 +73,16 @@ class MeshResolver:
                 path = os.path.join(self.source.parent, path)
         elif re.match(r"^[A-Za-z][A-Za-z0-9+.\-]*://", uri):
             problems.add(f"link '{link}': mesh '{uri}': unsupported URI scheme "
-                         "(use package://, file:// or a path)")
+                         "(use package://, file:// or a path)", line)
             return None
         else:
             path = uri if os.path.isabs(uri) else os.path.join(self.source.parent, uri)
         path = os.path.normpath(path)
         if not os.path.isfile(path):
-            problems.add(f"link '{link}': mesh '{uri}' not found (looked for {display_path(path)})")
+            problems.add(f"link '{link}': mesh '{uri}' not found (looked for {display_path(path)})", line)
             return None
         if os.path.splitext(path)[1].lower() not in MESH_FORMATS:
-            problems.add(f"link '{link}': mesh '{uri}' has an unsupported format (robotkit reads STL, OBJ and DAE)")
+            problems.add(f"link '{link}': mesh '{uri}' has an unsupported format (robotkit reads STL, OBJ and DAE)", line)
             return None
         return path
 

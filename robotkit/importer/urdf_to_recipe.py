@@ -443,7 +443,7 @@ def _mesh(shape, what: str, link: str, use: tuple[str, str, int], r: _Reading) -
     if not uri:
         r.problems.add(f"{what}: <mesh> has no filename")
         return None
-    path = r.resolver.locate(uri, link, r.problems)
+    path = r.resolver.locate(uri, link, r.problems, r.line(shape))
     scale = read_floats(shape.get("scale"), 3, f"{what} mesh scale", r.problems, [1.0, 1.0, 1.0])
     if path is None:
         return None

@@ -847,9 +847,9 @@ def test_missing_mesh_package_and_file(tmp_path, monkeypatch):
     with pytest.raises(RobotkitError) as info:
         import_file(src, tmp_path / "r.yaml", {"pkg": str(tmp_path / "pkg")}, {})
     assert info.value.lines() == [
-        "robot.urdf: link 'base': mesh 'package://foo/meshes/a.stl': package 'foo' not found; "
+        "robot.urdf:3: link 'base': mesh 'package://foo/meshes/a.stl': package 'foo' not found; "
         "give --package-path foo=DIR",
-        "robot.urdf: link 'base': mesh 'package://pkg/meshes/missing.stl' not found "
+        "robot.urdf:4: link 'base': mesh 'package://pkg/meshes/missing.stl' not found "
         "(looked for pkg/meshes/missing.stl)",
     ]
     assert not (tmp_path / "r.yaml").exists()
