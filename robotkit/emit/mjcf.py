@@ -14,11 +14,13 @@ import os
 
 import numpy as np
 
+from robotkit import mj
 from robotkit.emit import layout
 from robotkit.emit.controllers import joints_phrase
 from robotkit.emit.env import render
 from robotkit.geometry import rpy_quat
 from robotkit.emit.formats import Format, Limit
+from robotkit.errors import Problem, RecipeError
 from robotkit.emit.meshfiles import collision_file, conversions, visual_file
 from robotkit.emit.sdf import extras_losses
 from robotkit.emit.sensors import losses as sensor_losses
@@ -76,6 +78,46 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     # urdf_extras are the URDF's and Gazebo's own vocabulary (<gazebo>, <transmission>), which
     # MuJoCo does not read: a limit of the format (report.json), not a warning
     return out + [Limit(x) for x in extras_losses(robot, "the MJCF")] + sensor_losses(robot)["mjcf"]
+
+
+def mjcf_extras_losses(robot: Robot, where: str) -> list[str]:
+    """``mjcf_extras`` go into the MJCF only: what ``where`` (another format) does not get."""
+    if not robot.mjcf_extras:
+        return []
+    parts = [f"<{tag}> ({len(sec['children'])} element{'s' * (len(sec['children']) != 1)})" if sec["children"]
+             else f"<{tag}>" for tag, sec in extras_sections(robot).items()]
+    return [Limit(f"mjcf_extras {', '.join(parts)} are in the MJCF only, not in {where}")]
+
+
+def extras_sections(robot: Robot) -> dict[str, dict]:
+    """The ``mjcf_extras`` by section: its children (XML text, two levels indented) and attributes."""
+    import xml.etree.ElementTree as ET
+
+    out: dict[str, dict] = {}
+    for text in robot.mjcf_extras:
+        element = ET.fromstring(text)
+        section = out.setdefault(element.tag, {"attrs": {}, "children": []})
+        section["attrs"].update(element.attrib)
+        for child in element:
+            child.tail = None
+            ET.indent(child, "  ", level=2)
+            section["children"].append(ET.tostring(child, encoding="unicode").replace(" />", "/>"))
+    return out
+
+
+def refusal(xml: str) -> str | None:
+    """Why MuJoCo refuses the MJCF ``xml`` (None: it loads it), each mesh a tetrahedron in place
+    of its file (the build checks the MJCF before its meshes are read)."""
+    mujoco = mj.load()
+    try:
+        spec = mujoco.MjSpec.from_string(xml)
+        for mesh in spec.meshes:
+            mesh.file = ""
+            mesh.uservert = [0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]
+        spec.compile()
+    except ValueError as exc:
+        return " ".join(str(exc).replace("Error: ", "", 1).split())
+    return None
 
 
 def _geom(robot: Robot, geom: Geom, name: str, assets: dict, role: str = "visual") -> dict:
@@ -165,6 +207,7 @@ def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str
             site["size"], site["pos"] = _touch_volume(link)
     c = link.contact
     friction = c.mu1 if c is not None else None
+    sites = extras["sites"] + frame_site(link, joint, sens)
     return {
         "name": name,
         "pos": joint.origin.xyz if joint is not None else (0.0, 0.0, 0.0),
@@ -177,8 +220,21 @@ def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str
                        for i, g in enumerate(link.collisions_for("mjcf"))],
         "children": children,
         "cameras": extras["cameras"],
-        "sites": extras["sites"],
+        "sites": sites,
     }
+
+
+def frame_site(link, joint, sens: dict) -> list[dict]:
+    """A site of the link's name at its body's origin when the link is a frame (no mass, no shape,
+    fixed to its parent): what an MJCF site was (robotkit.importer.mjcf.sites), so that tendons,
+    sensors and actuators of ``mjcf_extras`` name it as they named the site.  None when a sensor's
+    site has that name already."""
+    if (link.inertial is not None or link.visuals or link.collisions_for("mjcf") or joint is None
+            or joint.type != "fixed"):
+        return []
+    if "site_names" not in sens:
+        sens["site_names"] = {s["name"] for b in sens["bodies"].values() for s in b["sites"]}
+    return [] if link.name in sens["site_names"] else [{"name": link.name, "frame": True}]
 
 
 def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list[dict], list[dict]]:
@@ -298,7 +354,8 @@ def context(robot: Robot, lift: float = 0.0, lift_at=None) -> dict:
     return {"robot": robot, "collide": collide, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "keys": keys,
             "assets": sorted(assets.values(), key=lambda a: a["name"]),
             "materials": robot.materials, "world_geoms": world_geoms, "tree": tree,
-            "equalities": equalities, "cone": "elliptic" if _high_friction(robot) else None}
+            "equalities": equalities, "cone": "elliptic" if _high_friction(robot) else None,
+            "extras": extras_sections(robot)}
 
 
 def _high_friction(robot: Robot) -> bool:
@@ -415,7 +472,11 @@ def render_mjcf(robot: Robot, points: dict[str, np.ndarray] | None = None) -> st
         # up to the next micrometre: never inside the floor, and no float32 noise in the file
         return math.ceil(-low * 1e6) / 1e6 if low is not None else 0.0
 
-    return render("mjcf/robot.xml.j2", **context(robot, lift=lift_at(), lift_at=lift_at))
+    xml = render("mjcf/robot.xml.j2", **context(robot, lift=lift_at(), lift_at=lift_at))
+    why = refusal(xml) if robot.mjcf_extras else None
+    if why is not None:
+        raise RecipeError(Problem(f"MuJoCo refuses the MJCF with these elements: {why}", key="mjcf_extras"))
+    return xml
 
 
 def floor_height(robot: Robot, points: dict[str, np.ndarray] | None = None) -> float:

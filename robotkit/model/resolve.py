@@ -165,7 +165,7 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None, moveit: bool = False) 
         raise RecipeError(cx.problems)
     return Robot(r.robot, tuple(links), tuple(joints), materials, _metadata(r.metadata), r.self_collide,
                  tuple(r.urdf_extras), tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base, tuple(poses),
-                 self_collision=collision, moveit=r.moveit or moveit)
+                 self_collision=collision, moveit=r.moveit or moveit, mjcf_extras=tuple(r.mjcf_extras))
 
 
 def _safe_name(src: str) -> str:

@@ -301,6 +301,7 @@ class Robot:
     self_collision: Settings = Settings()
     collision_matrix: Matrix | None = None  # once the build has sampled it (robotkit.model.selfcollision)
     moveit: bool = False  # write the MoveIt 2 configuration (robotkit.emit.moveit)
+    mjcf_extras: tuple[str, ...] = ()  # MJCF section elements, verbatim (robotkit.emit.mjcf)
 
     def home(self) -> NamedPose | None:
         """The pose the robot starts in: ``home``, else the first pose, else None (all zero)."""
