@@ -350,12 +350,15 @@ def context(robot: Robot, lift: float = 0.0, lift_at=None) -> dict:
                    "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
                   for j in robot.joints if j.mimic is not None]
     collide, excludes = self_contacts(robot)
-    keys = keyframes(robot, tree, actuators, lift_at or (lambda values: lift))
+    extras = extras_sections(robot)
+    more = len(extras.get("actuator", {}).get("children", []))  # the extras' actuators: ctrl 0 at every keyframe
+    keys = [dict(k, ctrl=k["ctrl"] + (0.0,) * more if k["ctrl"] else ())
+            for k in keyframes(robot, tree, actuators, lift_at or (lambda values: lift))]
     return {"robot": robot, "collide": collide, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "keys": keys,
             "assets": sorted(assets.values(), key=lambda a: a["name"]),
             "materials": robot.materials, "world_geoms": world_geoms, "tree": tree,
             "equalities": equalities, "cone": "elliptic" if _high_friction(robot) else None,
-            "extras": extras_sections(robot)}
+            "extras": extras}
 
 
 def _high_friction(robot: Robot) -> bool:

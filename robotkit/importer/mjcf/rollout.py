@@ -54,7 +54,7 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
     for e in range(om.neq):
         if e not in equalities:
             om.eq_active0[e] = 0
-        elif tree.mimics[e] in rebuilt_eq:  # its softness: the rebuilt's (MuJoCo's defaults)
+        elif e in tree.mimics and tree.mimics[e] in rebuilt_eq:  # its softness: the rebuilt's (MuJoCo's defaults)
             r = rebuilt_eq[tree.mimics[e]]
             om.eq_solref[e], om.eq_solimp[e] = rm.eq_solref[r], rm.eq_solimp[r]
     om.jnt_stiffness[:] = 0
@@ -64,9 +64,10 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
             d, e = int(om.jnt_dofadr[j]), int(rm.jnt_dofadr[r])
             om.jnt_solref[j], om.jnt_solimp[j], om.jnt_margin[j] = rm.jnt_solref[r], rm.jnt_solimp[r], rm.jnt_margin[r]
             om.dof_solref[d], om.dof_solimp[d] = rm.dof_solref[e], rm.dof_solimp[e]
+    dropped = [t for t in range(om.ntendon) if t not in tree.verbatim.get("tendon", {})]  # the others are verbatim
     for field in ("tendon_stiffness", "tendon_damping", "tendon_frictionloss", "tendon_limited"):
         if hasattr(om, field):
-            getattr(om, field)[:] = 0
+            getattr(om, field)[dropped] = 0
     for a in range(om.nu):
         if a not in kept:
             om.actuator_gainprm[a][:] = 0

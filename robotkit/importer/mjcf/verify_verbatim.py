@@ -1,0 +1,93 @@
+"""The verification of what the import kept verbatim (``mjcf_extras``:
+:mod:`robotkit.importer.mjcf.verbatim`; ``tree.verbatim``: {kind: {original id: rebuilt name}}),
+the rebuilt model against the original, both at the same configuration: each kept tendon's length;
+each kept sensor's reading; each kept connect or weld constraint's two anchor points in the world
+(the bodies' frames moved to their links' in the rebuild) and its relative orientation, each joint
+or tendon coupling's coefficients; each kept actuator's types, gains, bias, dynamics, gear and
+ranges; the counts.  ``check(kind, error, where)`` records each comparison."""
+
+from __future__ import annotations
+
+import numpy as np
+
+CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
+SITE = 6  # mjOBJ_SITE
+
+
+def counts(check, om, rm, tree) -> None:
+    kept = tree.verbatim.get("tendon", {})
+    check("tendon", float(rm.ntendon != len(kept)),
+          f"tendon count: {rm.ntendon} rebuilt, {len(kept)} kept of the original's {om.ntendon}")
+    kept = tree.verbatim.get("sensor", {})
+    imus = len(tree.kept_sensors)
+    check("sensor", float(rm.nsensor != len(kept) + imus),
+          f"sensor count: {rm.nsensor} rebuilt, {len(kept) + imus} kept of the original's {om.nsensor}")
+
+
+def actuators(check, om, rm, tree) -> dict[int, int]:
+    """Each verbatim actuator as the original's: {original id: rebuilt id}."""
+    out = {}
+    for a, name in tree.verbatim.get("actuator", {}).items():
+        r = rm.actuator(name).id
+        out[a] = r
+        where = f"actuator '{om.actuator(a).name or name}'"
+        types = [(int(m.actuator_trntype[i]), int(m.actuator_gaintype[i]), int(m.actuator_biastype[i]),
+                  int(m.actuator_dyntype[i])) for m, i in ((om, a), (rm, r))]
+        check("actuator", float(types[0] != types[1]), f"{where} transmission, gain, bias and dynamics types")
+        mine, theirs = (np.concatenate([m.actuator_gainprm[i], m.actuator_biasprm[i], m.actuator_dynprm[i],
+                                        m.actuator_gear[i], m.actuator_ctrlrange[i], m.actuator_forcerange[i]])
+                        for m, i in ((om, a), (rm, r)))
+        check("actuator", float(np.abs(mine - theirs).max() / max(np.abs(mine).max(), 1e-300)),
+              f"{where} gains, bias, dynamics, gear and ranges")
+    return out
+
+
+def equalities(check, om, rm, tree) -> set[int]:
+    """Each verbatim joint or tendon coupling's coefficients and every kept constraint's
+    softness and state; the original's verbatim equalities."""
+    kept = tree.verbatim.get("equality", {})
+    for e, name in kept.items():
+        r = rm.eq(name).id
+        where = f"equality '{om.eq(e).name or name}'"
+        same = [int(om.eq_type[e]) == int(rm.eq_type[r]), bool(om.eq_active0[e]) == bool(rm.eq_active0[r])]
+        check("equality", float(not all(same)), f"{where} type and state")
+        mine = np.concatenate([om.eq_solref[e], om.eq_solimp[e]] + ([om.eq_data[e][:5]] if om.eq_type[e] in (JOINT, TENDON) else []))
+        theirs = np.concatenate([rm.eq_solref[r], rm.eq_solimp[r]] + ([rm.eq_data[r][:5]] if om.eq_type[e] in (JOINT, TENDON) else []))
+        check("equality", float(np.abs(mine - theirs).max() / max(np.abs(mine).max(), 1e-300)),
+              f"{where} softness and coefficients")
+    return set(kept)
+
+
+def at_configuration(check, om, od, rm, rd, tree, label: str) -> None:
+    """The tendons' lengths, the sensors' readings and the loops' anchors, both models at rest at
+    the same configuration (``mj_forward`` done)."""
+    for t, name in tree.verbatim.get("tendon", {}).items():
+        r = rm.tendon(name).id
+        check("tendon", abs(float(od.ten_length[t]) - float(rd.ten_length[r])), f"tendon '{name}' length at {label}")
+    for s, name in tree.verbatim.get("sensor", {}).items():
+        r = rm.sensor(name).id
+        a, b = int(om.sensor_adr[s]), int(rm.sensor_adr[r])
+        dim = int(om.sensor_dim[s])
+        mine, theirs = od.sensordata[a:a + dim], rd.sensordata[b:b + dim]
+        scale = max(float(np.abs(mine).max()), 1.0)
+        check("sensor", float(np.abs(mine - theirs).max()) / scale, f"sensor '{name}' at {label}")
+    for e, name in tree.verbatim.get("equality", {}).items():
+        if int(om.eq_type[e]) in (CONNECT, WELD) and int(om.eq_objtype[e]) != SITE:
+            r = rm.eq(name).id
+            err = max(np.abs(po - pr).max() for po, pr in zip(_anchors(om, od, e), _anchors(rm, rd, r)))
+            check("pose", float(err), f"equality '{om.eq(e).name or name}' anchors at {label}")
+
+
+def _anchors(m, d, e: int) -> list[np.ndarray]:
+    """A body connect's or weld's two points in the world (a weld's: and body1's frame turned by its
+    relative orientation, against body2's)."""
+    b1, b2, data = int(m.eq_obj1id[e]), int(m.eq_obj2id[e]), m.eq_data[e]
+    R1, R2 = d.xmat[b1].reshape(3, 3), d.xmat[b2].reshape(3, 3)
+    if int(m.eq_type[e]) == CONNECT:
+        return [d.xpos[b1] + R1 @ data[:3], d.xpos[b2] + R2 @ data[3:6]]
+    q = np.asarray(data[6:10], float)
+    w, x, y, z = q / np.linalg.norm(q)
+    Rq = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                   [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                   [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    return [d.xpos[b1] + R1 @ data[3:6], d.xpos[b2] + R2 @ data[:3], (R1 @ Rq).ravel()]
