@@ -84,7 +84,8 @@ def _controls(om, rm, kept: dict[int, int], rng) -> list[tuple[np.ndarray, np.nd
             lo, hi = om.actuator_ctrlrange[a] if om.actuator_ctrllimited[a] else (-1.0, 1.0)
             uo[a] = rng.uniform(lo, hi)
             motor = int(om.actuator_biastype[a]) == 0
-            ur[r] = uo[a] * float(om.actuator_gear[a][0]) / float(rm.actuator_gear[r][0]) if motor else uo[a]
+            same = om.actuator_gear[a][0] == rm.actuator_gear[r][0]  # a verbatim actuator's (its gear may be 0)
+            ur[r] = uo[a] * float(om.actuator_gear[a][0]) / float(rm.actuator_gear[r][0]) if motor and not same else uo[a]
         out.append((uo, ur))
     return out
 

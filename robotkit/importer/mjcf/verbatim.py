@@ -19,6 +19,9 @@ import numpy as np
 
 from robotkit import mj
 from robotkit.importer.mjcf.extras import EQ_KINDS, SOLIMP, SOLREF
+from robotkit.importer.mjcf.frames import origin
+from robotkit.importer.mjcf.sites import free_name
+from robotkit.importer.names import valid_frame_name
 from robotkit.importer.recipe_writer import fmt
 
 KEPT = "dropped: {why} (kept verbatim in mjcf_extras for the MJCF)"
@@ -49,7 +52,7 @@ class Names:
     """The rebuilt model's name of each element an extra names."""
 
     def __init__(self, src, tree, recipe: dict):
-        self.m, self.tree = src.model, tree
+        self.m, self.tree, self._zero = src.model, tree, None
         self.actuators = {a: f"{joint}_{recipe['actuators'][joint]['interface']}" for a, joint in tree.actuated.items()}
         self.taken = {"actuator": set(self.actuators.values()),
                       "sensor": {f"{n}_{s}" for n in recipe.get("sensors", {}) for s in ("gyro", "accel")},
@@ -74,6 +77,43 @@ class Names:
 
     def offset(self, b: int) -> np.ndarray:
         return np.zeros(3) if b == 0 else np.asarray(self.tree.offset[b], float)
+
+    def same_at_zero(self, e: int) -> bool:
+        """Whether a body connect's point in body2 (where MuJoCo found body1's point at the
+        original's ``qpos0``) is where the rebuild finds it, at its zero configuration (hinges and
+        slides at 0: not at a ``ref`` of theirs)."""
+        m = self.m
+        if self._zero is None:
+            mujoco = mj.load()
+            self._zero = mujoco.MjData(m)
+            q = np.array(m.qpos0)
+            for j in range(m.njnt):
+                if int(m.jnt_type[j]) in HINGE_SLIDE:
+                    q[int(m.jnt_qposadr[j])] = 0.0
+            self._zero.qpos[:] = q
+            mujoco.mj_kinematics(m, self._zero)
+        d, a, b, data = self._zero, int(m.eq_obj1id[e]), int(m.eq_obj2id[e]), m.eq_data[e]
+        point = d.xpos[a] + d.xmat[a].reshape(3, 3) @ data[:3]
+        there = d.xmat[b].reshape(3, 3).T @ (point - d.xpos[b])
+        return bool(np.abs(there - data[3:6]).max() <= 1e-12)
+
+    def anchor(self, e: int, b: int, point, k: int) -> str:
+        """A frame link at a connect constraint's ``point`` in body ``b``'s frame (a site of the
+        rebuilt MJCF), the ``k``-th of its two."""
+        if b not in self.tree.link_of:
+            raise Dropped("an anchor on the world, and the robot has no world link")
+        eq = self.m.eq(e).name
+        base = f"{eq if valid_frame_name(eq) else f'loop{e}'}_anchor{k}"
+        name = free_name(self.tree, base)
+        joint = free_name(self.tree, f"{name}_fixed", self.tree.joints)
+        self.tree.links[name] = {}
+        self.tree.joints[joint] = {"type": "fixed", "parent": self.tree.link_of[b], "child": name}
+        o = origin(np.asarray(point, float) - self.offset(b), np.eye(3))
+        if o:
+            self.tree.joints[joint]["origin"] = o
+        self.tree.notes[joint] = (f"an anchor of MJCF connect constraint {f'{eq!r}' if eq else f'#{e}'} (a site of the "
+                                  "rebuilt MJCF, which mjcf_extras constrains)")
+        return name
 
     def joint(self, j: int) -> str:
         if int(self.m.jnt_type[j]) not in HINGE_SLIDE:
@@ -296,7 +336,9 @@ def _equality_target(m, e: int, kind: str | None, names: Names) -> dict:
     if kind in ("connect", "weld") and sites:
         out = {"site1": names.site(a), "site2": names.site(b)}
         return out if kind == "connect" else {**out, "torquescale": fmt(data[10])}
-    if kind == "connect":  # the anchor in body1's frame
+    if kind == "connect" and not names.same_at_zero(e):  # two frame links at its two points, as sites
+        return {"site1": names.anchor(e, a, data[:3], 1), "site2": names.anchor(e, b, data[3:6], 2)}
+    if kind == "connect":  # the anchor in body1's frame (MuJoCo finds it in body2's at the zero configuration)
         return {"body1": names.body(a), "body2": names.body(b), "anchor": _numbers(data[:3] - names.offset(a), 3)}
     if kind == "weld":  # the anchor in body2's frame; body2's pose in body1's
         pose = np.concatenate([data[3:6] - names.offset(a), data[6:10]])
@@ -316,7 +358,8 @@ def _sensors(src, tree, names: Names):
             return None
         tag = enums.mjtSensor(int(m.sensor_type[i])).name.removeprefix("mjSENS_").lower()
         tag = {"jointactfrc": "jointactuatorfrc", "tendonactfrc": "tendonactuatorfrc"}.get(tag, tag)
-        attrs = {"name": names.own("sensor", i), **_sensor_target(m, i, tag, names)}
+        target = _sensor_target(m, i, tag, names)
+        attrs = {"name": names.own("sensor", i), **target}
         if float(m.sensor_noise[i]):
             attrs["noise"] = fmt(m.sensor_noise[i])
         if float(m.sensor_cutoff[i]):

@@ -74,7 +74,8 @@ def at_configuration(check, om, od, rm, rd, tree, label: str) -> None:
     for e, name in tree.verbatim.get("equality", {}).items():
         if int(om.eq_type[e]) in (CONNECT, WELD) and int(om.eq_objtype[e]) != SITE:
             r = rm.eq(name).id
-            err = max(np.abs(po - pr).max() for po, pr in zip(_anchors(om, od, e), _anchors(rm, rd, r)))
+            points = zip(_anchors(om, od, e), _anchors(rm, rd, r))  # a weld's orientation only if both have one
+            err = max(np.abs(po - pr).max() for po, pr in points)
             check("pose", float(err), f"equality '{om.eq(e).name or name}' anchors at {label}")
 
 
@@ -82,6 +83,8 @@ def _anchors(m, d, e: int) -> list[np.ndarray]:
     """A body connect's or weld's two points in the world (a weld's: and body1's frame turned by its
     relative orientation, against body2's)."""
     b1, b2, data = int(m.eq_obj1id[e]), int(m.eq_obj2id[e]), m.eq_data[e]
+    if int(m.eq_objtype[e]) == SITE:  # a connect between frame links' sites (robotkit.importer.mjcf.verbatim)
+        return [d.site_xpos[b1], d.site_xpos[b2]]
     R1, R2 = d.xmat[b1].reshape(3, 3), d.xmat[b2].reshape(3, 3)
     if int(m.eq_type[e]) == CONNECT:
         return [d.xpos[b1] + R1 @ data[:3], d.xpos[b2] + R2 @ data[3:6]]
