@@ -207,7 +207,6 @@ def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str
             site["size"], site["pos"] = _touch_volume(link)
     c = link.contact
     friction = c.mu1 if c is not None else None
-    sites = extras["sites"] + frame_site(link, joint, sens)
     return {
         "name": name,
         "pos": joint.origin.xyz if joint is not None else (0.0, 0.0, 0.0),
@@ -220,21 +219,25 @@ def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str
                        for i, g in enumerate(link.collisions_for("mjcf"))],
         "children": children,
         "cameras": extras["cameras"],
-        "sites": sites,
+        "sites": extras["sites"],
     }
 
 
-def frame_site(link, joint, sens: dict) -> list[dict]:
-    """A site of the link's name at its body's origin when the link is a frame (no mass, no shape,
-    fixed to its parent): what an MJCF site was (robotkit.importer.mjcf.sites), so that tendons,
-    sensors and actuators of ``mjcf_extras`` name it as they named the site.  None when a sensor's
-    site has that name already."""
-    if (link.inertial is not None or link.visuals or link.collisions_for("mjcf") or joint is None
-            or joint.type != "fixed"):
-        return []
+def frame_sites(links: dict, parent_joint: dict, children: list[str], sens: dict) -> list[dict]:
+    """A site of each child link that is a frame (no mass, no shape, fixed to this one), of its
+    name, at its pose, in this body: what an MJCF site was (robotkit.importer.mjcf.sites), in the
+    body that carries it, so that tendons, sensors, actuators and constraints of ``mjcf_extras``
+    name it and act on that body as they did on the site's.  None where a sensor's site has that
+    name already."""
     if "site_names" not in sens:
         sens["site_names"] = {s["name"] for b in sens["bodies"].values() for s in b["sites"]}
-    return [] if link.name in sens["site_names"] else [{"name": link.name, "frame": True}]
+    out = []
+    for name in children:
+        link, joint = links[name], parent_joint[name]
+        if (link.inertial is None and not link.visuals and not link.collisions_for("mjcf") and joint.type == "fixed"
+                and name not in sens["site_names"]):
+            out.append({"name": name, "frame": True, "pos": joint.origin.xyz, "quat": rpy_quat(joint.origin.rpy)})
+    return out
 
 
 def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list[dict], list[dict]]:
@@ -249,12 +252,14 @@ def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list
     comp = gravcomp_sets(robot)
 
     def make(name: str, joint) -> dict:
-        return body(robot, links[name], joint, assets, sens, children.get(name, []), comp)
+        b = body(robot, links[name], joint, assets, sens, children.get(name, []), comp)
+        b["sites"] = b["sites"] + frame_sites(links, parent_joint, b["children"], sens)
+        return b
 
     root = robot.root
     if root == WORLD:
         world = make(root, None)
-        world_geoms = world["visuals"] + world["collisions"]
+        world_geoms = world["visuals"] + world["collisions"] + [s for s in world["sites"] if s.get("frame")]
         tops = [make(name, parent_joint[name]) for name in world["children"]]
     else:
         world_geoms = []

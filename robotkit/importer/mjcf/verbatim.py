@@ -83,19 +83,42 @@ class Names:
         original's ``qpos0``) is where the rebuild finds it, at its zero configuration (hinges and
         slides at 0: not at a ``ref`` of theirs)."""
         m = self.m
+        d, a, b, data = self.zero(), int(m.eq_obj1id[e]), int(m.eq_obj2id[e]), m.eq_data[e]
+        point = d.xpos[a] + d.xmat[a].reshape(3, 3) @ data[:3]
+        there = d.xmat[b].reshape(3, 3).T @ (point - d.xpos[b])
+        return bool(np.abs(there - data[3:6]).max() <= 1e-12)
+
+    def zero(self):
+        """The original at the rebuild's zero configuration (hinges and slides at 0, the others at
+        ``qpos0``): its MjData, positions and tendon lengths computed."""
         if self._zero is None:
-            mujoco = mj.load()
+            m, mujoco = self.m, mj.load()
             self._zero = mujoco.MjData(m)
             q = np.array(m.qpos0)
             for j in range(m.njnt):
                 if int(m.jnt_type[j]) in HINGE_SLIDE:
                     q[int(m.jnt_qposadr[j])] = 0.0
             self._zero.qpos[:] = q
-            mujoco.mj_kinematics(m, self._zero)
-        d, a, b, data = self._zero, int(m.eq_obj1id[e]), int(m.eq_obj2id[e]), m.eq_data[e]
-        point = d.xpos[a] + d.xmat[a].reshape(3, 3) @ data[:3]
-        there = d.xmat[b].reshape(3, 3).T @ (point - d.xpos[b])
-        return bool(np.abs(there - data[3:6]).max() <= 1e-12)
+            mujoco.mj_fwdPosition(m, self._zero)
+        return self._zero
+
+    def coupling(self, kind: str, a: int, b: int, coef) -> str:
+        """A joint or tendon coupling's ``polycoef`` for the rebuild: MuJoCo couples the values'
+        changes from ``qpos0`` (``y - y0 = p(x - x0)``), and the rebuild's zero configuration is not
+        the original's ``qpos0`` where a joint has a ``ref``."""
+        from numpy.polynomial import Polynomial
+
+        m, d = self.m, self.zero()
+        coef = np.asarray(coef, float) if b >= 0 else np.array([float(coef[0]), 0.0])  # alone: fixed
+        if kind == "joint":
+            (y0, x0), (y1, x1) = ([float(m.qpos0[m.jnt_qposadr[j]]) if j >= 0 else 0.0 for j in (a, b)],
+                                  [0.0, 0.0])
+        else:
+            (y0, x0), (y1, x1) = ([float(m.tendon_length0[t]) if t >= 0 else 0.0 for t in (a, b)],
+                                  [float(d.ten_length[t]) if t >= 0 else 0.0 for t in (a, b)])
+        # the rebuild's: y - y1 = p'(x - x1), with p'(z) = y0 - y1 + p(z + x1 - x0)
+        p = Polynomial(np.asarray(coef, float))(Polynomial([x1 - x0, 1.0])) + (y0 - y1)
+        return _numbers(np.pad(p.coef, (0, 5))[:5], 5)
 
     def anchor(self, e: int, b: int, point, k: int) -> str:
         """A frame link at a connect constraint's ``point`` in body ``b``'s frame (a site of the
@@ -139,11 +162,14 @@ class Names:
             raise Dropped(f"actuator '{self.m.actuator(a).name}' is not kept")
         return self.tree.verbatim["actuator"][a]
 
-    def object(self, objtype: int, i: int) -> tuple[str, str]:
-        """(MJCF object type, name) of a frame sensor's object or reference."""
+    def object(self, objtype: int, i: int, oriented: bool) -> tuple[str, str]:
+        """(MJCF object type, name) of a frame sensor's object or reference (``oriented``: its axes are read)."""
         kind = mj.load().mjtObj(objtype).name.removeprefix("mjOBJ_").lower()
         if kind == "site":
             return kind, self.site(i)
+        if kind == "body" and oriented:
+            raise Dropped(f"it reads the axes of body '{self.m.body(i).name}''s inertial frame, which MuJoCo "
+                          "chooses anew from the rebuilt inertia tensor")
         if kind == "body":
             return kind, self.body(i)
         if kind == "xbody":
@@ -346,7 +372,8 @@ def _equality_target(m, e: int, kind: str | None, names: Names) -> dict:
                 "relpose": _numbers(pose, 7), "torquescale": fmt(data[10])}
     if kind in ("joint", "tendon"):
         name = names.joint if kind == "joint" else names.tendon
-        return {f"{kind}1": name(a), **({f"{kind}2": name(b)} if b >= 0 else {}), "polycoef": _numbers(data[:5], 5)}
+        return {f"{kind}1": name(a), **({f"{kind}2": name(b)} if b >= 0 else {}),
+                "polycoef": names.coupling(kind, a, b, data[:5])}
     raise Dropped(f"the recipe has no {kind} constraints")
 
 
@@ -381,10 +408,11 @@ def _sensor_target(m, i: int, tag: str, names: Names) -> dict:
         if tag.startswith(prefix):
             return {attr: name(obj)}
     if tag.startswith("frame"):
-        kind, name = names.object(int(m.sensor_objtype[i]), obj)
+        oriented = tag in ("framequat", "framexaxis", "frameyaxis", "framezaxis")
+        kind, name = names.object(int(m.sensor_objtype[i]), obj, oriented)
         out = {"objtype": kind, "objname": name}
         if ref >= 0:
-            rkind, rname = names.object(int(m.sensor_reftype[i]), ref)
+            rkind, rname = names.object(int(m.sensor_reftype[i]), ref, True)
             out.update(reftype=rkind, refname=rname)
         return out
     if tag.startswith("subtree"):
@@ -393,13 +421,14 @@ def _sensor_target(m, i: int, tag: str, names: Names) -> dict:
 
 
 def _custom(m) -> list[str]:
+    mujoco = mj.load()
     out = []
     for i in range(m.nnumeric):
         adr, size = int(m.numeric_adr[i]), int(m.numeric_size[i])
-        out.append(_xml("numeric", {"name": m.numeric(i).name,
+        out.append(_xml("numeric", {"name": mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_NUMERIC, i),
                                     "data": " ".join(fmt(v) for v in m.numeric_data[adr:adr + size])}))
     for i in range(m.ntext):
         adr, size = int(m.text_adr[i]), int(m.text_size[i])
         text = bytes(m.text_data[adr:adr + size]).split(b"\0")[0].decode("utf-8", "replace")
-        out.append(_xml("text", {"name": m.text(i).name, "data": text}))
+        out.append(_xml("text", {"name": mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_TEXT, i), "data": text}))
     return out

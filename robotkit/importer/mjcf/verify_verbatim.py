@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from robotkit import mj
+
 CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
 SITE = 6  # mjOBJ_SITE
+ACC = 3  # mjSTAGE_ACC
 
 
 def counts(check, om, rm, tree) -> None:
@@ -43,18 +46,15 @@ def actuators(check, om, rm, tree) -> dict[int, int]:
 
 
 def equalities(check, om, rm, tree) -> set[int]:
-    """Each verbatim joint or tendon coupling's coefficients and every kept constraint's
-    softness and state; the original's verbatim equalities."""
+    """Each kept constraint's type, softness and state; the original's verbatim equalities."""
     kept = tree.verbatim.get("equality", {})
     for e, name in kept.items():
         r = rm.eq(name).id
         where = f"equality '{om.eq(e).name or name}'"
         same = [int(om.eq_type[e]) == int(rm.eq_type[r]), bool(om.eq_active0[e]) == bool(rm.eq_active0[r])]
         check("equality", float(not all(same)), f"{where} type and state")
-        mine = np.concatenate([om.eq_solref[e], om.eq_solimp[e]] + ([om.eq_data[e][:5]] if om.eq_type[e] in (JOINT, TENDON) else []))
-        theirs = np.concatenate([rm.eq_solref[r], rm.eq_solimp[r]] + ([rm.eq_data[r][:5]] if om.eq_type[e] in (JOINT, TENDON) else []))
-        check("equality", float(np.abs(mine - theirs).max() / max(np.abs(mine).max(), 1e-300)),
-              f"{where} softness and coefficients")
+        mine, theirs = (np.concatenate([m.eq_solref[i], m.eq_solimp[i]]) for m, i in ((om, e), (rm, r)))
+        check("equality", float(np.abs(mine - theirs).max() / max(np.abs(mine).max(), 1e-300)), f"{where} softness")
     return set(kept)
 
 
@@ -64,19 +64,51 @@ def at_configuration(check, om, od, rm, rd, tree, label: str) -> None:
     for t, name in tree.verbatim.get("tendon", {}).items():
         r = rm.tendon(name).id
         check("tendon", abs(float(od.ten_length[t]) - float(rd.ten_length[r])), f"tendon '{name}' length at {label}")
-    for s, name in tree.verbatim.get("sensor", {}).items():
-        r = rm.sensor(name).id
-        a, b = int(om.sensor_adr[s]), int(rm.sensor_adr[r])
-        dim = int(om.sensor_dim[s])
-        mine, theirs = od.sensordata[a:a + dim], rd.sensordata[b:b + dim]
-        scale = max(float(np.abs(mine).max()), 1.0)
-        check("sensor", float(np.abs(mine - theirs).max()) / scale, f"sensor '{name}' at {label}")
+    _sensors(check, om, od, rm, rd, tree, label)
     for e, name in tree.verbatim.get("equality", {}).items():
         if int(om.eq_type[e]) in (CONNECT, WELD) and int(om.eq_objtype[e]) != SITE:
             r = rm.eq(name).id
             points = zip(_anchors(om, od, e), _anchors(rm, rd, r))  # a weld's orientation only if both have one
             err = max(np.abs(po - pr).max() for po, pr in points)
             check("pose", float(err), f"equality '{om.eq(e).name or name}' anchors at {label}")
+        elif int(om.eq_type[e]) in (JOINT, TENDON):
+            r = rm.eq(name).id
+            check("equality", abs(_coupling(om, od, e) - _coupling(rm, rd, r)),
+                  f"equality '{om.eq(e).name or name}' coupling at {label}")
+
+
+def _sensors(check, om, od, rm, rd, tree, label: str) -> None:
+    """Each kept sensor's reading; those of the acceleration stage (touch, force, accelerometer...)
+    with contacts off in both, as the rollout has them (the contact parameters the recipe cannot
+    hold are on the ledger)."""
+    sensors = tree.verbatim.get("sensor", {})
+    if any(int(om.sensor_needstage[s]) == ACC for s in sensors):
+        mujoco = mj.load()
+        flags = int(om.opt.disableflags), int(rm.opt.disableflags)
+        try:
+            for m, d in ((om, od), (rm, rd)):
+                m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+                mujoco.mj_forward(m, d)
+        finally:
+            om.opt.disableflags, rm.opt.disableflags = flags
+    for s, name in sensors.items():
+        r = rm.sensor(name).id
+        a, b = int(om.sensor_adr[s]), int(rm.sensor_adr[r])
+        dim = int(om.sensor_dim[s])
+        mine, theirs = od.sensordata[a:a + dim], rd.sensordata[b:b + dim]
+        scale = max(float(np.abs(mine).max()), 1.0)
+        check("sensor", float(np.abs(mine - theirs).max()) / scale, f"sensor '{name}' at {label}")
+
+
+def _coupling(m, d, e: int) -> float:
+    """How far a joint or tendon coupling is from holding: ``y - y0 - p(x - x0)`` (MuJoCo's)."""
+    a, b, coef = int(m.eq_obj1id[e]), int(m.eq_obj2id[e]), m.eq_data[e][:5]
+    if int(m.eq_type[e]) == JOINT:
+        value = lambda j: float(d.qpos[m.jnt_qposadr[j]]) - float(m.qpos0[m.jnt_qposadr[j]])  # noqa: E731
+    else:
+        value = lambda t: float(d.ten_length[t]) - float(m.tendon_length0[t])  # noqa: E731
+    x = value(b) if b >= 0 else 0.0
+    return value(a) - (float(coef[0]) + (sum(float(c) * x ** k for k, c in enumerate(coef) if k) if b >= 0 else 0.0))
 
 
 def _anchors(m, d, e: int) -> list[np.ndarray]:
