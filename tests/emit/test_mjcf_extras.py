@@ -61,12 +61,29 @@ def _robot(tmp_path, text: str):
 
 
 def test_frame_links_are_sites_of_their_name(tmp_path):
+    """Each frame link (no mass, no shape, fixed) is also a site of its name, at its pose, in the
+    body that carries it (its own body stays: tf's frame, the SDF's <frame>)."""
     xml = render_mjcf(_robot(tmp_path, LOOP))
-    assert ('      <body name="tip" pos="0.1 0 0.05" quat="1 0 0 0">\n'
-            '        <site name="tip" group="4"/>\n'
-            '      </body>\n') in xml
-    assert '          <site name="arm_tip" group="4"/>\n' in xml
+    assert ('      <site name="tip" pos="0.1 0 0.05" quat="1 0 0 0" group="4"/>\n'
+            '      <geom name="base_visual_0"') in xml
+    assert '        <site name="arm_tip" pos="0 0 0.15" quat="1 0 0 0" group="4"/>\n' in xml
+    assert '      <body name="tip" pos="0.1 0 0.05" quat="1 0 0 0">\n      </body>\n' in xml
     assert '<site name="base"' not in xml and '<site name="arm"' not in xml  # links with mass are not frames
+
+
+def test_a_frame_of_the_world_is_a_site_of_the_worldbody(tmp_path):
+    robot = _robot(tmp_path, """
+robot: fixed
+links:
+  world: {}
+  mark: {}
+  base: {visual: {box: {size: [0.1, 0.1, 0.1]}}, inertial: {mass: 1}}
+joints:
+  mark_joint: {type: fixed, parent: world, child: mark, origin: {xyz: [1, 2, 3], rpy: [0, 0, 1.5707963267948966]}}
+  base_joint: {type: fixed, parent: world, child: base}
+""")
+    xml = render_mjcf(robot)
+    assert '  <worldbody>\n    <site name="mark" pos="1 2 3" quat="0.707106781186548 0 0 0.707106781186547" group="4"/>\n' in xml
 
 
 def test_extras_join_the_generated_sections(tmp_path):
