@@ -1,6 +1,7 @@
 """Keyframes as named poses, ``<contact><exclude>`` as self-collision pairs never checked,
 joint equalities as mimic joints, and the ledger lines of everything the recipe has no key for
-(tendons, other equality constraints, sensors, cameras, lights, flexes, joint springs)."""
+and ``mjcf_extras`` does not keep (cameras, lights, flexes, contact pairs, joint springs: the
+tendons, other equality constraints and sensors are :mod:`robotkit.importer.mjcf.verbatim`'s)."""
 
 from __future__ import annotations
 

@@ -7,10 +7,11 @@ the end of every hold.
 
 What is on the ledger is taken out of both first, so that the rollout compares everything
 else: the rebuilt model runs with the original's simulation options (timestep, integrator,
-gravity, fluid density...); the original's dropped equality constraints are off (the kept ones
-have the rebuilt's softness), its tendons and joint springs have no stiffness, damping or
-friction, its joints' limits and friction loss have the rebuilt's softness, and its dropped
-actuators no force.  A model with a ball joint has no rollout: the three joints through massless
+gravity, fluid density...); the original's dropped equality constraints are off (the mimic
+joints have the rebuilt's softness; those kept verbatim in ``mjcf_extras`` act in both as
+written), its dropped tendons and its joint springs have no stiffness, damping or friction, its
+joints' limits and friction loss have the rebuilt's softness, and its dropped actuators no force
+(those kept verbatim get the same control in both).  A model with a ball joint has no rollout: the three joints through massless
 links part from the ball (:func:`robotkit.importer.mjcf.verify.verify` says so).  Contacts are off in both: the robot
 alone has no floor, and the contact parameters the recipe cannot hold are on the ledger."""
 

@@ -11,7 +11,9 @@ velocities, and the bias forces at random joint velocities (Coriolis and centrif
 too); the same mass matrix and gravity forces from the rebuilt URDF in Pinocchio
 (:mod:`robotkit.importer.mjcf.pinocchio_mass`: joints matched by name); each hinge's and slide's
 armature; each kept actuator's types, gain, bias and gear, and the actuator count; each joint
-equality kept as a mimic joint, and the equality count; and a rollout of 0.5 s from each
+equality kept as a mimic joint, and the equality count; what ``mjcf_extras`` keeps verbatim
+(:mod:`robotkit.importer.mjcf.verify_verbatim`: tendons' lengths, sensors' readings, loops'
+anchors and couplings at every configuration, actuators, constraints); and a rollout of 0.5 s from each
 keyframe under one control sequence (:mod:`robotkit.importer.mjcf.rollout`; none for a model
 with a ball joint, which says so).  Tolerances (:data:`TOL`): relative to the largest value of
 the same kind, plus an absolute floor for lengths."""
