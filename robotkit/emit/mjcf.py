@@ -80,6 +80,23 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     return out + [Limit(x) for x in extras_losses(robot, "the MJCF")] + sensor_losses(robot)["mjcf"]
 
 
+def loop_sites(robot: Robot, link: str) -> list[dict]:
+    """The sites of the loops that close on ``link``: ``<loop>_1`` on link1, ``<loop>_2`` on link2."""
+    return [{"name": f"{loop.name}_{k}", "frame": True, "pos": pose.xyz, "quat": rpy_quat(pose.rpy)}
+            for loop in robot.loops for k, (end, pose) in enumerate(((loop.link1, loop.pose1), (loop.link2, loop.pose2)), 1)
+            if end == link]
+
+
+def loop_losses(robot: Robot, where: str) -> list[str]:
+    """The recipe's loops, which a tree (``where``: the URDF, model.sdf) leaves open."""
+    if not robot.loops:
+        return []
+    names = ", ".join(f"'{loop.name}'" for loop in robot.loops)
+    return [Limit(f"loop{'s' * (len(robot.loops) != 1)} {names}: {where} is a tree and leaves "
+                  f"{'them' if len(robot.loops) != 1 else 'it'} open (the MJCF closes "
+                  f"{'them' if len(robot.loops) != 1 else 'it'} with an equality constraint)")]
+
+
 def mjcf_extras_losses(robot: Robot, where: str) -> list[str]:
     """``mjcf_extras`` go into the MJCF only: what ``where`` (another format) does not get."""
     if not robot.mjcf_extras:
@@ -253,7 +270,7 @@ def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list
 
     def make(name: str, joint) -> dict:
         b = body(robot, links[name], joint, assets, sens, children.get(name, []), comp)
-        b["sites"] = b["sites"] + frame_sites(links, parent_joint, b["children"], sens)
+        b["sites"] = b["sites"] + frame_sites(links, parent_joint, b["children"], sens) + loop_sites(robot, name)
         return b
 
     root = robot.root
@@ -363,7 +380,7 @@ def context(robot: Robot, lift: float = 0.0, lift_at=None) -> dict:
             "assets": sorted(assets.values(), key=lambda a: a["name"]),
             "materials": robot.materials, "world_geoms": world_geoms, "tree": tree,
             "equalities": equalities, "cone": "elliptic" if _high_friction(robot) else None,
-            "extras": extras}
+            "extras": extras, "loops": robot.loops}
 
 
 def _high_friction(robot: Robot) -> bool:

@@ -164,3 +164,47 @@ def test_extras_are_a_limit_of_urdf_and_sdf(tmp_path):
             "<contact> (1 element), <size> are in the MJCF only, not in ")
     assert said + "the URDF" in limits["urdf"] and said + "model.sdf" in limits["sdf"]
     assert not any("mjcf_extras" in x for x in limits["mjcf"])
+
+
+def test_loops_are_equality_constraints_between_two_sites(tmp_path):
+    robot = _robot(tmp_path, LOOP + """
+loops:
+  close: {link1: arm, origin1: {xyz: [0, 0, 0.15]}, link2: base, origin2: {xyz: [0, 0, 0.15]}}
+  hold: {type: weld, link1: arm, link2: base, origin2: {rpy: [0, 0.5, 0]}}
+""")
+    xml = render_mjcf(robot)
+    assert '        <site name="close_1" pos="0 0 0.15" quat="1 0 0 0" group="4"/>\n' in xml
+    assert '      <site name="close_2" pos="0 0 0.15" quat="1 0 0 0" group="4"/>\n' in xml
+    assert ("  <equality>\n"
+            '    <connect name="close" site1="close_1" site2="close_2"/>\n'
+            '    <weld name="hold" site1="hold_1" site2="hold_2"/>\n'
+            "  </equality>\n") in xml
+    mujoco = mj.load()
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)  # the arm upright: the connect's two points coincide
+    rows = [i for i in range(d.nefc) if d.efc_type[i] == mujoco.mjtConstraint.mjCNSTR_EQUALITY]
+    assert np.abs(d.efc_pos[rows[:3]]).max() < 1e-12
+    assert np.abs(d.efc_pos[rows[3:]]).max() == pytest.approx(math.sin(0.25))  # the weld's frames 0.5 rad apart
+
+
+def test_loop_names_links_of_the_robot(tmp_path):
+    recipe = write_recipe(tmp_path, LOOP + """
+loops:
+  close: {link1: arm, link2: bse}
+  self: {link1: arm, link2: arm}
+""")
+    with pytest.raises(RobotkitError) as err:
+        build([recipe], tmp_path / "out")
+    assert err.value.lines() == [
+        f"{recipe}:24: loops.close.link2: no link named 'bse' (did you mean 'base'?)",
+        f"{recipe}:25: loops.self.link2: a loop cannot close link 'arm' on itself"]
+
+
+@pytest.mark.slow
+def test_loops_are_a_limit_of_urdf_and_sdf(tmp_path):
+    recipe = write_recipe(tmp_path, LOOP + "loops:\n  close: {link1: arm, link2: tip}\n")
+    build([recipe], tmp_path / "out")
+    limits = json.loads((tmp_path / "out" / "loop" / "report.json").read_text())["limits"]
+    said = "loop 'close': {} is a tree and leaves it open (the MJCF closes it with an equality constraint)"
+    assert said.format("the URDF") in limits["urdf"] and said.format("model.sdf") in limits["sdf"]
