@@ -51,11 +51,12 @@ def test_tendons_actuators_equalities_sensors_custom_word_for_word(converted):
         'gainprm="3" biasprm="0" gear="1" ctrllimited="true" ctrlrange="-1 1" forcelimited="false" '
         'actlimited="false"/>\n'
         '</actuator>',
-        # the loop: MuJoCo found its point on the lever with the crank at its ref (20 degrees), where
-        # the rebuild's zero configuration is not: two frame links at its two points, as sites;
+        # the loop (with a softness of its own: not the recipe's loops): MuJoCo found its point on the
+        # lever with the crank at its ref (20 degrees), where the rebuild's zero configuration is not:
+        # two frame links at its two points, as sites;
         # the couplings: from the rebuild's zero configuration (the lever's ref 10 degrees)
         '<equality>\n'
-        '  <connect name="loop" site1="loop_anchor1" site2="loop_anchor2"/>\n'
+        '  <connect name="loop" site1="loop_anchor1" site2="loop_anchor2" solref="0.01 1"/>\n'
         '  <joint name="cubic" joint1="slide" joint2="lever" polycoef="-0.0017506458289285372 0.010091385225936013 '
         '-0.0005235987755982989 0.001 0"/>\n'
         '  <weld name="hold" body1="lever" body2="base" anchor="0 0 0" relpose="-0.2 0 -0.15000000000000002 1 0 0 0" '
@@ -85,32 +86,44 @@ def test_loop_anchors_are_frame_links(converted):
 def test_ledger_word_for_word(converted):
     lines = [line for line in converted[1].lines() if "site '" not in line and "option" not in line]
     assert lines == [
-        f"extras.xml:33: tendon 'cable': urdf, sdf: dropped: the recipe has no tendons {KEPT}",
-        f"extras.xml:40: tendon 'couple': urdf, sdf: dropped: the recipe has no tendons {KEPT}",
-        f"extras.xml:52: actuator 'pull': urdf, sdf: dropped: a tendon transmission (the recipe's actuators drive "
+        "extras.xml:55: equality connect 'pin': urdf, sdf: the recipe's loop 'pin': URDF and SDF are trees, which "
+        "leave it open",
+        "extras.xml:56: equality weld 'glue': urdf, sdf: the recipe's loop 'glue': URDF and SDF are trees, which "
+        "leave it open",
+        f"extras.xml:41: tendon 'cable': urdf, sdf: dropped: the recipe has no tendons {KEPT}",
+        f"extras.xml:48: tendon 'couple': urdf, sdf: dropped: the recipe has no tendons {KEPT}",
+        f"extras.xml:62: actuator 'pull': urdf, sdf: dropped: a tendon transmission (the recipe's actuators drive "
         f"joints) {KEPT}",
-        f"extras.xml:53: actuator 'push': urdf, sdf: dropped: a site transmission (the recipe's actuators drive "
+        f"extras.xml:63: actuator 'push': urdf, sdf: dropped: a site transmission (the recipe's actuators drive "
         f"joints) {KEPT}",
-        "extras.xml:55: actuator 'filtered': urdf, sdf: dropped: a gain, bias or dynamics other than a position or "
+        "extras.xml:65: actuator 'filtered': urdf, sdf: dropped: a gain, bias or dynamics other than a position or "
         f"velocity servo or a motor {KEPT}",
-        f"extras.xml:46: equality connect 'loop': urdf, sdf: dropped: the recipe has no loop closures or couplings of "
+        f"extras.xml:54: equality connect 'loop': urdf, sdf: dropped: the recipe has no loop closures or couplings of "
         f"this kind {KEPT}",
-        f"extras.xml:47: equality joint 'cubic': urdf, sdf: dropped: the recipe has no loop closures or couplings of "
+        f"extras.xml:57: equality joint 'cubic': urdf, sdf: dropped: the recipe has no loop closures or couplings of "
         f"this kind {KEPT}",
-        f"extras.xml:48: equality weld 'hold': urdf, sdf: dropped: the recipe has no loop closures or couplings of "
+        f"extras.xml:58: equality weld 'hold': urdf, sdf: dropped: the recipe has no loop closures or couplings of "
         f"this kind {KEPT}",
-        f"extras.xml:49: equality tendon 'tendons': urdf, sdf: dropped: the recipe has no loop closures or couplings "
+        f"extras.xml:59: equality tendon 'tendons': urdf, sdf: dropped: the recipe has no loop closures or couplings "
         f"of this kind {KEPT}",
-        f"extras.xml:58: sensor 'cable_length': urdf, sdf: dropped: the recipe has no tendonpos sensors {KEPT}",
-        "extras.xml:59: sensor 'tip_pos': all: dropped: it reads the axes of body 'base''s inertial frame, which "
+        f"extras.xml:68: sensor 'cable_length': urdf, sdf: dropped: the recipe has no tendonpos sensors {KEPT}",
+        "extras.xml:69: sensor 'tip_pos': all: dropped: it reads the axes of body 'base''s inertial frame, which "
         "MuJoCo chooses anew from the rebuilt inertia tensor",
-        f"extras.xml:60: sensor 'servo_force': urdf, sdf: dropped: the recipe has no actuatorfrc sensors {KEPT}",
-        f"extras.xml:61: sensor 'com': urdf, sdf: dropped: the recipe has no subtreecom sensors {KEPT}",
-        f"extras.xml:62: sensor 'touch': urdf, sdf: dropped: the recipe has no touch sensors {KEPT}",
-        "extras.xml:63: sensor 'time': all: dropped: the recipe has no clock sensors",
-        f"extras.xml:66: custom numeric 'gains': urdf, sdf: dropped: the recipe has no custom numerics {KEPT}",
-        f"extras.xml:67: custom text 'note': urdf, sdf: dropped: the recipe has no custom texts {KEPT}",
+        f"extras.xml:70: sensor 'servo_force': urdf, sdf: dropped: the recipe has no actuatorfrc sensors {KEPT}",
+        f"extras.xml:71: sensor 'com': urdf, sdf: dropped: the recipe has no subtreecom sensors {KEPT}",
+        f"extras.xml:72: sensor 'touch': urdf, sdf: dropped: the recipe has no touch sensors {KEPT}",
+        "extras.xml:73: sensor 'time': all: dropped: the recipe has no clock sensors",
+        f"extras.xml:76: custom numeric 'gains': urdf, sdf: dropped: the recipe has no custom numerics {KEPT}",
+        f"extras.xml:77: custom text 'note': urdf, sdf: dropped: the recipe has no custom texts {KEPT}",
     ]
+
+
+def test_loops_with_default_softness_are_the_recipes_loops(converted):
+    """Each end in its link's frame: the pendulum's hinge off its body's origin moves its link frame."""
+    assert converted[0]["loops"] == {
+        "pin": {"link1": "pend", "origin1": {"xyz": [0.0, 0.0, -0.12000000000000001]}, "link2": "base",
+                "origin2": {"xyz": [-0.1, 0.0, 0.10000000000000003]}},
+        "glue": {"type": "weld", "link1": "tray", "origin1": {"xyz": [0.0, -0.1, -0.1]}, "link2": "base"}}
 
 
 @pytest.fixture(scope="module")
@@ -131,7 +144,8 @@ def test_rebuild_with_its_extras_agrees_with_the_original(rebuilt):
     assert result.verdict.rollouts == 1  # the tendons, actuators and constraints acting in both
     assert {k for k, v in result.verdict.worst.items() if v[1]} >= {"tendon", "sensor", "equality"}
     m = mj.load().MjModel.from_xml_path(str(folder / "copy" / "mjcf" / "extras.xml"))
-    assert (m.ntendon, m.neq, m.nu, m.nsensor, m.nnumeric, m.ntext) == (2, 4, 4, 4, 1, 1)
+    assert (m.ntendon, m.neq, m.nu, m.nsensor, m.nnumeric, m.ntext) == (2, 6, 4, 4, 1, 1)
+    assert '<connect name="pin" site1="pin_1" site2="pin_2"/>' in (folder / "copy" / "mjcf" / "extras.xml").read_text()
 
 
 def _mutated(folder: Path, tmp_path: Path, old: str, new: str) -> Path:
@@ -148,6 +162,8 @@ def _mutated(folder: Path, tmp_path: Path, old: str, new: str) -> Path:
     ('<joint joint="crank" coef="0.5"/>', '<joint joint="crank" coef="0.6"/>',
      "tendon 'couple' length at the zero configuration: tendon off by 3.49e-02 (tolerance 1e-09)"),
     ('site2="loop_anchor2"', 'site2="crank_tip"', "equality 'loop' anchors at the zero configuration: pose off by "),
+    ('<site name="pin_2" pos="-0.1 0 0.1', '<site name="pin_2" pos="-0.1 0 0.11',
+     "equality 'pin' anchors at the zero configuration: pose off by 1.00e-02 (tolerance 1e-09)"),
     ('polycoef="0.17453292519943295 0 0 0 0"', 'polycoef="0.17 0 0 0 0"',
      "equality 'tendons' coupling at the zero configuration: equality off by 4.53e-03 (tolerance 1e-09)"),
     ('gainprm="3"', 'gainprm="4"', "actuator 'filtered' gains, bias, dynamics, gear and ranges: actuator off by "),

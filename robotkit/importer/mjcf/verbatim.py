@@ -19,9 +19,9 @@ import numpy as np
 
 from robotkit import mj
 from robotkit.importer.mjcf.extras import EQ_KINDS, SOLIMP, SOLREF
-from robotkit.importer.mjcf.frames import origin
+from robotkit.importer.mjcf.frames import origin, quat_matrix
 from robotkit.importer.mjcf.sites import free_name
-from robotkit.importer.names import valid_frame_name
+from robotkit.importer.names import valid_frame_name, valid_name
 from robotkit.importer.recipe_writer import fmt
 
 KEPT = "dropped: {why} (kept verbatim in mjcf_extras for the MJCF)"
@@ -53,6 +53,7 @@ class Names:
 
     def __init__(self, src, tree, recipe: dict):
         self.m, self.tree, self._zero = src.model, tree, None
+        self.looped: set[int] = set()  # equalities that are the recipe's loops
         self.actuators = {a: f"{joint}_{recipe['actuators'][joint]['interface']}" for a, joint in tree.actuated.items()}
         self.taken = {"actuator": set(self.actuators.values()),
                       "sensor": {f"{n}_{s}" for n in recipe.get("sensors", {}) for s in ("gyro", "accel")},
@@ -182,6 +183,9 @@ class Names:
 def add_verbatim(src, tree, recipe: dict, ledger) -> None:
     """``recipe['mjcf_extras']`` and the ledger lines of what it keeps and drops."""
     names = Names(src, tree, recipe)
+    loops = _loops(src, tree, names, ledger)
+    if loops:
+        recipe["loops"] = loops
     sections = {}
     for tag, items in (("tendon", _tendons), ("actuator", _actuators), ("equality", _equalities),
                        ("sensor", _sensors)):
@@ -339,7 +343,7 @@ def _equalities(src, tree, names: Names):
     m = src.model
 
     def write(e: int):
-        if e in tree.mimics:
+        if e in tree.mimics or e in names.looped:
             return None
         kind = EQ_KINDS.get(int(m.eq_type[e]))
         attrs = {"name": None, **_equality_target(m, e, kind, names)}
@@ -353,6 +357,51 @@ def _equalities(src, tree, names: Names):
 
     yield from _each(src, "equality", m.neq, lambda e: f"equality {EQ_KINDS.get(int(m.eq_type[e]), m.eq_type[e])}",
                      write)
+
+
+LOOP = "the recipe's loop '{name}': URDF and SDF are trees, which leave it open"
+
+
+def _loops(src, tree, names: Names, ledger) -> dict:
+    """The recipe's ``loops``: the active connect and weld constraints with MuJoCo's default
+    softness (a weld: and torque scale) between two imported bodies or sites (the others are
+    verbatim: the recipe has no constraint softness), each end in its link's frame."""
+    m, specs, out = src.model, list(src.spec.equalities), {}
+    sites = int(mj.load().mjtObj.mjOBJ_SITE)
+    for e in range(m.neq):
+        kind = EQ_KINDS.get(int(m.eq_type[e]))
+        data = np.asarray(m.eq_data[e], float)
+        if (kind not in ("connect", "weld") or not m.eq_active0[e] or not np.allclose(m.eq_solref[e], SOLREF)
+                or not np.allclose(m.eq_solimp[e], SOLIMP) or (kind == "weld" and data[10] != 1)):
+            continue
+        a, b = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+        try:
+            if int(m.eq_objtype[e]) == sites:
+                ends = [(names.site(a), None), (names.site(b), None)]
+            elif kind == "connect":
+                ends = [(names.body(a), origin(data[:3] - names.offset(a), np.eye(3))),
+                        (names.body(b), origin(data[3:6] - names.offset(b), np.eye(3)))]
+            else:  # body1's point and the relative orientation; body2's anchor
+                ends = [(names.body(a), origin(data[3:6] - names.offset(a), quat_matrix(data[6:10]))),
+                        (names.body(b), origin(data[:3] - names.offset(b), np.eye(3)))]
+            if any(link == "world" and "world" not in tree.links for link, _ in ends):
+                raise Dropped("the robot has no world link")
+        except Dropped:
+            continue  # kept verbatim, or dropped saying why (_equalities)
+        eq = m.eq(e).name
+        name = eq if valid_name(eq) and eq not in names.taken.get("equality", set()) else f"loop{e}"
+        names.taken.setdefault("equality", set()).add(name)
+        loop = {"type": kind} if kind == "weld" else {}
+        for k, (link, o) in enumerate(ends, 1):
+            loop[f"link{k}"] = link
+            if o:
+                loop[f"origin{k}"] = o
+        out[name] = loop
+        names.looped.add(e)
+        tree.verbatim.setdefault("equality", {})[e] = name
+        ledger.add(src.where(specs[e]) if e < len(specs) else src.where(),
+                   f"equality {kind}" + (f" '{eq}'" if eq else f" #{e}"), OTHERS, LOOP.format(name=name))
+    return out
 
 
 def _equality_target(m, e: int, kind: str | None, names: Names) -> dict:
