@@ -6,8 +6,10 @@ resolved as MuJoCo resolved them), in the rebuilt model's names: bodies are thei
 (``tree.link_of``), joints the recipe's (``tree.joint_map``), sites their frame links
 (``tree.sites``: the rebuilt MJCF gives every frame link a site of its name), actuators the
 rebuilt ones (``<joint>_<interface>``) or the verbatim ones.  Points in a body's frame move to its
-link's frame (``tree.offset``).  Kept: tendons (fixed, and spatial through sites and pulleys),
-equality constraints other than the mimic joints (connect, weld, joint, tendon), actuators the
+link's frame (``tree.offset``).  Active connect and weld constraints with MuJoCo's default
+softness are the recipe's ``loops`` instead (:func:`_loops`).  Kept: tendons (fixed, and spatial
+through sites and pulleys), the other equality constraints but the mimic joints (connect, weld,
+joint, tendon), actuators the
 recipe's actuators do not hold (``tree.refused``), sensors other than the IMUs', custom numerics
 and texts.  Each is on the ledger for the URDF and SDF; what cannot be written (a wrap around a
 geom, a flex, a ball joint's sensor...) is dropped for all formats, saying why.  ``tree.verbatim``:
