@@ -14,11 +14,13 @@ import os
 
 import numpy as np
 
+from robotkit import mj
 from robotkit.emit import layout
 from robotkit.emit.controllers import joints_phrase
 from robotkit.emit.env import render
 from robotkit.geometry import rpy_quat
 from robotkit.emit.formats import Format, Limit
+from robotkit.errors import Problem, RecipeError
 from robotkit.emit.meshfiles import collision_file, conversions, visual_file
 from robotkit.emit.sdf import extras_losses
 from robotkit.emit.sensors import losses as sensor_losses
@@ -76,6 +78,63 @@ def losses(robot: Robot, facts: dict | None = None) -> list[str]:
     # urdf_extras are the URDF's and Gazebo's own vocabulary (<gazebo>, <transmission>), which
     # MuJoCo does not read: a limit of the format (report.json), not a warning
     return out + [Limit(x) for x in extras_losses(robot, "the MJCF")] + sensor_losses(robot)["mjcf"]
+
+
+def loop_sites(robot: Robot, link: str) -> list[dict]:
+    """The sites of the loops that close on ``link``: ``<loop>_1`` on link1, ``<loop>_2`` on link2."""
+    return [{"name": f"{loop.name}_{k}", "frame": True, "pos": pose.xyz, "quat": rpy_quat(pose.rpy)}
+            for loop in robot.loops for k, (end, pose) in enumerate(((loop.link1, loop.pose1), (loop.link2, loop.pose2)), 1)
+            if end == link]
+
+
+def loop_losses(robot: Robot, where: str) -> list[str]:
+    """The recipe's loops, which a tree (``where``: the URDF, model.sdf) leaves open."""
+    if not robot.loops:
+        return []
+    names = ", ".join(f"'{loop.name}'" for loop in robot.loops)
+    return [Limit(f"loop{'s' * (len(robot.loops) != 1)} {names}: {where} is a tree and leaves "
+                  f"{'them' if len(robot.loops) != 1 else 'it'} open (the MJCF closes "
+                  f"{'them' if len(robot.loops) != 1 else 'it'} with an equality constraint)")]
+
+
+def mjcf_extras_losses(robot: Robot, where: str) -> list[str]:
+    """``mjcf_extras`` go into the MJCF only: what ``where`` (another format) does not get."""
+    if not robot.mjcf_extras:
+        return []
+    parts = [f"<{tag}> ({len(sec['children'])} element{'s' * (len(sec['children']) != 1)})" if sec["children"]
+             else f"<{tag}>" for tag, sec in extras_sections(robot).items()]
+    return [Limit(f"mjcf_extras {', '.join(parts)} are in the MJCF only, not in {where}")]
+
+
+def extras_sections(robot: Robot) -> dict[str, dict]:
+    """The ``mjcf_extras`` by section: its children (XML text, two levels indented) and attributes."""
+    import xml.etree.ElementTree as ET
+
+    out: dict[str, dict] = {}
+    for text in robot.mjcf_extras:
+        element = ET.fromstring(text)
+        section = out.setdefault(element.tag, {"attrs": {}, "children": []})
+        section["attrs"].update(element.attrib)
+        for child in element:
+            child.tail = None
+            ET.indent(child, "  ", level=2)
+            section["children"].append(ET.tostring(child, encoding="unicode").replace(" />", "/>"))
+    return out
+
+
+def refusal(xml: str) -> str | None:
+    """Why MuJoCo refuses the MJCF ``xml`` (None: it loads it), each mesh a tetrahedron in place
+    of its file (the build checks the MJCF before its meshes are read)."""
+    mujoco = mj.load()
+    try:
+        spec = mujoco.MjSpec.from_string(xml)
+        for mesh in spec.meshes:
+            mesh.file = ""
+            mesh.uservert = [0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]
+        spec.compile()
+    except ValueError as exc:
+        return " ".join(str(exc).replace("Error: ", "", 1).split())
+    return None
 
 
 def _geom(robot: Robot, geom: Geom, name: str, assets: dict, role: str = "visual") -> dict:
@@ -181,6 +240,23 @@ def body(robot: Robot, link, joint, assets: dict, sens: dict, children: list[str
     }
 
 
+def frame_sites(links: dict, parent_joint: dict, children: list[str], sens: dict) -> list[dict]:
+    """A site of each child link that is a frame (no mass, no shape, fixed to this one), of its
+    name, at its pose, in this body: what an MJCF site was (robotkit.importer.mjcf.sites), in the
+    body that carries it, so that tendons, sensors, actuators and constraints of ``mjcf_extras``
+    name it and act on that body as they did on the site's.  None where a sensor's site has that
+    name already."""
+    if "site_names" not in sens:
+        sens["site_names"] = {s["name"] for b in sens["bodies"].values() for s in b["sites"]}
+    out = []
+    for name in children:
+        link, joint = links[name], parent_joint[name]
+        if (link.inertial is None and not link.visuals and not link.collisions_for("mjcf") and joint.type == "fixed"
+                and name not in sens["site_names"]):
+            out.append({"name": name, "frame": True, "pos": joint.origin.xyz, "quat": rpy_quat(joint.origin.rpy)})
+    return out
+
+
 def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list[dict], list[dict]]:
     """(geoms of the worldbody, the body tree as opening and closing steps, depth first, without
     recursion: chains of 1000 links)."""
@@ -193,12 +269,14 @@ def body_tree(robot: Robot, lift: float, assets: dict, sens: dict) -> tuple[list
     comp = gravcomp_sets(robot)
 
     def make(name: str, joint) -> dict:
-        return body(robot, links[name], joint, assets, sens, children.get(name, []), comp)
+        b = body(robot, links[name], joint, assets, sens, children.get(name, []), comp)
+        b["sites"] = b["sites"] + frame_sites(links, parent_joint, b["children"], sens) + loop_sites(robot, name)
+        return b
 
     root = robot.root
     if root == WORLD:
         world = make(root, None)
-        world_geoms = world["visuals"] + world["collisions"]
+        world_geoms = world["visuals"] + world["collisions"] + [s for s in world["sites"] if s.get("frame")]
         tops = [make(name, parent_joint[name]) for name in world["children"]]
     else:
         world_geoms = []
@@ -294,11 +372,15 @@ def context(robot: Robot, lift: float = 0.0, lift_at=None) -> dict:
                    "polycoef": (j.mimic.offset, j.mimic.multiplier, 0.0, 0.0, 0.0)}
                   for j in robot.joints if j.mimic is not None]
     collide, excludes = self_contacts(robot)
-    keys = keyframes(robot, tree, actuators, lift_at or (lambda values: lift))
+    extras = extras_sections(robot)
+    more = len(extras.get("actuator", {}).get("children", []))  # the extras' actuators: ctrl 0 at every keyframe
+    keys = [dict(k, ctrl=k["ctrl"] + (0.0,) * more if k["ctrl"] else ())
+            for k in keyframes(robot, tree, actuators, lift_at or (lambda values: lift))]
     return {"robot": robot, "collide": collide, "excludes": excludes, "sensors": sens["sensors"], "actuators": actuators, "keys": keys,
             "assets": sorted(assets.values(), key=lambda a: a["name"]),
             "materials": robot.materials, "world_geoms": world_geoms, "tree": tree,
-            "equalities": equalities, "cone": "elliptic" if _high_friction(robot) else None}
+            "equalities": equalities, "cone": "elliptic" if _high_friction(robot) else None,
+            "extras": extras, "loops": robot.loops}
 
 
 def _high_friction(robot: Robot) -> bool:
@@ -415,7 +497,11 @@ def render_mjcf(robot: Robot, points: dict[str, np.ndarray] | None = None) -> st
         # up to the next micrometre: never inside the floor, and no float32 noise in the file
         return math.ceil(-low * 1e6) / 1e6 if low is not None else 0.0
 
-    return render("mjcf/robot.xml.j2", **context(robot, lift=lift_at(), lift_at=lift_at))
+    xml = render("mjcf/robot.xml.j2", **context(robot, lift=lift_at(), lift_at=lift_at))
+    why = refusal(xml) if robot.mjcf_extras else None
+    if why is not None:
+        raise RecipeError(Problem(f"MuJoCo refuses the MJCF with these elements: {why}", key="mjcf_extras"))
+    return xml
 
 
 def floor_height(robot: Robot, points: dict[str, np.ndarray] | None = None) -> float:

@@ -30,7 +30,9 @@ def urdf_losses(robot: Robot) -> list[str]:
 
 def losses(robot: Robot, facts: dict) -> dict[str, list[str]]:
     """Every loss per format, the format's limits (:class:`Limit`) among them."""
-    return {"urdf": urdf_losses(robot), "sdf": sdf.losses(robot), "mjcf": mjcf.losses(robot, facts),
+    return {"urdf": urdf_losses(robot) + mjcf.loop_losses(robot, "the URDF") + mjcf.mjcf_extras_losses(robot, "the URDF"),
+            "sdf": sdf.losses(robot) + mjcf.loop_losses(robot, "model.sdf") + mjcf.mjcf_extras_losses(robot, "model.sdf"),
+            "mjcf": mjcf.losses(robot, facts),
             "package": ros.losses(robot) + gravcomp_losses(robot, "the ros_control controllers (controllers.yaml)")
             + matrix_losses(robot),
             **({"moveit": moveit.losses(robot)} if robot.moveit else {})}

@@ -10,7 +10,7 @@ from collections import Counter
 
 
 TOP_KEYS = ("robot", "units", "density", "ros", "metadata", "values", "materials", "defaults", "links", "joints",
-            "urdf_extras")
+            "urdf_extras", "mjcf_extras")
 
 
 def fmt(x: float) -> str:

@@ -27,7 +27,7 @@ from robotkit.model.drives import resolve_actuators, resolve_poses, resolve_sett
 from robotkit.model.massprops import Bounding, bounding_primitive, combine
 from robotkit.model.robot import (
     Author, Contact, Dynamics, Geom, Inertial, InertialSpec, Joint, Limit, Link, Material, MeshRef,
-    Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World,
+    Loop, Metadata, Mimic, Pose, Robot, Sensor, Shape, Strategy, World,
 )
 from robotkit.paths import ReadPolicy, file_stem, recipe_policy
 from robotkit.recipe import schema
@@ -161,11 +161,26 @@ def resolve(loaded: LoadedRecipe, ros: str | None = None, moveit: bool = False) 
     links = _share_mesh_tasks(links)
     if loaded.partial != "tree":  # joints dropped as invalid would show as false tree problems
         cx.problems.extend(_check_tree(link_names, joints, cx.marks))
+    loops = _loops(cx, set(link_names))
     if cx.problems:
         raise RecipeError(cx.problems)
     return Robot(r.robot, tuple(links), tuple(joints), materials, _metadata(r.metadata), r.self_collide,
                  tuple(r.urdf_extras), tuple(worlds), tuple(sensors), tuple(actuators), gazebo, ros, r.base, tuple(poses),
-                 self_collision=collision, moveit=r.moveit or moveit)
+                 self_collision=collision, moveit=r.moveit or moveit, mjcf_extras=tuple(r.mjcf_extras),
+                 loops=loops)
+
+
+def _loops(cx, links: set[str]) -> tuple[Loop, ...]:
+    out = []
+    for name, loop in cx.r.loops.items():
+        for end in ("link1", "link2"):
+            if getattr(loop, end) not in links:
+                cx.report(("loops", name, end), unknown_name("link", getattr(loop, end), sorted(links)))
+        if loop.link1 == loop.link2:
+            cx.report(("loops", name, "link2"), f"a loop cannot close link '{loop.link1}' on itself")
+        out.append(Loop(name, loop.type, loop.link1, Pose(_t(loop.origin1.xyz), _t(loop.origin1.rpy)),
+                        loop.link2, Pose(_t(loop.origin2.xyz), _t(loop.origin2.rpy))))
+    return tuple(out)
 
 
 def _safe_name(src: str) -> str:

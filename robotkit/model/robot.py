@@ -265,6 +265,19 @@ class Actuator:
 
 
 @dataclass(frozen=True)
+class Loop:
+    """A closed loop: ``pose1`` on ``link1`` and ``pose2`` on ``link2`` held together (``connect``:
+    their points; ``weld``: their frames)."""
+
+    name: str
+    type: str
+    link1: str
+    pose1: Pose
+    link2: str
+    pose2: Pose
+
+
+@dataclass(frozen=True)
 class NamedPose:
     """A named joint configuration: (joint, value) for the joints it names (the others at zero)."""
 
@@ -301,6 +314,8 @@ class Robot:
     self_collision: Settings = Settings()
     collision_matrix: Matrix | None = None  # once the build has sampled it (robotkit.model.selfcollision)
     moveit: bool = False  # write the MoveIt 2 configuration (robotkit.emit.moveit)
+    mjcf_extras: tuple[str, ...] = ()  # MJCF section elements, verbatim (robotkit.emit.mjcf)
+    loops: tuple[Loop, ...] = ()
 
     def home(self) -> NamedPose | None:
         """The pose the robot starts in: ``home``, else the first pose, else None (all zero)."""

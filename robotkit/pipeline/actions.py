@@ -169,7 +169,7 @@ def self_collision(robot, fact_paths: dict[str, str], meshes: str, target: str):
 
     placeholder = {link.name: Inertial(1.0, (0.0, 0.0, 0.0), (1e-3, 0.0, 0.0, 1e-3, 0.0, 1e-3)) for link in robot.links}
     full = replace(finalize(robot, read_facts(fact_paths), placeholder), self_collide=False, collision_matrix=None,
-                   actuators=(), sensors=())
+                   actuators=(), sensors=(), mjcf_extras=(), loops=())
     files = collision_meshes(full)
     xml = render_mjcf(full, points={rel: read_vertices(os.path.join(meshes, rel)) for rel in files})
     geometry = "\n".join(line for line in xml.splitlines() if "<inertial " not in line)

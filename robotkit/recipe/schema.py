@@ -174,6 +174,24 @@ def _xml_element(text: str) -> str:
 
 XmlElement = Annotated[str, AfterValidator(_xml_element)]
 
+MJCF_SECTIONS = ("size", "visual", "statistic", "default", "extension", "custom", "asset", "deformable", "contact",
+                 "equality", "tendon", "actuator", "sensor", "keyframe")
+"""The MJCF sections an ``mjcf_extras`` element may be, in the order MuJoCo writes them."""
+
+
+def _mjcf_section(text: str) -> str:
+    """One well-formed MJCF section element (``<tendon>``, ``<equality>``...)."""
+    import xml.etree.ElementTree as ET
+
+    tag = ET.fromstring(_xml_element(text)).tag
+    if tag not in MJCF_SECTIONS:
+        raise ValueError(f"<{tag}> is not an MJCF section the build takes verbatim; one of "
+                         + ", ".join(f"<{t}>" for t in MJCF_SECTIONS))
+    return text
+
+
+MjcfSection = Annotated[str, AfterValidator(_mjcf_section)]
+
 
 Name = Annotated[str, AfterValidator(check_name)]
 """A name of the recipe: it becomes a file or element name (check_name: safe on every filesystem)."""
@@ -781,6 +799,21 @@ class Part(Strict):
     """Nested instances of parts, placed in this part's links."""
 
 
+class Loop(Strict):
+    """A closed kinematic loop: a point (``connect``) or a frame (``weld``) on each of two links, held together by the simulator (the MJCF's equality constraint; URDF and SDF have no loops: report.json says so)."""
+
+    type: Literal["connect", "weld"] = "connect"
+    """``connect``: the two points coincide (a ball joint closing the loop); ``weld``: the two frames coincide."""
+    link1: FrameName
+    """The first link."""
+    origin1: Origin = Origin()
+    """The point (or frame) on ``link1``, in its frame."""
+    link2: FrameName
+    """The second link."""
+    origin2: Origin = Origin()
+    """The point (or frame) on ``link2``, in its frame; where the loop closes, it is where ``origin1`` is."""
+
+
 class SelfCollision(Strict):
     """How the self-collision matrix is found: MoveIt Setup Assistant's classification (Adjacent, Default, Always, Never) over configurations sampled uniformly within the joint limits (docs/selfcollision.md)."""
 
@@ -821,6 +854,10 @@ class Recipe(Strict):
     """The self-collision matrix (``srdf/<robot>.srdf``, the MJCF's excludes, the SDF's bit masks): how many configurations to sample and which pairs to force out of or into checking."""
     urdf_extras: list[XmlElement] = []
     """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF; ``<gazebo>`` blocks are also carried into model.sdf as libsdformat's URDF conversion places them (sensors and plugins into the link named, surface tags into its collisions, joint tags into the joint), and what cannot be carried is listed. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
+    loops: dict[Name, Loop] = {}
+    """Closed kinematic loops by name (a four-bar linkage, a gripper's coupler): the MJCF holds each as an equality constraint between two sites (``<loop>_1`` on ``link1``, ``<loop>_2`` on ``link2``) with MuJoCo's default softness; the URDF and SDF, trees, leave them open (report.json lists them)."""
+    mjcf_extras: list[MjcfSection] = []
+    """Raw MJCF section elements (``<tendon>``, ``<equality>``, ``<sensor>``, ``<actuator>``, ``<contact>``, ``<custom>``... for what the recipe cannot express: tendons, loop closures, MuJoCo's other sensors) copied verbatim into the MJCF: each one's children are appended to that section of the generated file. Names in them are the MJCF's: bodies are links, joints are joints, and every frame link (no mass, no shape, fixed) is also a site of its name. Each must be well-formed XML and MuJoCo must load the MJCF with them (else the MJCF is not written); the other formats do not get them (report.json says so); ``${...}`` in them is not evaluated."""
     metadata: Metadata = Metadata()
     materials: dict[Name, Material] = {}
     defaults: Defaults = Defaults()

@@ -153,12 +153,14 @@ def test_ledger_word_for_word(features):
         "features.xml:59: actuator 'shoulder_servo': all: ctrlrange [-1.2, 1.2] written as the joint's range "
         "[-1.5708, 1.5708]",
         "features.xml:61: actuator 'extend_motor': all: gear 2: the recipe's motor takes the joint's force (ctrl x 2)",
-        "features.xml:21: site 'tool': mjcf: a frame link (a body without mass in the rebuilt MJCF, not a site): its "
-        "sphere of size 0.005 is not drawn",
-        "features.xml:26: site 'elbow_mark': mjcf: a frame link (a body without mass in the rebuilt MJCF, not a "
-        "site): its box of size 0.01 0.02 0.03 is not drawn",
-        "features.xml:54: tendon 'fingers': all: dropped: the recipe has no tendons",
-        "features.xml:65: sensor 'shoulder_angle': all: dropped: the recipe has no jointpos sensors",
+        "features.xml:21: site 'tool': mjcf: a frame link (in the rebuilt MJCF a body without mass holding a site "
+        "of its name): its sphere of size 0.005 is not drawn",
+        "features.xml:26: site 'elbow_mark': mjcf: a frame link (in the rebuilt MJCF a body without mass holding a "
+        "site of its name): its box of size 0.01 0.02 0.03 is not drawn",
+        "features.xml:54: tendon 'fingers': urdf, sdf: dropped: the recipe has no tendons (kept verbatim in "
+        "mjcf_extras for the MJCF)",
+        "features.xml:65: sensor 'shoulder_angle': urdf, sdf: dropped: the recipe has no jointpos sensors (kept "
+        "verbatim in mjcf_extras for the MJCF)",
         "features.xml:32: joint 'wrist_ball' (ball): all: approximated: three revolute joints about the body's x, y, z "
         "through two links, each a point mass taken from the body at the ball's centre (the dynamics unchanged); its "
         "armature, damping and friction act on each angle, not on the angular velocity",
@@ -219,7 +221,11 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     assert "# verified in MuJoCo against the original at 22 configurations and 0 rollouts: every quantity agrees" in text
     assert ("#   note: no rollout: ball joint 'wrist_ball' is three revolute joints through chain links in the "
             "rebuild (approximated, on the ledger), whose motion parts from the ball's") in text
-    assert "#   features.xml:54: tendon 'fingers': all: dropped: the recipe has no tendons" in text
+    assert ("#   features.xml:54: tendon 'fingers': urdf, sdf: dropped: the recipe has no tendons (kept verbatim in mjcf_extras\n"
+            "#   for the MJCF)") in text
+    assert yaml.safe_load(text)["mjcf_extras"] == [
+        '<tendon>\n  <fixed name="fingers">\n    <joint joint="finger_a" coef="1"/>\n  </fixed>\n</tendon>',
+        '<sensor>\n  <jointpos name="shoulder_angle" joint="shoulder"/>\n</sensor>']
     assert yaml.safe_load(text)["robot"] == "features"
     assert ("  # MJCF ref 0.02: the origin takes the body back to the joint's zero, so joint values (limits,\n"
             "  # poses) are MuJoCo's; driven, with no velocity limit in the MJCF (unlimited): 1e+09\n  extend:\n") in text
@@ -369,8 +375,8 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
                         f"robotkit build --root {X2.parent / 'assets'} x2.yaml"]
     built = run_cli("build", "--root", X2.parent / "assets", "x2.yaml", "--no-report", cwd=tmp_path)
     assert built.returncode == 0, built.stderr
-    assert ("ledger: x2.xml:56: actuator 'thrust1': all: dropped: a site transmission (the recipe's actuators "
-            "drive joints)") in proc.stderr.splitlines()
+    assert ("ledger: x2.xml:56: actuator 'thrust1': urdf, sdf: dropped: a site transmission (the recipe's actuators "
+            "drive joints) (kept verbatim in mjcf_extras for the MJCF)") in proc.stderr.splitlines()
     assert ("ledger: x2.xml:26: material 'phong3SG': all: texture dropped: the recipe's material is a colour "
             "(its rgba kept)") in proc.stderr.splitlines()
     recipe = yaml.safe_load((tmp_path / "x2.yaml").read_text())

@@ -32,6 +32,7 @@ from robotkit.importer.mjcf.source import read
 from robotkit.importer.mjcf.sensors import add_imus
 from robotkit.importer.mjcf.sites import add_sites
 from robotkit.importer.mjcf.tree import build_tree
+from robotkit.importer.mjcf.verbatim import add_verbatim
 from robotkit.importer.mjcf.verify import Verdict, verify
 from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
 from robotkit.paths import recipe_policy, widened
@@ -51,10 +52,11 @@ def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, o
         recipe["base"] = "free"
     add_actuators(src, tree, recipe, ledger)
     add_equalities(src, tree, recipe, ledger)
-    add_poses(src, tree, recipe, ledger)
     add_excludes(src, tree, recipe, ledger)
     add_imus(src, tree, recipe, ledger)
     add_sites(src, tree, ledger)
+    add_verbatim(src, tree, recipe, ledger)
+    add_poses(src, tree, recipe, ledger)
     ledger_rest(src, tree, ledger)
     if len(ledger):  # the build copies it into report.json
         recipe["metadata"] = {"ledger": ledger.lines()}

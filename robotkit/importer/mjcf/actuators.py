@@ -41,8 +41,8 @@ def add_actuators(src, tree, recipe: dict, ledger) -> None:
         name = m.actuator(a).name or f"actuator {a}"
         where = src.where(spec_acts[a]) if a < len(spec_acts) else src.where()
         why = _refusal(m, a, tree, out)
-        if why:
-            ledger.add(where, f"actuator '{name}'", "all", f"dropped: {why}")
+        if why:  # kept verbatim if it can be (robotkit.importer.mjcf.verbatim), on the ledger
+            tree.refused[a] = why
             continue
         joint = tree.joint_map[int(m.actuator_trnid[a][0])][0]
         interface, gains = _kind(m, a)

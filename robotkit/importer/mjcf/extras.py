@@ -1,6 +1,7 @@
 """Keyframes as named poses, ``<contact><exclude>`` as self-collision pairs never checked,
 joint equalities as mimic joints, and the ledger lines of everything the recipe has no key for
-(tendons, other equality constraints, sensors, cameras, lights, flexes, joint springs)."""
+and ``mjcf_extras`` does not keep (cameras, lights, flexes, contact pairs, joint springs: the
+tendons, other equality constraints and sensors are :mod:`robotkit.importer.mjcf.verbatim`'s)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,6 @@ import math
 
 import numpy as np
 
-from robotkit import mj
 from robotkit.importer.mjcf.frames import quat_matrix
 from robotkit.importer.names import valid_name
 
@@ -77,7 +77,9 @@ def _ctrl_is_targets(m, tree, recipe: dict, k: int) -> bool:
     for a in range(m.nu):
         joint = tree.joint_map.get(int(m.actuator_trnid[a][0]), [None])[0] if m.actuator_trntype[a] == 0 else None
         act = recipe.get("actuators", {}).get(joint)
-        expected.append(values.get(joint, 0.0) if act and act["interface"] == "position" else float(m.key_ctrl[k][a]))
+        verbatim = a in tree.verbatim.get("actuator", {})  # the rebuilt keyframe's ctrl is 0
+        expected.append(values.get(joint, 0.0) if act and act["interface"] == "position" else
+                        0.0 if verbatim else float(m.key_ctrl[k][a]))
     return bool(abs(np.array(expected) - m.key_ctrl[k]).max() <= 1e-9)
 
 
@@ -122,14 +124,7 @@ def add_equalities(src, tree, recipe: dict, ledger) -> None:
                                f"a mimic joint: solref {_numbers(m.eq_solref[e])}, solimp {_numbers(m.eq_solimp[e])} "
                                "dropped: the rebuilt MJCF has MuJoCo's defaults (the recipe has no constraint softness)")
                 continue
-        label = f"equality {EQ_KINDS.get(t, t)}" + (f" '{name}'" if name else f" #{e}")
-        ledger.add(where, label, "all",
-                   "dropped: the recipe has no loop closures or couplings of this kind")
-
-
-def _sensor_type(m, i: int) -> str:
-    """A sensor's type as its MJCF tag names it (``jointpos``, ``framequat``...)."""
-    return mj.load().mjtSensor(int(m.sensor_type[i])).name.removeprefix("mjSENS_").lower()
+        # the others are kept verbatim if they can be (robotkit.importer.mjcf.verbatim), on the ledger
 
 
 def _one_dof(m, a: int, b: int) -> bool:
@@ -139,15 +134,12 @@ def _one_dof(m, a: int, b: int) -> bool:
 def ledger_rest(src, tree, ledger) -> None:
     """What the recipe has no key for, one line each."""
     spec, m = src.spec, src.model
-    for kind, what in (("tendon", "tendon"), ("sensor", "sensor"), ("camera", "camera"),
-                       ("light", "light"), ("flex", "flex"), ("skin", "skin"), ("pair", "contact pair"),
-                       ("hfield", "height field"), ("text", "custom text"), ("numeric", "custom numeric")):
-        for i, e in enumerate(getattr(spec, "flexes" if kind == "flex" else kind + "s", [])):
-            if kind == "sensor" and i in tree.kept_sensors:
-                continue
+    # tendons, sensors and custom data: robotkit.importer.mjcf.verbatim
+    for kind, what in (("camera", "camera"), ("light", "light"), ("flex", "flex"), ("skin", "skin"),
+                       ("pair", "contact pair"), ("hfield", "height field")):
+        for e in getattr(spec, "flexes" if kind == "flex" else kind + "s", []):
             label = f"{what} '{e.name}'" if e.name else what
-            ledger.add(src.where(e), label, "all", "dropped: the recipe has no "
-                       + (f"{_sensor_type(m, i)} sensors" if kind == "sensor" else what + "s"))
+            ledger.add(src.where(e), label, "all", f"dropped: the recipe has no {what}s")
     for j in range(m.njnt):
         softness = _softness(m, j)
         if softness:

@@ -7,12 +7,14 @@ the end of every hold.
 
 What is on the ledger is taken out of both first, so that the rollout compares everything
 else: the rebuilt model runs with the original's simulation options (timestep, integrator,
-gravity, fluid density...); the original's dropped equality constraints are off (the kept ones
-have the rebuilt's softness), its tendons and joint springs have no stiffness, damping or
-friction, its joints' limits and friction loss have the rebuilt's softness, and its dropped
-actuators no force.  A model with a ball joint has no rollout: the three joints through chain
-links part from the ball (:func:`robotkit.importer.mjcf.verify.verify` says so).  Contacts are off in both: the robot
-alone has no floor, and the contact parameters the recipe cannot hold are on the ledger."""
+gravity, fluid density...); the original's dropped equality constraints are off (the mimic
+joints have the rebuilt's softness; those kept verbatim in ``mjcf_extras`` act in both as
+written), its dropped tendons and its joint springs have no stiffness, damping or friction, its
+joints' limits and friction loss have the rebuilt's softness, and its dropped actuators no force
+(those kept verbatim get the same control in both).  A model with a ball joint has no rollout:
+the three joints through chain links part from the ball (:func:`robotkit.importer.mjcf.verify.verify`
+says so).  Contacts are off in both: the robot alone has no floor, and the contact parameters the
+recipe cannot hold are on the ledger."""
 
 from __future__ import annotations
 
@@ -54,7 +56,7 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
     for e in range(om.neq):
         if e not in equalities:
             om.eq_active0[e] = 0
-        elif tree.mimics[e] in rebuilt_eq:  # its softness: the rebuilt's (MuJoCo's defaults)
+        elif e in tree.mimics and tree.mimics[e] in rebuilt_eq:  # its softness: the rebuilt's (MuJoCo's defaults)
             r = rebuilt_eq[tree.mimics[e]]
             om.eq_solref[e], om.eq_solimp[e] = rm.eq_solref[r], rm.eq_solimp[r]
     om.jnt_stiffness[:] = 0
@@ -64,9 +66,10 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
             d, e = int(om.jnt_dofadr[j]), int(rm.jnt_dofadr[r])
             om.jnt_solref[j], om.jnt_solimp[j], om.jnt_margin[j] = rm.jnt_solref[r], rm.jnt_solimp[r], rm.jnt_margin[r]
             om.dof_solref[d], om.dof_solimp[d] = rm.dof_solref[e], rm.dof_solimp[e]
+    dropped = [t for t in range(om.ntendon) if t not in tree.verbatim.get("tendon", {})]  # the others are verbatim
     for field in ("tendon_stiffness", "tendon_damping", "tendon_frictionloss", "tendon_limited"):
         if hasattr(om, field):
-            getattr(om, field)[:] = 0
+            getattr(om, field)[dropped] = 0
     for a in range(om.nu):
         if a not in kept:
             om.actuator_gainprm[a][:] = 0
@@ -83,7 +86,8 @@ def _controls(om, rm, kept: dict[int, int], rng) -> list[tuple[np.ndarray, np.nd
             lo, hi = om.actuator_ctrlrange[a] if om.actuator_ctrllimited[a] else (-1.0, 1.0)
             uo[a] = rng.uniform(lo, hi)
             motor = int(om.actuator_biastype[a]) == 0
-            ur[r] = uo[a] * float(om.actuator_gear[a][0]) / float(rm.actuator_gear[r][0]) if motor else uo[a]
+            same = om.actuator_gear[a][0] == rm.actuator_gear[r][0]  # a verbatim actuator's (its gear may be 0)
+            ur[r] = uo[a] * float(om.actuator_gear[a][0]) / float(rm.actuator_gear[r][0]) if motor and not same else uo[a]
         out.append((uo, ur))
     return out
 

@@ -1,6 +1,6 @@
 """MuJoCo sites as the recipe's frames: each site a link of its own without mass or shape, fixed
 to its body's link at the site's pose (a ``<frame>`` in model.sdf, a link in the URDF, a body
-without mass in the rebuilt MJCF).  ROS reads them as tf frames (a gripper's pinch point, an IMU's
+without mass holding a site of the link's name in the rebuilt MJCF: :func:`robotkit.emit.mjcf.frame_site`).  ROS reads them as tf frames (a gripper's pinch point, an IMU's
 mounting).  What a site draws (its type, size, colour) is on the ledger."""
 
 from __future__ import annotations
@@ -38,8 +38,8 @@ def add_sites(src, tree, ledger) -> None:
         tree.joints[free_name(tree, f"{name}_fixed", tree.joints)] = joint
         tree.sites[s] = name
         renamed = f" '{name}'" if name != site else ""
-        ledger.add(where, label, "mjcf", f"a frame link{renamed} (a body without mass in the rebuilt MJCF, not a "
-                   f"site): its {_shape(m, s)} is not drawn")
+        ledger.add(where, label, "mjcf", f"a frame link{renamed} (in the rebuilt MJCF a body without mass holding a "
+                   f"site of its name): its {_shape(m, s)} is not drawn")
 
 
 def site_origin(m, tree, s: int) -> dict | None:

@@ -49,6 +49,8 @@ class Tree:
     mimics: dict = field(default_factory=dict)  # MuJoCo equality id -> (mimic joint, leader) (kept ones)
     sites: dict = field(default_factory=dict)  # MuJoCo site id -> its frame link (robotkit.importer.mjcf.sites)
     kept_sensors: set = field(default_factory=set)  # MuJoCo sensor ids the recipe's sensors hold
+    refused: dict = field(default_factory=dict)  # MuJoCo actuator id -> why the recipe's actuators cannot hold it
+    verbatim: dict = field(default_factory=dict)  # kind -> {MuJoCo id: name} kept in mjcf_extras (verbatim.py)
     ledger: list = field(default_factory=list)
 
 

@@ -12,10 +12,12 @@ the original's velocities, and the bias forces at random joint velocities (Corio
 centrifugal forces too); the same mass matrix and gravity forces from the rebuilt URDF in
 Pinocchio (:mod:`robotkit.importer.mjcf.pinocchio_mass`: joints matched by name); each hinge's
 and slide's armature; each kept actuator's types, gain, bias and gear, and the actuator count;
-each joint equality kept as a mimic joint, and the equality count; and a rollout of 0.5 s from
-each keyframe under one control sequence (:mod:`robotkit.importer.mjcf.rollout`; none for a
-model with a ball joint, which says so).  Tolerances (:data:`TOL`): relative to the largest
-value of the same kind, plus an absolute floor for lengths."""
+each joint equality kept as a mimic joint, and the equality count; what ``mjcf_extras`` keeps
+verbatim (:mod:`robotkit.importer.mjcf.verify_verbatim`: tendons' lengths, sensors' readings,
+loops' anchors and couplings at every configuration, actuators, constraints); and a rollout of
+0.5 s from each keyframe under one control sequence (:mod:`robotkit.importer.mjcf.rollout`; none
+for a model with a ball joint, which says so).  Tolerances (:data:`TOL`): relative to the
+largest value of the same kind, plus an absolute floor for lengths."""
 
 from __future__ import annotations
 
@@ -29,13 +31,14 @@ from robotkit.emit.layout import URDF, output_path
 from robotkit.importer.mjcf.pinocchio_mass import PinocchioModel
 from robotkit.importer.mjcf.rollout import rollouts
 from robotkit.importer.mjcf.state import mapped, velocity_map
+from robotkit.importer.mjcf import verify_verbatim
 
 SAMPLES = 20
 SEED = 0
 TOL = {"mass": 1e-9, "pose": 1e-9, "inertia": 1e-9, "matrix": 1e-6, "bias": 1e-6, "pinocchio": 1e-6,
-       "actuator": 1e-9, "equality": 1e-9, "rollout": 1e-4}
-"""Relative tolerances (pose and rollout: metres and rotation-matrix entries, absolute). The
-matrices' are looser: a chain link that cannot take its mass from its body carries an added
+       "actuator": 1e-9, "equality": 1e-9, "tendon": 1e-9, "sensor": 1e-6, "rollout": 1e-4}
+"""Relative tolerances (pose, tendon and rollout: metres and rotation-matrix entries, absolute).
+The matrices' are looser: a chain link that cannot take its mass from its body carries an added
 millionth of the lightest body's (on the ledger); the rollout's, as that millionth and the
 solver's own tolerance grow over 0.5 s."""
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
@@ -74,17 +77,20 @@ def verify(src, tree, rebuilt_path) -> Verdict:
     urdf = Path(rebuilt_path).parent.parent / output_path(URDF, Path(rebuilt_path).stem)
     pin = _pinocchio(verdict, om, tree, urdf)
     rng = np.random.default_rng(SEED + 1)
+    check = lambda kind, err, where: _check(verdict, kind, err, where)  # noqa: E731
     for label, q in configs:
         T = _at(mujoco, om, od, rm, rd, tree, q)
         _bodies(verdict, om, od, rm, rd, tree, label)
         _sites(verdict, od, rm, rd, tree, label)
+        verify_verbatim.at_configuration(check, om, od, rm, rd, tree, label)
         _dynamics(verdict, mujoco, om, od, rm, rd, T, label)
         if pin is not None:
             _in_pinocchio(verdict, pin, om, od, rm, rd, T, label)
         _moving_bias(verdict, mujoco, om, od, rm, rd, T, rng, label)
     verdict.configurations = len(configs)
-    kept = _actuators(verdict, om, rm, tree)
-    equalities = _equalities(verdict, om, rm, tree)
+    kept = _actuators(verdict, om, rm, tree) | verify_verbatim.actuators(check, om, rm, tree)
+    equalities = _equalities(verdict, om, rm, tree) | verify_verbatim.equalities(check, om, rm, tree)
+    verify_verbatim.counts(check, om, rm, tree)
     balls = [om.joint(j).name for j in range(om.njnt) if int(om.jnt_type[j]) == BALL]
     if balls:  # Cassie's achilles rods part by 4e-6 m in 5 ms, 1 m in 0.5 s: the approximation, not a defect
         verdict.notes.append(f"no rollout: ball joint '{balls[0]}' is three revolute joints through chain links "
@@ -153,7 +159,9 @@ def _actuators(verdict: Verdict, om, rm, tree) -> dict[int, int]:
     ledger): the rebuilt one on its joint has its types (gain, bias, dynamics), gain, bias and gear
     (a motor's gear is in its control, which the ledger says); the rebuilt model has no other.
     {original actuator: rebuilt actuator}."""
-    rebuilt = {rm.joint(int(rm.actuator_trnid[a][0])).name: a for a in range(rm.nu) if rm.actuator_trntype[a] == 0}
+    verbatim = set(tree.verbatim.get("actuator", {}).values())
+    rebuilt = {rm.joint(int(rm.actuator_trnid[a][0])).name: a for a in range(rm.nu)
+               if rm.actuator_trntype[a] == 0 and rm.actuator(a).name not in verbatim}
     kept = {}
     for a, joint in tree.actuated.items():
         where = f"actuator '{om.actuator(a).name}'" if om.actuator(a).name else f"actuator #{a}"
@@ -170,8 +178,8 @@ def _actuators(verdict: Verdict, om, rm, tree) -> dict[int, int]:
                                         [1.0 if motor else m.actuator_gear[i][0]]]) for m, i in ((om, a), (rm, r)))
         err = float(np.abs(mine - theirs).max() / max(np.abs(mine).max(), 1e-300))
         _check(verdict, "actuator", err, f"{where} gain, bias and gear")
-    _check(verdict, "actuator", float(rm.nu != len(tree.actuated)),
-           f"actuator count: {rm.nu} rebuilt, {len(tree.actuated)} kept of the original's {om.nu}")
+    count = len(tree.actuated) + len(verbatim)
+    _check(verdict, "actuator", float(rm.nu != count), f"actuator count: {rm.nu} rebuilt, {count} kept of the original's {om.nu}")
     return kept
 
 
@@ -180,9 +188,9 @@ def _equalities(verdict: Verdict, om, rm, tree) -> set[int]:
     others are on the ledger): a rebuilt joint equality couples the same joints by the same line
     (mimic = offset + multiplier x leader, the original's possibly turned round); the rebuilt
     model has no other equality.  The original's kept equalities."""
-    rebuilt = {}
+    rebuilt, verbatim = {}, set(tree.verbatim.get("equality", {}).values())
     for e in range(rm.neq):
-        if int(rm.eq_type[e]) == 2 and int(rm.eq_obj2id[e]) >= 0:
+        if int(rm.eq_type[e]) == 2 and int(rm.eq_obj2id[e]) >= 0 and rm.eq(e).name not in verbatim:
             rebuilt[(rm.joint(int(rm.eq_obj1id[e])).name, rm.joint(int(rm.eq_obj2id[e])).name)] = rm.eq_data[e][:2]
     for e, (child, leader) in tree.mimics.items():
         where = f"equality '{om.eq(e).name}'" if om.eq(e).name else f"equality #{e}"
@@ -195,8 +203,8 @@ def _equalities(verdict: Verdict, om, rm, tree) -> set[int]:
         r0, r1 = (float(v) for v in rebuilt[(child, leader)])
         _check(verdict, "equality", max(abs(c0 - r0), abs(c1 - r1)) / max(abs(c0), abs(c1), 1e-300),
                f"{where} coupling")
-    _check(verdict, "equality", float(rm.neq != len(tree.mimics)),
-           f"equality count: {rm.neq} rebuilt, {len(tree.mimics)} kept of the original's {om.neq}")
+    count = len(tree.mimics) + len(verbatim)
+    _check(verdict, "equality", float(rm.neq != count), f"equality count: {rm.neq} rebuilt, {count} kept of the original's {om.neq}")
     return set(tree.mimics)
 
 

@@ -28,7 +28,7 @@ from robotkit.recipe.expand.language import (
 from robotkit.recipe.expand.parts import expand_instances
 
 CONTROL = ("args", "values", "parts", "instances", "variants")
-VERBATIM = ("urdf_extras",)  # raw XML, copied as written (it may hold ${...} of its own)
+VERBATIM = ("urdf_extras", "mjcf_extras")  # raw XML, copied as written (it may hold ${...} of its own)
 
 
 @dataclass
