@@ -44,8 +44,11 @@ def _cases():
     open_box = trimesh.Trimesh(open_box.vertices, open_box.faces[2:], process=False)
     fin = trimesh.Trimesh(np.vstack([sphere.vertices, [[0, 0, 2.0]]]),  # a third face on a sphere's edge
                           np.vstack([sphere.faces, [[*sphere.faces[0][:2], len(sphere.vertices)]]]), process=False)
+    boxes = trimesh.util.concatenate([trimesh.creation.box().apply_translation((3 * i, 0, 0)) for i in range(40)])
+    shuffled = trimesh.Trimesh(boxes.vertices, boxes.faces[np.random.default_rng(5).permutation(len(boxes.faces))],
+                               process=False)  # parts whose walk starts where networkx's set of their faces does
     for name, mesh in (("sphere", sphere), ("two bodies", two), ("open box", open_box), ("fin", fin),
-                       ("moebius", _moebius())):
+                       ("moebius", _moebius()), ("forty boxes", shuffled)):
         for fraction, seed in ((0.01, 0), (0.5, 1), (0.5, 2)):
             yield pytest.param(_flipped(mesh, fraction, seed), id=f"{name}-{fraction}-{seed}")
     yield pytest.param(_moebius(), id="moebius-as-built")
