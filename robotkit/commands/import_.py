@@ -48,7 +48,8 @@ in MuJoCo and the URDF it loads in Pinocchio; nothing else (the SDF, the ROS pac
 
 def build_mjcf(recipe: Path, folder: str) -> Path:
     """Build ``recipe`` into ``folder`` (no report, only :data:`VERIFIED_OUTPUTS`, from a copy
-    beside it, so that its mesh paths read the same); the rebuilt MJCF's path."""
+    beside it, so that its mesh paths read the same; no self-collision matrix: the verification
+    compares no contacts, its rollouts run without them); the rebuilt MJCF's path."""
     from robotkit.emit.layout import robot_layout
     from robotkit.pipeline.runner import build
 
@@ -56,7 +57,7 @@ def build_mjcf(recipe: Path, folder: str) -> Path:
     copy = recipe.with_name(f".{recipe.name}.verify.yaml")
     copy.write_text(recipe.read_text(encoding="utf-8").rstrip("\n") + "\n" + VERIFIED_OUTPUTS, encoding="utf-8")
     try:
-        result = build([copy], folder, report=False)
+        result = build([copy], folder, report=False, matrix=False)
     finally:
         copy.unlink(missing_ok=True)
     return robot_layout(Path(folder) / result.robots[0]).mjcf

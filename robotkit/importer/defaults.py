@@ -44,6 +44,13 @@ def factor_defaults(recipe: dict) -> dict:
         groups: dict[str, list[tuple]] = {}
         for path in paths:
             groups.setdefault(path[0], []).append(path)
+        sizes: dict[int, tuple] = {}  # id -> (value, its text's length): the kept items are measured once
+
+        def size(key: str, value) -> int:
+            if id(value) not in sizes:
+                sizes[id(value)] = (value, len(section_text(key, value)))
+            return sizes[id(value)][1]
+
         for group in groups.values():  # a mapping's values together (limit: effort and velocity), else one by one
             for tried in [group] + ([[p] for p in group] if len(group) > 1 else []):
                 trial_base, trial = copy.deepcopy(base), items
@@ -52,9 +59,11 @@ def factor_defaults(recipe: dict) -> dict:
                     if value is not _NONE:
                         _set(trial_base, path, value)
                         trial = {name: _without(item, path, value, kind, trial_base) for name, item in trial.items()}
-                before = len(section_text(section, items)) + (len(section_text(kind, base)) if base else 0)
-                after = len(section_text(section, trial)) + len(section_text(kind, trial_base))
-                if trial is not items and after < before:
+                if trial is items:  # nothing shared: nothing to weigh
+                    continue
+                before = size(section, items) + (size(kind, base) if base else 0)
+                after = size(section, trial) + size(kind, trial_base)
+                if after < before:
                     base, items = trial_base, trial
         if base:
             recipe[section] = items

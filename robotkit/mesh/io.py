@@ -9,6 +9,7 @@ then the recipe's policy (convex hull with a warning, or an error).
 from __future__ import annotations
 
 import os
+from collections import OrderedDict
 
 import numpy as np
 
@@ -45,6 +46,41 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
         problem = _stl_problem(path)
         if problem:
             raise fail(f"mesh file '{name}' {problem}")
+    vertices, faces = _parsed(path, ext, fail)
+    vertices = np.asarray(vertices, dtype=np.float64)
+    if not np.isfinite(vertices).all():
+        raise fail(f"mesh file '{name}' has vertices that are not finite numbers (NaN or inf)")
+    scale = np.asarray(scale, dtype=np.float64)
+    vertices = vertices * scale
+    reach = float(np.abs(vertices).max())
+    if not reach <= MAX_EXTENT:
+        raise fail(f"mesh file '{name}' reaches {reach:.3g} m from its origin once scaled; robotkit takes meshes "
+                   f"within {MAX_EXTENT:g} m (check its units or scale)")
+    mesh = trimesh.Trimesh(vertices, faces.copy(), process=True)
+    if np.prod(scale) < 0:  # a mirroring scale turns the winding inside out
+        mesh.invert()
+    return mesh
+
+
+PARSED_BYTES = 128 * 2**20
+"""Most bytes of parsed mesh files :func:`_parsed` keeps (a build reads a file for its facts, at
+each scale it is used at, and again to convert it)."""
+PARSED: OrderedDict = OrderedDict()
+"""(path, size, mtime, inode) -> (vertices, faces), read-only: the files :func:`_parsed` keeps."""
+
+
+def _parsed(path: str, ext: str, fail) -> tuple[np.ndarray, np.ndarray]:
+    """The vertices and faces of a mesh file as trimesh reads it (``process=False``: nothing
+    merged or dropped), kept for this process while the file keeps its size, time and inode:
+    what :func:`load_mesh` does with them is done again, the same, for each call."""
+    import trimesh
+
+    name = os.path.basename(path)
+    stat = os.stat(path)
+    key = (os.path.realpath(path), stat.st_size, stat.st_mtime_ns, stat.st_ino)
+    if key in PARSED:
+        PARSED.move_to_end(key)
+        return PARSED[key]
     try:
         if ext == ".dae":
             loaded = _dae_in_metres(path)
@@ -54,19 +90,13 @@ def load_mesh(path: str, scale=(1.0, 1.0, 1.0), where: Problem | None = None):
         raise fail(f"cannot read mesh file '{name}': {type(exc).__name__}: {exc}".rstrip(": ")) from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise fail(f"mesh file '{name}' holds no triangles")
-    vertices = np.asarray(loaded.vertices, dtype=np.float64)
-    if not np.isfinite(vertices).all():
-        raise fail(f"mesh file '{name}' has vertices that are not finite numbers (NaN or inf)")
-    scale = np.asarray(scale, dtype=np.float64)
-    vertices = vertices * scale
-    reach = float(np.abs(vertices).max())
-    if not reach <= MAX_EXTENT:
-        raise fail(f"mesh file '{name}' reaches {reach:.3g} m from its origin once scaled; robotkit takes meshes "
-                   f"within {MAX_EXTENT:g} m (check its units or scale)")
-    mesh = trimesh.Trimesh(vertices, np.asarray(loaded.faces), process=True)
-    if np.prod(scale) < 0:  # a mirroring scale turns the winding inside out
-        mesh.invert()
-    return mesh
+    parsed = np.array(loaded.vertices), np.array(loaded.faces)
+    for a in parsed:
+        a.flags.writeable = False
+    PARSED[key] = parsed
+    while sum(v.nbytes + f.nbytes for v, f in PARSED.values()) > PARSED_BYTES and len(PARSED) > 1:
+        PARSED.popitem(last=False)
+    return parsed
 
 
 def _dae_in_metres(path: str):

@@ -10,9 +10,10 @@ visual meshes are copied verbatim).
 
 Library parts and hand-written parts:
 
-- merging, duplicate and degenerate faces, winding: trimesh
-  (``merge_vertices``, ``unique_faces``, ``nondegenerate_faces``,
-  ``trimesh.repair.fix_winding``);
+- merging, duplicate and degenerate faces: trimesh (``merge_vertices``,
+  ``unique_faces``, ``nondegenerate_faces``); winding: trimesh's
+  ``trimesh.repair.fix_winding`` result, face for face (:func:`fix_winding`: its
+  breadth-first walk over the face adjacency, without its per-pair Python work);
 - hole filling is hand-written: ``trimesh.repair.fill_holes`` fills every
   boundary cycle it finds (triangles and quads only unless ``use_fan``, and
   fans from a vertex, wrong for non-convex holes).  Here boundary loops are
@@ -91,7 +92,7 @@ def repair(mesh, fill_holes: bool = True, *,
 
     before = np.array(m.faces)  # orientation reference for faces_flipped
     if len(m.faces) and not m.is_winding_consistent:
-        trimesh.repair.fix_winding(m)
+        fix_winding(m)
 
     holes = _fill_holes(m, (max_hole_edges or len(m.faces) * 3) if fill_holes else 0)
     report.update(holes)
@@ -111,6 +112,105 @@ def repair(mesh, fill_holes: bool = True, *,
         "nonfinite_faces_removed", "vertices_merged", "duplicate_faces_removed", "degenerate_faces_removed",
         "unreferenced_vertices_removed", "faces_flipped", "faces_added"))
     return m, report
+
+
+def fix_winding(m) -> None:
+    """``trimesh.repair.fix_winding(m)``, the same faces flipped, in place, at a fraction of its
+    cost (it spends its time building a networkx graph and grouping the edges of each pair of
+    faces it walks).
+
+    trimesh walks each connected part of the face adjacency breadth-first (networkx's
+    ``bfs_edges`` from the part's first node) and reverses a face reached from a neighbour whose
+    shared edge runs the same way.  A face is reached once and its neighbour is final by then,
+    so its flip is its neighbour's flip XOR whether the pair's *input* edges run the same way:
+    the walk here is networkx's (:func:`_walk`), the same order, and the edge comparison one
+    vectorised step.  A pair sharing other than exactly one edge (not after ``repair``'s unique
+    and non-degenerate faces), or an adjacency listing a pair twice, goes to trimesh's own."""
+    if m.is_winding_consistent:
+        return
+    faces = m.faces.view(np.ndarray)
+    tree = _walk(np.asarray(m.face_adjacency, dtype=np.int64).reshape(-1, 2))
+    if tree is None:
+        trimesh.repair.fix_winding(m)
+        return
+    if len(tree) == 0:
+        return
+    parent, child = faces[tree[:, 0]], faces[tree[:, 1]]
+    # directed edges (k, 3, 2) of each face: (v0, v1), (v1, v2), (v2, v0)
+    pe = np.stack([parent, np.roll(parent, -1, axis=1)], axis=2)
+    ce = np.stack([child, np.roll(child, -1, axis=1)], axis=2)
+    same = (pe[:, :, None, :] == ce[:, None, :, :]).all(axis=3)  # a directed edge in both
+    reverse = (pe[:, :, None, :] == ce[:, None, :, ::-1]).all(axis=3)  # an edge run both ways
+    shared = same.sum(axis=(1, 2)) + reverse.sum(axis=(1, 2))
+    if (shared != 1).any():
+        trimesh.repair.fix_winding(m)
+        return
+    flips = [False] * len(faces)
+    for (a, b), s in zip(tree.tolist(), same.any(axis=(1, 2)).tolist()):
+        flips[b] = flips[a] ^ s
+    flip = np.array(flips, dtype=bool)
+    if flip.any():
+        out = faces.copy()
+        out[flip] = out[flip][:, ::-1]
+        m.faces = out
+
+
+def _walk(edges: np.ndarray) -> np.ndarray | None:
+    """The (parent, child) pairs, in order, of trimesh's walk over the graph of ``edges`` (face
+    pairs): ``nx.from_edgelist`` (nodes in order of first appearance, each one's neighbours in
+    edge order), then for each of ``nx.connected_components`` (from each unseen node in graph
+    order) ``nx.bfs_edges`` from the first node of its ``subgraph`` (the component's first node
+    in graph order, or, for a component under half the graph, the first of networkx's set of its
+    nodes, rebuilt here the same way).  None for an edge list networkx would merge (a pair twice,
+    a loop): trimesh's own walk then."""
+    if len(edges) == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    if (edges[:, 0] == edges[:, 1]).any() or len(np.unique(np.sort(edges, axis=1), axis=0)) != len(edges):
+        return None
+    n = int(edges.max()) + 1
+    src = np.concatenate([edges[:, 0], edges[:, 1]])
+    dst = np.concatenate([edges[:, 1], edges[:, 0]])
+    order = np.lexsort((np.tile(np.arange(len(edges)), 2), src))
+    starts = np.concatenate([[0], np.cumsum(np.bincount(src, minlength=n))]).tolist()
+    neighbours = dst[order].tolist()
+    flat = edges.ravel()
+    nodes = flat[np.sort(np.unique(flat, return_index=True)[1])].tolist()
+    mark = [0] * n  # the walk that reached each node (0: none yet)
+    walks = [0]
+
+    def bfs(source: int) -> list[tuple[int, int]]:
+        walks[0] += 1
+        stamp = walks[0]
+        mark[source] = stamp
+        out, queue, i = [], [source], 0
+        while i < len(queue):
+            parent = queue[i]
+            i += 1
+            for child in neighbours[starts[parent]:starts[parent + 1]]:
+                if mark[child] != stamp:
+                    mark[child] = stamp
+                    queue.append(child)
+                    out.append((parent, child))
+        return out
+
+    tree: list[tuple[int, int]] = []
+    done = bytearray(n)
+    for v in nodes:
+        if done[v]:
+            continue
+        walk = bfs(v)
+        component = [v] + [c for _, c in walk]
+        for c in component:
+            done[c] = 1
+        if 2 * len(component) < len(nodes):  # networkx iterates its set of the subgraph's nodes
+            members = set()
+            for c in component:  # connected_components' set, filled in its order
+                members.add(c)
+            start = next(iter(set(c for c in members)))  # show_nodes' set, filled from that one
+            if start != v:
+                walk = bfs(start)
+        tree += walk
+    return np.array(tree, dtype=np.int64).reshape(-1, 2)
 
 
 def _flipped(before: np.ndarray, after: np.ndarray) -> np.ndarray:

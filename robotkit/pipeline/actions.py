@@ -62,20 +62,45 @@ def dump_json(data) -> str:
 
 @_user_errors_fail
 def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
-    """Load a mesh, make it a closed volume, record its unit-density mass properties."""
+    """Load a mesh, make it a closed volume, record its unit-density mass properties.
+
+    What the mesh gives (:func:`measured_mesh`) is cached by content: the file's bytes, the
+    scale, the open-mesh policy and the name its warnings give it, not the recipe file and
+    line naming it (``where``), so that an import's verification and the later build of its
+    recipe, or a second recipe naming the same file, measure it once.  ``where`` only shapes
+    the record's ``source`` and the warnings' location."""
+    name = display_path(source)
+    params = {"scale": [float(v) for v in scale], "policy": policy, "name": name, "version": FACTS_VERSION,
+              "code": code_digest()}
+    try:
+        content = Path(source).read_bytes()
+    except OSError:  # load_mesh says why, at the recipe line naming it
+        content = None
+    if content is None:
+        facts = measured_mesh(source, scale, policy, name, where)
+    else:
+        _, info = Cache().get_or_compute(
+            "mesh-facts", params, [content],
+            lambda: ([], {"facts": json.dumps(measured_mesh(source, scale, policy, name, where))}))
+        facts = json.loads(info["facts"])  # as JSON text: the record's floats (-0.0 too) exactly as measured
+    facts = {"version": FACTS_VERSION, "source": _label(source, where), "scale": list(scale), **facts,
+             "warnings": [f"{_where_text(where)}{w}" for w in facts["warnings"]]}
+    write_if_changed(target, dump_json(facts))
+
+
+def measured_mesh(source: str, scale, policy: str, name: str, where: dict) -> dict:
+    """The facts of one mesh file at one scale: size, extent, hull points, repairs, the volume's
+    unit-density mass properties, and its warnings without their location.  A mesh robotkit
+    cannot read, or that encloses no volume, is a RobotkitError at ``where``."""
     loc = Problem("", **where)
     mesh = load_mesh(source, scale, loc)
-    name = display_path(source)
     faces_in = len(mesh.faces)
     bbox_min, bbox_max = mesh.bounds
     vol_mesh, repairs, used, warnings = volume_mesh(mesh, policy, name, loc)
     props = mesh_mass_properties(vol_mesh.vertices, vol_mesh.faces)
     if not props.volume > 0:
         raise RobotkitError(Problem(f"mesh '{name}' encloses no volume", **where))
-    facts = {
-        "version": FACTS_VERSION,
-        "source": _label(source, where),
-        "scale": list(scale),
+    return {
         "faces": faces_in,
         "vertices": int(len(mesh.vertices)),
         "bbox_min": [float(v) for v in bbox_min],
@@ -87,9 +112,8 @@ def mesh_facts(source: str, scale, policy: str, where: dict, target: str):
         "used": used,
         "convex": bool(vol_mesh.is_convex),
         "repairs": repairs,
-        "warnings": [f"{_where_text(where)}{w}" for w in warnings],
+        "warnings": warnings,
     }
-    write_if_changed(target, dump_json(facts))
 
 
 def _label(source: str, where: dict) -> str:

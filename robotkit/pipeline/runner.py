@@ -144,11 +144,13 @@ def to_doit(task: dict) -> dict:
 def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build", jobs: int = 1,
           echo=None, progress=None, ros: str | None = None, stamp_options: dict | None = None,
           report: bool = False, args: dict[str, str] | None = None, keep_going: bool = False,
-          moveit: bool = False, variant: str | None = None) -> BuildResult:
+          moveit: bool = False, variant: str | None = None, matrix: bool = True) -> BuildResult:
     """Build every recipe into ``out_dir``.  Raises RobotkitError with every user problem.
     ``ros`` (ros1 | ros2) overrides the recipes' ``ros`` key, ``moveit`` turns their ``moveit``
     key on; ``args`` sets recipe arguments (``--arg``); ``variant`` builds only that variant of
-    each recipe (``--variant``; a recipe without it is bad input).
+    each recipe (``--variant``; a recipe without it is bad input).  ``matrix=False`` leaves out
+    the self-collision matrix (the outputs render as for a robot without one): an import's
+    verification, which compares no contacts, builds so.
     ``report`` also writes each robot's picture report (``<robot>/report/report.html``); the
     command line does unless ``--no-report``.
 
@@ -162,13 +164,15 @@ def build(recipes: list[str | os.PathLike], out_dir: str | os.PathLike = "build"
     """
     if stamp_options is None:  # a build without the report is another build than one with it
         stamp_options = stamp.build_options(recipes, out_dir, ros, report, moveit, args, variant)
+        stamp_options.update({} if matrix else {"no_matrix": True})
     stamp.remove(out_dir, stamp_options)
     out = Path(out_dir).absolute()
     robots = load_robots(recipes, ros, args, moveit=moveit, variant=variant)  # raises before anything is written
     result = BuildResult(robots=[r.name for _, r in robots])
     chosen = chosen_outputs(robots)  # an unknown format under outputs: is bad input, before anything is written
     tasks = [t for loaded, robot in robots for t in robot_tasks(robot, out, mesh_locations(loaded, robot),
-                                                                 report=report, outputs=chosen[robot.name])]
+                                                                 report=report, outputs=chosen[robot.name],
+                                                                 matrix=matrix)]
     (out / STATE).mkdir(parents=True, exist_ok=True)
     recorder = _Recorder(result, echo, progress)
     inputs = _input_stats(robots, tasks)  # before running: an edit during the build is a change

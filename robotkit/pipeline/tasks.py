@@ -52,12 +52,14 @@ class Place:
     root: Path
     state: Path
     where: dict
+    with_matrix: bool = True  # False: no self-collision matrix (a verification's build, which reads none)
 
     @classmethod
-    def of(cls, robot: Robot, out_dir: str | os.PathLike, where: dict | None = None) -> "Place":
+    def of(cls, robot: Robot, out_dir: str | os.PathLike, where: dict | None = None,
+           with_matrix: bool = True) -> "Place":
         out_dir = Path(out_dir).absolute()
         return cls(robot, out_join(stage_dir(out_dir), robot.name, key="robot"), out_dir / STATE / robot.name,
-                   where or {})
+                   where or {}, with_matrix)
 
     @property
     def out_dir(self) -> Path:
@@ -92,9 +94,10 @@ class Place:
 
     @property
     def matrix(self) -> str | None:
-        """The self-collision matrix's record, for a robot with two links with collision geometry."""
+        """The self-collision matrix's record, for a robot with two links with collision geometry
+        (None in a build without the matrix: outputs render as for a robot without one)."""
         solid = [link for link in self.robot.links if link.collisions_for("mjcf")]
-        return self.record("self-collision", "") if len(solid) >= 2 else None
+        return self.record("self-collision", "") if len(solid) >= 2 and self.with_matrix else None
 
     @property
     def inertials(self) -> dict[str, str]:
@@ -116,15 +119,16 @@ def cached(task: dict, place: Place, outputs: dict | None = None) -> dict:
 
 
 def robot_tasks(robot: Robot, out_dir: str | os.PathLike, where: dict | None = None,
-                report: bool = False, outputs: Outputs | None = None) -> list[dict]:
+                report: bool = False, outputs: Outputs | None = None, matrix: bool = True) -> list[dict]:
     """The task dicts that build ``robot`` into ``out_dir/<robot>/``.
 
     ``where`` maps a mesh key, and ``link:<name>``, to the recipe location naming it (for messages);
     ``report`` adds the picture report (``report/report.html``, drawn from the MJCF: not without it);
-    ``outputs``: the formats written (default: :func:`robotkit.emit.formats.outputs_of` the robot).
+    ``outputs``: the formats written (default: :func:`robotkit.emit.formats.outputs_of` the robot);
+    ``matrix``: False leaves out the self-collision matrix (:meth:`Place.matrix`).
     """
     outputs = outputs or outputs_of(robot, FORMATS)
-    place = Place.of(robot, out_dir, where)
+    place = Place.of(robot, out_dir, where, matrix)
     meshes = mesh_tasks(place)
     # collision pieces before the other mesh work: CoACD is the longest, and doit -j N hands
     # out tasks in list order, so the slow ones start first and the quick ones fill in around them

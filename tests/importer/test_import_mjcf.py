@@ -6,6 +6,7 @@ shared set in the slow tier)."""
 
 from __future__ import annotations
 
+import difflib
 import json
 import math
 import shutil
@@ -230,6 +231,29 @@ def test_rebuild_agrees_with_the_original_in_mujoco(rebuilt):
     assert ("  # MJCF ref 0.02: the origin takes the body back to the joint's zero, so joint values (limits,\n"
             "  # poses) are MuJoCo's; driven, with no velocity limit in the MJCF (unlimited): 1e+09\n  extend:\n") in text
     assert "  # one of the three revolute joints ball joint 'wrist_ball' becomes (x, y, z of its body)\n" in text
+
+
+def test_verification_builds_everything_but_the_self_collision_matrix(rebuilt, tmp_path, monkeypatch):
+    """No comparison reads contacts (the rollouts run without them), so the verification's
+    build computes no self-collision matrix: its MJCF is the recipe's own build's but for the
+    contact filters (MuJoCo's <exclude> pairs, and no self-contacts without a matrix)."""
+    from robotkit.emit.layout import robot_layout
+    from robotkit.pipeline.runner import build
+
+    _, folder = rebuilt
+    monkeypatch.setenv("ROBOTKIT_ROOT", str(FEATURES.parent))
+    full = build([folder / "features.yaml"], tmp_path, report=False)
+    assert (tmp_path / ".robotkit" / "features" / "self_collision.json").is_file()
+    theirs = robot_layout(tmp_path / full.robots[0]).mjcf.read_text().splitlines()
+    mine = (folder / "copy" / "mjcf" / "features.xml").read_text().splitlines()
+    diff = [f"{line[0]} {line[2:].strip()}" for line in difflib.ndiff(mine, theirs) if line[:1] in "+-"]
+    assert [line for line in diff if line.startswith("-")] == [
+        "- <!-- self_collide: false: robot geoms collide with the world, not each other -->",
+        '- <geom group="3" density="0" rgba="0.6 0.6 0.6 0.4" contype="2" conaffinity="1"/>']
+    added = [line for line in diff if line.startswith("+")]
+    assert added[0] == '+ <geom group="3" density="0" rgba="0.6 0.6 0.6 0.4"/>'
+    assert added[1] == "+ <contact>" and added[-1] == "+ </contact>"
+    assert len(added) == 14 and all(line.startswith("+ <exclude body1=") for line in added[2:-1])
 
 
 def test_verification_catches_a_rebuild_that_differs(rebuilt, features, tmp_path):

@@ -122,3 +122,36 @@ def test_a_build_from_the_cache_runs_in_this_process(project):
     assert files(project / "two" / "bot") == files(project / "one" / "bot")
     shutil.copy(REPO / "recipes" / "meshes" / "turret_bot" / "rotor.stl", project / "slider.stl")
     assert not warm(tasks_of(recipe, project / "three"))  # the mesh's facts are to compute
+
+
+def test_mesh_facts_are_shared_by_recipes_naming_the_same_file(project):
+    """A mesh's facts are cached by its content, scale and policy, not by the recipe file and
+    line naming it: a second recipe (the mesh two lines further down) measures nothing again (an
+    entry changed in the cache shows in its record, which is otherwise the first's); another
+    scale is another entry."""
+    build([project / "bot.yaml"], project / "one", report=False)
+
+    def measured() -> dict:
+        return {m["key"]: m for m in (json.loads(p.read_text()) for p in (project / "cache").glob("v1/*/*.json"))
+                if m["op"] == "mesh-facts"}
+
+    assert len(measured()) == 1
+    key = next(iter(measured()))
+    cache = Cache(project / "cache", versions={})
+    _, info = cache.get(key)
+    facts = json.loads(info["facts"])
+    assert facts["volume"] > 0 and facts["warnings"] == [] and "source" not in facts
+    cache.put(key, ([], {"facts": json.dumps({**facts, "repairs": ["from the cache"]})}), op="mesh-facts")
+
+    other = "# another recipe\n\n" + RECIPE.replace("robot: bot", "robot: other")
+    (project / "other.yaml").write_text(other)
+    build([project / "other.yaml"], project / "two", report=False)
+
+    one = json.loads(next((project / "one" / ".robotkit" / "bot" / "mesh").glob("*.json")).read_text())
+    two = json.loads(next((project / "two" / ".robotkit" / "other" / "mesh").glob("*.json")).read_text())
+    assert one["repairs"] == [] and two["repairs"] == ["from the cache"]
+    assert {**two, "repairs": []} == one and one["source"] == "slider.stl"
+
+    (project / "other.yaml").write_text(other.replace("mesh: slider.stl}", "mesh: slider.stl, scale: [2, 2, 2]}"))
+    build([project / "other.yaml"], project / "three", report=False)
+    assert len(measured()) == 2
