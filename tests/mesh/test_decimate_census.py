@@ -1,8 +1,10 @@
 """The input's closedness read from MeshLib's own mesh (issue 33: the numpy edge census was 2-5 %
-of a decimation's time): where MeshLib's mesh is the input's own it answers, and its answer is
-the census's; where MeshLib dropped faces, split vertices or kept two edges between the same two
-vertices it does not answer, and ``decimate`` asks the census.  ``is_volume_before`` is checked
-against trimesh's ``is_volume`` (an independent reference) in every case."""
+of a decimation's time): a hole in MeshLib's mesh of every face means an open input; no hole
+means a closed input only where MeshLib's mesh is the input's own (no vertex split, no two edges
+between the same two vertices); otherwise, or where MeshLib dropped a face, it does not answer
+and ``decimate`` asks the census.  Where it answers, its answer is the census's, and
+``is_volume_before`` is checked against trimesh's ``is_volume`` (an independent reference) in
+every case."""
 
 from __future__ import annotations
 
@@ -40,12 +42,14 @@ def cases() -> dict:
         "unused vertices after the last": (np.vstack([V, V[:7] + 5.0]), F, True),
         "inside out": (V, F[:, ::-1], True),
         "one face removed": (V, F[1:], False),
-        "one face flipped": (V, np.vstack([F[:1, ::-1], F[1:]]), None),  # its edges: directed twice
+        # vertices split by MeshLib, holes left: open
+        "one face flipped": (V, np.vstack([F[:1, ::-1], F[1:]]), False),
+        "a face twice": (V, np.vstack([F, F[:1]]), False),
+        "two faces back to back": (V, np.vstack([F, F[:1, ::-1]]), False),
+        "an edge of three faces": (np.vstack([V, [[3.0, 3.0, 3.0]]]), np.vstack([F, [[tri[0], tri[1], n]]]), False),
+        # no answer: a face dropped; a vertex split and no hole (closed, by the census)
         "a degenerate face added": (V, np.vstack([F, [[tri[0], tri[0], tri[1]]]]), None),
-        "a face twice": (V, np.vstack([F, F[:1]]), None),
-        "two faces back to back": (V, np.vstack([F, F[:1, ::-1]]), None),
         "two spheres touching at a vertex": (shifted, touching, None),
-        "an edge of three faces": (np.vstack([V, [[3.0, 3.0, 3.0]]]), np.vstack([F, [[tri[0], tri[1], n]]]), None),
     }
 
 
