@@ -321,7 +321,8 @@ def main() -> int:
                              args.pymeshlab_python)))
         return 0
     rows = []
-    print(f"keep {args.keep} of the faces; best of {args.repeat}; Hausdorff / diagonal from {args.samples} "
+    aim = f"to {args.faces} faces (meshes with more)" if args.faces > 0 else f"keep {args.keep} of the faces"
+    print(f"{aim}; best of {args.repeat}; Hausdorff / diagonal from {args.samples} "
           f"samples each way; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"{'mesh':44} {'faces':>7} {'target':>6} C | " + " | ".join(f"{t[:10]:>27}" for t in tools))
     for path in visual_meshes([e for e in args.extra.split(",") if e]):
