@@ -35,7 +35,13 @@ times), how often robotkit's quality check sent it to MeshLib alone (issue 33), 
 Hausdorff over pymeshlab's.  ``python benchmarks/bench_decimate.py [--keep 0.1 | --faces 3000]
 [--repeat 3] [--samples 5000] [--json out.json] [--only SUBSTRING,SUBSTRING]
 [--pymeshlab-python PY]`` (``PY``: an interpreter with pymeshlab, where this one has none).
-The meshes of ``tests/data/meshes`` (the Panda's link0 and link4) are included.  Needs ``pip install pymeshlab
+The meshes of ``tests/data/meshes`` (the Panda's link0 and link4) are included; ``--extra DIR,...``
+adds folders (the Panda's nine visual meshes, issue 33: ``pip download example-robot-data==6.0.0
+--no-deps``, unzip, and give ``.../robots/panda_description/meshes/visual``; a file with the same
+bytes as one before is left out).  ``meshlib-1thread`` is MeshLib called plainly with its TBB
+limited to one thread, as robotkit limits it: the same work on the same core count, where
+``meshlib`` uses every core.  Each result's bytes are hashed, and the summary says on how many
+meshes robotkit's result is MeshLib's, byte for byte.  Needs ``pip install pymeshlab
 meshoptimizer fast-simplification`` (benchmark only).
 """
 
@@ -57,13 +63,21 @@ if not ASSETS.is_dir():
     ASSETS = Path("/work/shared/assets")
 
 
-def visual_meshes() -> list[str]:
-    out = []
-    for root in (REPO / "recipes" / "meshes", REPO / "tests" / "data" / "meshes", ASSETS):
+def visual_meshes(extra: list[str] = ()) -> list[str]:
+    """The visual meshes of the examples, ``tests/data/meshes``, shared/assets and the ``extra``
+    folders (``--extra``), each file once (a file with the same bytes as one before is left out:
+    the Panda's link0 and link4 are in ``tests/data`` and in the wheel's folder)."""
+    import hashlib
+
+    out, seen = [], set()
+    for root in (REPO / "recipes" / "meshes", REPO / "tests" / "data" / "meshes", ASSETS, *extra):
         for p in sorted(glob.glob(str(root) + "/**/*", recursive=True)):
             low = p.lower()
             if low.endswith((".stl", ".dae", ".obj")) and "collision" not in low and "/maps/" not in low:
-                out.append(p)
+                digest = hashlib.sha256(Path(p).read_bytes()).hexdigest()
+                if digest not in seen:
+                    seen.add(digest)
+                    out.append(p)
     return out
 
 
@@ -100,6 +114,16 @@ def t_meshlib(V, F, target):
     s.packMesh = True  # MeshLib's defaults otherwise, as a user would call it
     mm.decimateMesh(m, s)
     return mn.getNumpyVerts(m).astype(np.float64), mn.getNumpyFaces(m.topology)
+
+
+def t_meshlib_one_thread(V, F, target):
+    """MeshLib called plainly, its TBB limited to one thread for this process as robotkit limits
+    it (robotkit's builds decimate meshes in parallel processes, one per core): the same work
+    as robotkit's, on one core."""
+    from robotkit.mesh.decimate import _meshlib_single_threaded
+
+    _meshlib_single_threaded()
+    return t_meshlib(V, F, target)
 
 
 def t_meshoptimizer(V, F, target):
@@ -172,8 +196,20 @@ def t_pymeshlab(V, F, target):
     return m.vertex_matrix(), m.face_matrix()
 
 
-TOOLS = {"robotkit": t_robotkit, "robotkit-shortcuts": t_robotkit_shortcuts, "meshlib": t_meshlib, "meshoptimizer": t_meshoptimizer,
+TOOLS = {"robotkit": t_robotkit, "robotkit-shortcuts": t_robotkit_shortcuts, "meshlib": t_meshlib,
+         "meshlib-1thread": t_meshlib_one_thread, "meshoptimizer": t_meshoptimizer,
          "fast-simplification": t_fast_simplification, "pymeshlab": t_pymeshlab}
+
+
+def result_digest(v, f) -> str:
+    """A digest of a result's bytes (float64 vertices, int64 faces), to tell the same result."""
+    import hashlib
+
+    import numpy as np
+
+    h = hashlib.sha256(np.ascontiguousarray(v, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(f, dtype=np.int64).tobytes())
+    return h.hexdigest()[:16]
 
 
 def is_closed(F) -> bool:
@@ -250,7 +286,7 @@ def one(path: str, keep: float, repeat: int, samples: int, tools: list[str], fix
     for name, (v, f) in results.items():
         f = np.asarray(f, np.int64)
         row["tools"][name] = {"faces": int(len(f)), "time": min(times[name]), "cpu": min(cpus[name]),
-                              "closed": is_closed(f),
+                              "closed": is_closed(f), "digest": result_digest(v, f),
                               "hausdorff": hausdorff(V, F, np.asarray(v, np.float64), f, samples)}
     if "robotkit-shortcuts" in results:  # whether the shortcuts' heuristic check sent it to MeshLib alone
         import trimesh
@@ -269,6 +305,8 @@ def main() -> int:
     ap.add_argument("--samples", type=int, default=5000)
     ap.add_argument("--min-faces", type=int, default=1000, help="leave out meshes with fewer faces")
     ap.add_argument("--only", default="")
+    ap.add_argument("--extra", default="", help="more folders of meshes, comma-separated (the unpacked "
+                    "example-robot-data wheel's panda_description: the Panda's nine visual meshes)")
     ap.add_argument("--json")
     ap.add_argument("--one", help=argparse.SUPPRESS)
     ap.add_argument("--tools", default=",".join(TOOLS))
@@ -283,10 +321,11 @@ def main() -> int:
                              args.pymeshlab_python)))
         return 0
     rows = []
-    print(f"keep {args.keep} of the faces; best of {args.repeat}; Hausdorff / diagonal from {args.samples} "
+    aim = f"to {args.faces} faces (meshes with more)" if args.faces > 0 else f"keep {args.keep} of the faces"
+    print(f"{aim}; best of {args.repeat}; Hausdorff / diagonal from {args.samples} "
           f"samples each way; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"{'mesh':44} {'faces':>7} {'target':>6} C | " + " | ".join(f"{t[:10]:>27}" for t in tools))
-    for path in visual_meshes():
+    for path in visual_meshes([e for e in args.extra.split(",") if e]):
         if not any(part in path for part in args.only.split(",")):  # comma-separated substrings
             continue
         from robotkit.mesh.io import load_mesh
@@ -349,13 +388,22 @@ def summary(rows, tools):
         print(f"  Hausdorff {mine} / meshlib: median {np.median(h):.2f}, max {h.max():.2f}, "
               f"<= 1.0 on {int((h <= 1.0 + 1e-9).sum())}/{len(h)}, <= 1.05 on {int((h <= 1.05).sum())}/{len(h)}; "
               f"fell back to MeshLib alone on {sum(bool(r['tools'][mine].get('fallback')) for r in both)}/{len(both)}")
+        same = sum(r["tools"][mine].get("digest") == r["tools"]["meshlib"].get("digest") for r in both)
+        print(f"  {mine}: the same bytes as meshlib on {same}/{len(both)}")
     both = [r for r in rows if all("error" not in r["tools"].get(t, {"error": 1}) for t in ("robotkit", "pymeshlab"))]
     if both:
         h = np.array([r["tools"]["robotkit"]["hausdorff"] / max(r["tools"]["pymeshlab"]["hausdorff"], 1e-300)
                       for r in both])
         print(f"  Hausdorff robotkit / pymeshlab: median {np.median(h):.2f}, max {h.max():.2f}, "
               f"<= 1.05 on {int((h <= 1.05).sum())}/{len(h)}")
-    for other in ("pymeshlab", "meshlib", "robotkit-shortcuts", "meshoptimizer", "fast-simplification"):
+    for mine in ("meshlib", "meshlib-1thread"):  # the ceiling: MeshLib's own speed against pymeshlab's
+        both = [r for r in rows if all("error" not in r["tools"].get(t, {"error": 1}) for t in (mine, "pymeshlab"))]
+        for clock in ("time", "cpu") if both else ():
+            ratio = np.array([r["tools"]["pymeshlab"][clock] / r["tools"][mine][clock] for r in both])
+            print(f"  {'wall' if clock == 'time' else 'CPU '} pymeshlab / {mine}: median {np.median(ratio):.2f} "
+                  f"({len(both)} meshes)")
+    for other in ("pymeshlab", "meshlib", "meshlib-1thread", "robotkit-shortcuts", "meshoptimizer",
+                  "fast-simplification"):
         both = [r for r in rows if "error" not in r["tools"].get("robotkit", {"error": 1})
                 and "error" not in r["tools"].get(other, {"error": 1})]
         if not both or other not in tools:
