@@ -335,7 +335,11 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout.splitlines()
     assert out[0] == "verified in MuJoCo against the original at 22 configurations and 1 rollout: every quantity agrees"
-    assert out[-2:] == ["wrote x2.yaml (robot Skydio_X2); build it with:",
+    # the model's name 'Skydio X2' as a ROS package's (the build names the package after the robot)
+    assert ("note: robot 'Skydio X2' (the MJCF's model name) named 'skydio_x2': the robot's name is its ROS "
+            "package's, which holds lower case letters, digits and '_', a letter first (REP 144)"
+            ) in proc.stderr.splitlines()
+    assert out[-2:] == ["wrote x2.yaml (robot skydio_x2); build it with:",
                         f"robotkit build --root {X2.parent / 'assets'} x2.yaml"]
     built = run_cli("build", "--root", X2.parent / "assets", "x2.yaml", "--no-report", cwd=tmp_path)
     assert built.returncode == 0, built.stderr
@@ -346,7 +350,7 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     recipe = yaml.safe_load((tmp_path / "x2.yaml").read_text())
     ledger = [line.removeprefix("ledger: ") for line in proc.stderr.splitlines() if line.startswith("ledger: ")]
     assert recipe["metadata"]["ledger"] == ledger  # and the build's report.json carries it
-    assert json.loads((tmp_path / "build" / "Skydio_X2" / "report.json").read_text())["ledger"] == ledger
+    assert json.loads((tmp_path / "build" / "skydio_x2" / "report.json").read_text())["ledger"] == ledger
     assert recipe["base"] == "free" and list(recipe["links"]) == ["x2"]
     mesh = next(s for s in recipe["links"]["x2"]["visual"] if "mesh" in s)
     assert mesh["scale"] == 0.01  # set in the default class
