@@ -310,7 +310,15 @@ def test_the_models_not_tree_shaped_are_the_ones_whose_import_drops_a_loop(impor
             if any(kind in line for line in imported.ledger for kind in LOOP_CLOSURES)] == LOOPED
 
 
-@pytest.mark.parametrize("name", ROBOTS)
+TEXTURE_LEFT_BEHIND = pytest.mark.xfail(strict=True, reason=(
+    "create_body.dae names its texture ../materials/textures/create_body.png (a Gazebo model's layout); "
+    "robotkit.mesh.io.companions copies only what lies below the mesh's folder, so the package has no texture and "
+    "RViz logs 'Could not locate resource package://create/meshes/visual/../materials/textures/create_body.png' "
+    "(the mesh shows untextured); the import's ledger does not say so"))
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=TEXTURE_LEFT_BEHIND) if n == "gazebo_models/create" else n
+                                  for n in ROBOTS])
 def test_display_launch(launches, recipes, name):
     from robotkit.emit.ros import link_poses
     from robotkit.model.resolve import resolve
@@ -338,6 +346,8 @@ def test_display_launch(launches, recipes, name):
         np.testing.assert_allclose(R, T[:3, :3], atol=1e-6, err_msg=link)
     assert "Could not load resource" not in r["output"], r["output"][-3000:]
     assert "[rviz-" in r["output"]
+    # no node logged an error (roscpp's "[ERROR] [time]: ..."; RViz, robot_state_publisher)
+    assert not [line for line in r["output"].splitlines() if "[ERROR] [" in line], r["output"][-3000:]
 
 
 def _start(joint: ET.Element, home: dict) -> float:
