@@ -1,6 +1,8 @@
 """Run by Debian's /usr/bin/python3 (rospy, tf2_ros) while `roslaunch <robot> display.launch` runs:
 prints, as JSON, /robot_description, one /joint_states message and every link's transform
 from the root link (tf2_ros.Buffer; Debian's `tf_echo` is broken, docs/libraries.md, section 10).
+A robot without a joint joint_state_publisher moves (a drone's one link, a sensor) has no
+/joint_states message (it publishes none empty): its joint states are {}.
 
     python3 ros1_probe.py ROOT LINK... > result.json
 """
@@ -8,6 +10,7 @@ from the root link (tf2_ros.Buffer; Debian's `tf_echo` is broken, docs/libraries
 import json
 import sys
 import time
+import xml.etree.ElementTree as ET
 
 import rospy
 import tf2_ros
@@ -23,7 +26,9 @@ def main():
             raise SystemExit("no /robot_description parameter")
         time.sleep(0.2)
     description = rospy.get_param("/robot_description")
-    js = rospy.wait_for_message("/joint_states", JointState, timeout=30)
+    # joint_state_publisher's own rule (its free and mimic joints): any joint but these
+    moved = [j for j in ET.fromstring(description).findall("joint") if j.get("type") not in ("fixed", "floating", "planar")]
+    js = rospy.wait_for_message("/joint_states", JointState, timeout=30) if moved else JointState()
     buf = tf2_ros.Buffer()
     tf2_ros.TransformListener(buf)
     tf = {}

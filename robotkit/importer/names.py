@@ -28,6 +28,23 @@ def material_name(name: str, taken: set[str]) -> str:
     return out
 
 
+def package_name(name: str) -> str:
+    """``name`` as a ROS package name (REP 144; catkin refuses a '.' or a leading '_' or digit
+    and warns of capitals): lower case letters, digits and '_', a letter first.  An imported
+    robot's name is its ROS package's (``robotkit build`` names the package after the robot)."""
+    out = re.sub(r"[^a-z0-9_]", "_", name.lower()).lstrip("_")
+    return out if out[:1].isalpha() else f"robot_{out}".rstrip("_")
+
+
+def renamed_robot(original: str, name: str, kind: str) -> list[str]:
+    """The line that states :func:`package_name`'s change, if it made one (the recipe's header
+    and the import's notes); ``kind`` is the original's format (MJCF, SDF)."""
+    if original == name:
+        return []
+    return [f"robot '{original}' (the {kind}'s model name) named '{name}': the robot's name is its ROS package's, "
+            "which holds lower case letters, digits and '_', a letter first (REP 144)"]
+
+
 def name_hint() -> str:
     return FRAME_NAME_HINT
 

@@ -395,7 +395,11 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout.splitlines()
     assert out[0] == "verified in MuJoCo against the original at 22 configurations and 1 rollout: every quantity agrees"
-    assert out[-2:] == ["wrote x2.yaml (robot Skydio_X2); build it with:",
+    # the model's name 'Skydio X2' as a ROS package's (the build names the package after the robot)
+    assert ("note: robot 'Skydio X2' (the MJCF's model name) named 'skydio_x2': the robot's name is its ROS "
+            "package's, which holds lower case letters, digits and '_', a letter first (REP 144)"
+            ) in proc.stderr.splitlines()
+    assert out[-2:] == ["wrote x2.yaml (robot skydio_x2); build it with:",
                         f"robotkit build --root {X2.parent / 'assets'} x2.yaml"]
     built = run_cli("build", "--root", X2.parent / "assets", "x2.yaml", "--no-report", cwd=tmp_path)
     assert built.returncode == 0, built.stderr
@@ -406,7 +410,7 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
     recipe = yaml.safe_load((tmp_path / "x2.yaml").read_text())
     ledger = [line.removeprefix("ledger: ") for line in proc.stderr.splitlines() if line.startswith("ledger: ")]
     assert recipe["metadata"]["ledger"] == ledger  # and the build's report.json carries it
-    assert json.loads((tmp_path / "build" / "Skydio_X2" / "report.json").read_text())["ledger"] == ledger
+    assert json.loads((tmp_path / "build" / "skydio_x2" / "report.json").read_text())["ledger"] == ledger
     assert recipe["base"] == "free" and list(recipe["links"]) == ["x2", "thrust1", "thrust2", "thrust3",
                                                                      "thrust4"]  # its sites as frames
     # its gyro and accelerometer on site 'imu': the recipe's imu sensor, whose frame is the site
@@ -414,7 +418,7 @@ def test_skydio_x2_on_the_command_line(tmp_path, monkeypatch):
                                          "origin": {"xyz": [0, 0, 0.02]}}}
     assert ("ledger: x2.xml:63: sensor 'body_gyro' (gyro): mjcf: the recipe's imu sensor 'imu': written as "
             "'imu_gyro' on site 'imu_site'") in proc.stderr.splitlines()
-    mjcf = (tmp_path / "build" / "Skydio_X2" / "mjcf" / "Skydio_X2.xml").read_text()
+    mjcf = (tmp_path / "build" / "skydio_x2" / "mjcf" / "skydio_x2.xml").read_text()
     assert '<gyro name="imu_gyro" site="imu_site"/>' in mjcf
     mesh = next(s for s in recipe["links"]["x2"]["visual"] if "mesh" in s)
     assert mesh["scale"] == 0.01  # set in the default class

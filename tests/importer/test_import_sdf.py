@@ -268,3 +268,25 @@ def test_joint_to_world_roots_the_recipe_in_world(tmp_path):
     assert recipe["links"]["arm"]["inertial"] == {"mass": 2, "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}
     assert _joints(recipe)["j"]["limit"] == {"lower": 0, "upper": 0.5, "effort": 1e9, "velocity": 1e9}
     assert "  # no effort or velocity limit in the SDF (unlimited): 1e+09\n  j:" in result.recipe_path.read_text()
+
+
+def test_model_name_becomes_a_ros_package_name_stated(tmp_path):
+    """The robot's name is its ROS package's: catkin refuses a '.' or a leading digit and warns
+    of capitals (REP 144); the import names it so and says so above the recipe."""
+    (tmp_path / "m.sdf").write_text("""<sdf version="1.9"><model name="2Wheel.Bot">
+<link name="base"><inertial><mass>1</mass></inertial></link></model></sdf>
+""")
+    result = import_sdf(tmp_path / "m.sdf", tmp_path / "m.yaml")
+    line = ("robot '2Wheel.Bot' (the SDF's model name) named 'robot_2wheel_bot': the robot's name is its ROS "
+            "package's, which holds lower case letters, digits and '_', a letter first (REP 144)")
+    assert result.robot == "robot_2wheel_bot" and result.notes == [line]
+    text = result.recipe_path.read_text()
+    assert f"# {line}\n" in text and yaml.safe_load(text)["robot"] == "robot_2wheel_bot"
+
+
+@pytest.mark.parametrize("name, package", [("Skydio_X2", "skydio_x2"), ("2f85", "robot_2f85"), ("_arm", "arm"),
+                                           ("ur-10.e", "ur_10_e"), ("so_arm100", "so_arm100"), ("", "robot")])
+def test_package_name(name, package):
+    from robotkit.importer.names import package_name
+
+    assert package_name(name) == package

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import tempfile
 from pathlib import Path
 
@@ -34,6 +33,7 @@ from robotkit.importer.mjcf.sites import add_sites
 from robotkit.importer.mjcf.tree import build_tree
 from robotkit.importer.mjcf.verbatim import add_verbatim
 from robotkit.importer.mjcf.verify import Verdict, verify
+from robotkit.importer.names import package_name, renamed_robot
 from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
 from robotkit.paths import recipe_policy, widened
 
@@ -47,7 +47,7 @@ def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, o
     add_geoms(src, tree, out, ledger, materials)
     add_inertials(src, tree, ledger)
     add_contacts(src, tree, ledger)
-    recipe: dict = {"robot": _robot_name(src)}
+    recipe: dict = {"robot": package_name(_model_name(src))}
     if tree.base == "free":
         recipe["base"] = "free"
     add_actuators(src, tree, recipe, ledger)
@@ -66,9 +66,8 @@ def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, o
     return recipe, ledger, src, tree
 
 
-def _robot_name(src) -> str:
-    name = re.sub(r"[^A-Za-z0-9_.\-]", "_", src.spec.modelname or src.path.stem)
-    return name if re.match(r"[A-Za-z_]", name) else "_" + name
+def _model_name(src) -> str:
+    return src.spec.modelname or src.path.stem
 
 
 def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=None) -> Imported:
@@ -82,12 +81,14 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
     comments = {"links": {n: _chain_comment(src, tree, n) for n in tree.chain_links}
                 | {n: "an MJCF site: a frame (no mass, no shape)" for n in tree.sites.values()}, "joints": tree.notes}
     header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (MJCF, "
-              "read through MuJoCo: inertials, shapes and poses as MuJoCo compiled them)"] + ledger.block()
+              "read through MuJoCo: inertials, shapes and poses as MuJoCo compiled them)"]
+    renamed = renamed_robot(_model_name(src), recipe["robot"], "MJCF")
+    header += renamed + ledger.block()
     files = [str(src.mesh_file(d)) for d in range(src.model.nmesh) if src.mesh_file(d) is not None]
     read = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
     root = display_path(os.path.commonpath(read)) if read else None
-    notes = [f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: build it "
-             f"with --root {root}"] if read else []
+    notes = renamed + ([f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: "
+                        f"build it with --root {root}"] if read else [])
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     try:

@@ -13,7 +13,6 @@ Nothing is written when the file cannot be read or the recipe would be invalid."
 from __future__ import annotations
 
 import os
-import re
 import tempfile
 from pathlib import Path
 
@@ -21,7 +20,7 @@ from robotkit.errors import Problem, RobotkitError, display_path
 from robotkit.importer.checked import Imported, resolves, validate_recipe
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.ledger import Ledger
-from robotkit.importer.names import joints_apart_from_links
+from robotkit.importer.names import joints_apart_from_links, package_name, renamed_robot
 from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
 from robotkit.importer.sdf.contacts import add_contacts
 from robotkit.importer.sdf.extras import add_extras
@@ -57,7 +56,7 @@ def convert(path, out: Path):
     files = add_shapes(src, m, tree, out, ledger, materials, repaired)
     take_chain_masses(src, tree, ledger)
     surfaces = add_contacts(m, tree)
-    recipe: dict = {"robot": _robot_name(m.name)}
+    recipe: dict = {"robot": package_name(m.name)}
     meta = _metadata(src.config)
     if meta:
         recipe["metadata"] = meta
@@ -70,11 +69,6 @@ def convert(path, out: Path):
         recipe["materials"] = materials
     recipe["links"], recipe["joints"] = tree.links, tree.joints
     return recipe, ledger, src, m, tree, repaired, files
-
-
-def _robot_name(name: str) -> str:
-    name = re.sub(r"[^A-Za-z0-9_.\-]", "_", name)
-    return name if re.match(r"[A-Za-z_]", name) else "_" + name
 
 
 def _metadata(config: dict) -> dict:
@@ -99,11 +93,12 @@ def import_sdf(path, out_recipe, build=None) -> Imported:
     comments = {"links": {**{n: _chain_comment(tree, n) for n in tree.chain_links}, **tree.link_notes, **repaired}, "joints": tree.notes}
     how = "read through libsdformat" if src.via == "libsdformat" else "read from its XML (libsdformat refuses it)"
     header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (SDF, {how})"]
-    header += ledger.block()
+    renamed = renamed_robot(m.name, recipe["robot"], "SDF")
+    header += renamed + ledger.block()
     read_dirs = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
     root = display_path(os.path.commonpath(read_dirs)) if read_dirs else None
-    notes = [f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: build it "
-             f"with --root {root}"] if read_dirs else []
+    notes = renamed + ([f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: "
+                        f"build it with --root {root}"] if read_dirs else [])
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     try:
