@@ -138,9 +138,12 @@ def test_shared_cache_on_s3(s3, tmp_path):
     assert "shared cache" not in first.stderr
     objects = _objects(fs, "team")
     _assert_entries_whole(objects)
-    kinds = [json.loads(b)["kind"] for p, b in objects.items() if p.endswith(".json")]
-    # the hull, the decomposition, the self-collision matrix; the rest are the pure tasks' output files
-    assert len(kinds) - kinds.count("files") == 3 and kinds.count("files") > 0
+    manifests = [json.loads(b) for p, b in objects.items() if p.endswith(".json")]
+    kinds = [m["kind"] for m in manifests]
+    # the hull, the decomposition, the self-collision matrix, each mesh's facts (keyed by content); the
+    # rest are the pure tasks' output files
+    ops = [m["op"] for m in manifests if m["kind"] != "files"]
+    assert len(ops) == 5 and ops.count("mesh-facts") == 2 and kinds.count("files") > 0
 
     second = _build(recipe, tmp_path / "b", {**shared, "ROBOTKIT_CACHE_LOCAL": str(tmp_path / "local_b")},
                     forbid_compute=True)
@@ -276,8 +279,9 @@ def test_build_publishes_a_warm_local_cache(tmp_path):
     assert cold.returncode == 0, cold.stderr
     used = _entries(local)
     kinds = {n: json.loads(b)["kind"] for n, b in used.items() if n.endswith(".json")}
-    meshes = [n for n, k in kinds.items() if k != "files"]  # the hull, the decomposition, the matrix
-    assert len(meshes) == 3 == _tally(tmp_path / "cold.log")["misses"]
+    # the hull, the decomposition, the matrix, each mesh's facts (keyed by content)
+    meshes = [n for n, k in kinds.items() if k != "files"]
+    assert len(meshes) == 5 == _tally(tmp_path / "cold.log")["misses"]
 
     shared = {"ROBOTKIT_CACHE": f"file://{tmp_path}/shared"}
     warm = _build(recipe, tmp_path / "b", {**shared, "ROBOTKIT_CACHE_LOCAL": str(local)}, tally=tmp_path / "warm.log")
