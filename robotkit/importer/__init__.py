@@ -24,6 +24,7 @@ from pydantic import ValidationError
 
 from robotkit import urdfxml
 from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.importer.checked import with_companions
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.fit import misfits
 from robotkit.importer.inertials import POLICIES, report_recomputed
@@ -140,8 +141,8 @@ def import_file(path: str | os.PathLike, out_recipe: str | os.PathLike, package_
             line for note in conv.left_out for line in wrap(note)]
         text_out = dump_recipe(recipe, header, {"links": conv.repairs, "joints": conv.joint_notes})
         copied = _copy_meshes(conv.copies, source, out)
-        tmp, robot = _write_checked(text_out, out, source, lines, [m.recipe_path for m in conv.meshes.values()],
-                                    warnings)
+        tmp, robot = _write_checked(text_out, out, source, lines,
+                                    with_companions(m.recipe_path for m in conv.meshes.values()), warnings)
         more, kept = misfits(robot, conv.explicit, fit)
         if not set(more) - set(overrides):
             break

@@ -3,13 +3,16 @@ against the schema, then loaded and resolved as the build will; every problem na
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from pydantic import ValidationError
 
-from robotkit.errors import Problem, RobotkitError
+from robotkit.errors import Problem, RobotkitError, display_path
+from robotkit.mesh.io import companions
 from robotkit.model.load import load_robots
+from robotkit.paths import recipe_policy
 from robotkit.recipe.schema import Recipe
 
 
@@ -44,3 +47,22 @@ def resolves(recipe: Path, source: Path) -> None:
     except RobotkitError as exc:
         raise RobotkitError([replace(p, file=str(source), line=None) if p.file == str(recipe) else p
                              for p in exc.problems]) from None
+
+
+def with_companions(meshes) -> list[str]:
+    """The files a build of an imported recipe reads: its mesh files, and the textures and
+    material files next to them that the build copies (a Gazebo model's ``../materials/textures/``)."""
+    meshes = sorted(set(meshes))
+    return meshes + [os.path.normpath(os.path.join(os.path.dirname(m), rel)) for m in meshes for rel in companions(m)]
+
+
+def outside_reads(files, out: Path) -> tuple[list[str], str | None, list[str]]:
+    """The folders outside the project of recipe ``out`` that a build reading ``files`` (and
+    their companions) reads, the ``--root`` naming them all (or None), and the note saying so."""
+    policy = recipe_policy(out)
+    read = sorted({os.path.dirname(f) for f in with_companions(files) if not policy.allows(f)})
+    root = display_path(os.path.commonpath(read)) if read else None
+    notes = [f"the recipe reads files outside its project {display_path(policy.roots[0])}: "
+             f"build it with --root {root}"] if read else []
+    return read, root, notes
+

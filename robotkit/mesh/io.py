@@ -142,8 +142,9 @@ def _dae_unbound(path: str):
 def companions(path: str) -> list[str]:
     """Files a mesh file references and its viewers load beside it, as relative paths: a
     COLLADA file's images (``<init_from>``), an OBJ's material library and that library's
-    texture maps.  Only existing files below the mesh's own folder (no ``..``, no absolute
-    paths): what a copy of the mesh needs next to it.  Reads text only (cheap)."""
+    texture maps.  Only existing files named by relative paths (no absolute paths, no URIs);
+    they may climb out of the mesh's folder (a Gazebo model's ``../materials/textures/``): where a
+    copy of the mesh needs them, relative to it.  Reads text only (cheap)."""
     import re
 
     folder = os.path.dirname(os.path.abspath(path))
@@ -167,8 +168,9 @@ def companions(path: str) -> list[str]:
     out = []
     for name in names:
         name = name.strip().removeprefix("file://").removeprefix("./")
-        if not name or os.path.isabs(name) or ".." in name.replace("\\", "/").split("/"):
+        if not name or os.path.isabs(name) or "://" in name:
             continue
+        name = os.path.normpath(name.replace("\\", "/")).replace(os.sep, "/")
         if os.path.isfile(os.path.join(folder, name)) and name not in out:
             out.append(name)
     return out

@@ -36,7 +36,7 @@ from robotkit.geometry import rpy_quat
 from robotkit.mesh.io import companions
 from robotkit.model.load import load_robots, mesh_locations
 from robotkit.model.robot import Robot
-from robotkit.paths import file_stem, out_join
+from robotkit.paths import file_stem, inside, out_join, recipe_policy
 from robotkit.pipeline import actions
 from robotkit.pipeline.publish import STATE, stage_dir  # STATE: below the output folder, doit's database and JSON
 from robotkit.recipe.yamlsafe import MAX_YAML_BYTES, yaml_limits
@@ -245,11 +245,16 @@ def texture_tasks(place: Place) -> list[dict]:
     """``<robot>:copy:<file>``: the textures and material files the copied meshes reference."""
     extras: dict[str, str] = {}
     for _, (source, _) in sorted(copied_meshes(place).items()):
+        allowed = _reads_allowed(place, source)
         for rel in companions(source):
-            extras.setdefault(rel, os.path.join(os.path.dirname(source), rel))
-    tasks = []
+            path = os.path.join(os.path.dirname(source), rel)
+            if allowed(path):
+                extras.setdefault(rel, path)
+    tasks, own = [], {os.path.normpath(place.mesh(name, layout.VISUAL_MESHES)) for name in copied_meshes(place)}
     for rel, source in sorted(extras.items()):
-        target = place.mesh(rel, layout.VISUAL_MESHES)
+        target = os.path.normpath(place.mesh(rel, layout.VISUAL_MESHES))
+        if not _texture_fits(place, target) or target in own:
+            continue
         tasks.append({
             "name": f"{place.robot.name}:copy:{rel}",
             "doc": f"texture or material file {rel}",
@@ -259,6 +264,28 @@ def texture_tasks(place: Place) -> list[dict]:
             "clean": True,
         })
     return tasks
+
+
+def _reads_allowed(place: Place, source: str):
+    """Which of a mesh's companion files the build may read: the read rules of the recipe naming
+    the mesh (robotkit.paths); without a recipe (tasks made in code), only files below the
+    mesh's own folder."""
+    meshes = place.robot.meshes()
+    recipes = sorted(place.where[key]["file"] for key, mesh in meshes.items()
+                     if mesh.source == source and place.where.get(key, {}).get("file"))
+    if recipes:
+        return recipe_policy(recipes[0]).allows
+    return lambda path: inside(path, os.path.dirname(source))
+
+
+def _texture_fits(place: Place, target: str) -> bool:
+    """Whether a companion file's place in the package is free for it: below ``meshes/`` (a
+    Gazebo model's ``../materials/textures/`` lands in ``meshes/materials/textures/``), outside
+    the folder of processed meshes that robotkit writes itself."""
+    meshes = os.path.normpath(place.mesh("", layout.MESHES))
+    inside = os.path.commonpath([meshes, target]) == meshes and target != meshes
+    processed = os.path.normpath(place.mesh("", layout.COLLISION_MESHES))
+    return inside and os.path.commonpath([processed, target]) != processed
 
 
 def convert_tasks(place: Place) -> list[dict]:

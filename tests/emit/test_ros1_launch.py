@@ -310,15 +310,7 @@ def test_the_models_not_tree_shaped_are_the_ones_whose_import_drops_a_loop(impor
             if any(kind in line for line in imported.ledger for kind in LOOP_CLOSURES)] == LOOPED
 
 
-TEXTURE_LEFT_BEHIND = pytest.mark.xfail(strict=True, reason=(
-    "create_body.dae names its texture ../materials/textures/create_body.png (a Gazebo model's layout); "
-    "robotkit.mesh.io.companions copies only what lies below the mesh's folder, so the package has no texture and "
-    "RViz logs 'Could not locate resource package://create/meshes/visual/../materials/textures/create_body.png' "
-    "(the mesh shows untextured); the import's ledger does not say so"))
-
-
-@pytest.mark.parametrize("name", [pytest.param(n, marks=TEXTURE_LEFT_BEHIND) if n == "gazebo_models/create" else n
-                                  for n in ROBOTS])
+@pytest.mark.parametrize("name", ROBOTS)
 def test_display_launch(launches, recipes, name):
     from robotkit.emit.ros import link_poses
     from robotkit.model.resolve import resolve

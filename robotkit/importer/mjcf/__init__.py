@@ -17,8 +17,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from robotkit.errors import display_path
-from robotkit.importer.checked import Imported, resolves, validate_recipe
+from robotkit.importer.checked import Imported, outside_reads, resolves, validate_recipe
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.actuators import add_actuators
 from robotkit.importer.mjcf.chainmass import CHAIN_POINT_MASS
@@ -35,7 +34,7 @@ from robotkit.importer.mjcf.verbatim import add_verbatim
 from robotkit.importer.mjcf.verify import Verdict, verify
 from robotkit.importer.names import package_name, renamed_robot
 from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
-from robotkit.paths import recipe_policy, widened
+from robotkit.paths import widened
 
 
 def convert(path: str | os.PathLike, out: Path) -> tuple[dict, Ledger, object, object]:
@@ -85,10 +84,8 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
     renamed = renamed_robot(_model_name(src), recipe["robot"], "MJCF")
     header += renamed + ledger.block()
     files = [str(src.mesh_file(d)) for d in range(src.model.nmesh) if src.mesh_file(d) is not None]
-    read = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
-    root = display_path(os.path.commonpath(read)) if read else None
-    notes = renamed + ([f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: "
-                        f"build it with --root {root}"] if read else [])
+    read, root, outside = outside_reads(files, out)
+    notes = renamed + outside
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     try:

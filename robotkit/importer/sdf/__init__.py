@@ -16,8 +16,8 @@ import os
 import tempfile
 from pathlib import Path
 
-from robotkit.errors import Problem, RobotkitError, display_path
-from robotkit.importer.checked import Imported, resolves, validate_recipe
+from robotkit.errors import Problem, RobotkitError
+from robotkit.importer.checked import Imported, outside_reads, resolves, validate_recipe
 from robotkit.importer.defaults import factor_defaults
 from robotkit.importer.mjcf.ledger import Ledger
 from robotkit.importer.names import joints_apart_from_links, package_name, renamed_robot
@@ -29,7 +29,7 @@ from robotkit.importer.sdf.shapes import add_shapes
 from robotkit.importer.sdf.source import read
 from robotkit.importer.sdf.tree import build_tree, take_chain_masses
 from robotkit.importer.sdf.verify import Verdict, verify
-from robotkit.paths import recipe_policy, widened
+from robotkit.paths import widened
 from robotkit.urdfxml import is_element
 
 
@@ -95,10 +95,8 @@ def import_sdf(path, out_recipe, build=None) -> Imported:
     header = [f"Imported by robotkit from {Path(os.path.relpath(src.path, out.parent)).as_posix()} (SDF, {how})"]
     renamed = renamed_robot(m.name, recipe["robot"], "SDF")
     header += renamed + ledger.block()
-    read_dirs = sorted({os.path.dirname(f) for f in files if not recipe_policy(out).allows(f)})
-    root = display_path(os.path.commonpath(read_dirs)) if read_dirs else None
-    notes = renamed + ([f"the recipe reads files outside its project {display_path(recipe_policy(out).roots[0])}: "
-                        f"build it with --root {root}"] if read_dirs else [])
+    read_dirs, root, outside = outside_reads(files, out)
+    notes = renamed + outside
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(f".{out.name}.tmp")
     try:
