@@ -107,6 +107,8 @@ def add_equalities(src, tree, recipe: dict, ledger) -> None:
         a, b = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
         coef = [float(v) for v in m.eq_data[e][:5]]
         if t == 2 and b >= 0 and not any(coef[2:]) and bool(m.eq_active0[e]) and _one_dof(m, a, b):
+            # MuJoCo couples the joints' moves from their refs: q1 - ref1 = c0 + c1 (q2 - ref2)
+            coef[0] += float(m.qpos0[m.jnt_qposadr[a]]) - coef[1] * float(m.qpos0[m.jnt_qposadr[b]])
             actuated = set(recipe.get("actuators", {}))
             child, leader = tree.joint_map[a][0], tree.joint_map[b][0]
             if child in actuated and leader not in actuated and coef[1]:  # the driven joint leads

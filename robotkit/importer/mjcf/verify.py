@@ -135,7 +135,7 @@ def _in_pinocchio(verdict: Verdict, pin, om, od, rm, rd, T, label: str) -> None:
     _check(verdict, "pinocchio", float(np.abs(expect - Mp).max() / max(np.abs(expect).max(), 1e-300)),
            f"URDF mass matrix in Pinocchio at {label}")
     go = A.T @ od.qfrc_bias
-    _check(verdict, "pinocchio", float(np.abs(go - gp).max() / max(np.abs(go).max(), 1e-12)),
+    _check(verdict, "pinocchio", float(np.abs(go - gp).max() / max(np.abs(go).max(), force_floor(om))),
            f"URDF gravity forces in Pinocchio at {label}")
 
 
@@ -150,7 +150,7 @@ def _moving_bias(verdict: Verdict, mujoco, om, od, rm, rd, T, rng, label: str) -
         data.qvel[:] = v
         mujoco.mj_forward(model, data)
     go, gr = T.T @ od.qfrc_bias, rd.qfrc_bias
-    _check(verdict, "bias", float(np.abs(go - gr).max() / max(np.abs(go).max(), 1e-12)),
+    _check(verdict, "bias", float(np.abs(go - gr).max() / max(np.abs(go).max(), force_floor(om))),
            f"bias forces at {label} (random velocities)")
 
 
@@ -191,21 +191,38 @@ def _equalities(verdict: Verdict, om, rm, tree) -> set[int]:
     rebuilt, verbatim = {}, set(tree.verbatim.get("equality", {}).values())
     for e in range(rm.neq):
         if int(rm.eq_type[e]) == 2 and int(rm.eq_obj2id[e]) >= 0 and rm.eq(e).name not in verbatim:
-            rebuilt[(rm.joint(int(rm.eq_obj1id[e])).name, rm.joint(int(rm.eq_obj2id[e])).name)] = rm.eq_data[e][:2]
+            rebuilt[(rm.joint(int(rm.eq_obj1id[e])).name, rm.joint(int(rm.eq_obj2id[e])).name)] = _line(rm, e)
     for e, (child, leader) in tree.mimics.items():
         where = f"equality '{om.eq(e).name}'" if om.eq(e).name else f"equality #{e}"
         if (child, leader) not in rebuilt:
             _check(verdict, "equality", 1.0, f"{where} missing from the rebuild")
             continue
-        c0, c1 = (float(v) for v in om.eq_data[e][:2])
+        c0, c1 = _line(om, e)
         if tree.joint_map[int(om.eq_obj1id[e])][0] != child:  # turned round: the driven joint leads
             c0, c1 = -c0 / c1, 1 / c1
-        r0, r1 = (float(v) for v in rebuilt[(child, leader)])
+        r0, r1 = rebuilt[(child, leader)]
         _check(verdict, "equality", max(abs(c0 - r0), abs(c1 - r1)) / max(abs(c0), abs(c1), 1e-300),
                f"{where} coupling")
     count = len(tree.mimics) + len(verbatim)
     _check(verdict, "equality", float(rm.neq != count), f"equality count: {rm.neq} rebuilt, {count} kept of the original's {om.neq}")
     return set(tree.mimics)
+
+
+def _line(m, e: int) -> tuple[float, float]:
+    """Joint equality ``e`` as the line q1 = c0 + c1 q2 in the joints' values: MuJoCo couples
+    their moves from their refs (q1 - ref1 = a0 + a1 (q2 - ref2))."""
+    a0, a1 = (float(v) for v in m.eq_data[e][:2])
+    ref1, ref2 = (float(m.qpos0[m.jnt_qposadr[int(j)]]) for j in (m.eq_obj1id[e], m.eq_obj2id[e]))
+    return a0 + ref1 - a1 * ref2, a1
+
+
+def force_floor(m) -> float:
+    """The least force scale that gravity and bias forces are compared against: a thousandth of
+    the model's weight times its extent (in N m; N for a slide).  Where the forces vanish (a
+    joint whose axis is vertical, a link balanced on its joint) both models give rounding noise,
+    1e-16 N m, which a relative comparison alone would count as a disagreement."""
+    weight = float(np.sum(m.body_mass)) * max(float(np.linalg.norm(m.opt.gravity)), 1.0)
+    return max(1e-3 * weight * max(float(m.stat.extent), 1e-3), 1e-12)
 
 
 def _check(verdict: Verdict, kind: str, err: float, where: str) -> None:
@@ -295,8 +312,8 @@ def _dynamics(verdict, mujoco, om, od, rm, rd, T, label: str) -> None:
     scale = max(np.abs(expect).max(), 1e-300)
     _check(verdict, "matrix", float(np.abs(expect - Mr).max() / scale), f"mass matrix at {label}")
     go, gr = T.T @ od.qfrc_bias, rd.qfrc_bias
-    scale = max(np.abs(go).max(), 1e-12)
-    _check(verdict, "matrix", float(np.abs(go - gr).max() / scale), f"gravity forces at {label}")
+    _check(verdict, "matrix", float(np.abs(go - gr).max() / max(np.abs(go).max(), force_floor(om))),
+           f"gravity forces at {label}")
     single = [(i, r) for i in range(om.nv) for r in np.flatnonzero(T[i]) if np.count_nonzero(T[:, r]) == 1
               and np.count_nonzero(T[i]) == 1 and om.jnt_type[om.dof_jntid[i]] in (SLIDE, HINGE)]
     for i, r in single:
