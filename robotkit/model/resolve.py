@@ -179,7 +179,9 @@ def _loops(cx, links: set[str]) -> tuple[Loop, ...]:
         if loop.link1 == loop.link2:
             cx.report(("loops", name, "link2"), f"a loop cannot close link '{loop.link1}' on itself")
         out.append(Loop(name, loop.type, loop.link1, Pose(_t(loop.origin1.xyz), _t(loop.origin1.rpy)),
-                        loop.link2, Pose(_t(loop.origin2.xyz), _t(loop.origin2.rpy))))
+                        loop.link2, Pose(_t(loop.origin2.xyz), _t(loop.origin2.rpy)),
+                        None if loop.solref is None else tuple(loop.solref),
+                        None if loop.solimp is None else tuple(loop.solimp), loop.torquescale))
     return tuple(out)
 
 

@@ -275,6 +275,9 @@ class Loop:
     pose1: Pose
     link2: str
     pose2: Pose
+    solref: tuple[float, ...] | None = None  # MuJoCo's softness; None: its defaults
+    solimp: tuple[float, ...] | None = None
+    torquescale: float | None = None  # a weld's
 
 
 @dataclass(frozen=True)

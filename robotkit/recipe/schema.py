@@ -812,6 +812,18 @@ class Loop(Strict):
     """The second link."""
     origin2: Origin = Origin()
     """The point (or frame) on ``link2``, in its frame; where the loop closes, it is where ``origin1`` is."""
+    solref: Annotated[list[Annotated[float, _bounded(-MAX_VALUE, MAX_VALUE)]], Field(min_length=2, max_length=2)] | None = None
+    """How softly MuJoCo holds the loop closed (its ``solref``: time constant and damping ratio, or with both negative stiffness and damping); default MuJoCo's 0.02 1."""
+    solimp: Annotated[list[Annotated[float, _bounded(-MAX_VALUE, MAX_VALUE)]], Field(min_length=3, max_length=5)] | None = None
+    """MuJoCo's ``solimp`` of the loop's constraint (impedance dmin, dmax, width, midpoint, power); default MuJoCo's 0.9 0.95 0.001 0.5 2."""
+    torquescale: Annotated[float, Field(ge=0, le=MAX_VALUE)] | None = None
+    """A weld's ``torquescale``: how much its rotation counts against its translation (MuJoCo's default 1)."""
+
+    @model_validator(mode="after")
+    def _weld_only(self):
+        if self.torquescale is not None and self.type != "weld":
+            raise ValueError("torquescale is a weld's: a connect holds points, not frames")
+        return self
 
 
 class SelfCollision(Strict):
@@ -855,7 +867,7 @@ class Recipe(Strict):
     urdf_extras: list[XmlElement] = []
     """Raw XML elements (for example ``<gazebo>`` or ``<transmission>`` blocks the recipe cannot express yet) copied verbatim into the URDF; ``<gazebo>`` blocks are also carried into model.sdf as libsdformat's URDF conversion places them (sensors and plugins into the link named, surface tags into its collisions, joint tags into the joint), and what cannot be carried is listed. Each must be well-formed XML; ``${...}`` in them is not evaluated."""
     loops: dict[Name, Loop] = {}
-    """Closed kinematic loops by name (a four-bar linkage, a gripper's coupler): the MJCF holds each as an equality constraint between two sites (``<loop>_1`` on ``link1``, ``<loop>_2`` on ``link2``) with MuJoCo's default softness; the URDF and SDF, trees, leave them open (report.json lists them)."""
+    """Closed kinematic loops by name (a four-bar linkage, a gripper's coupler): the MJCF holds each as an equality constraint between two sites (``<loop>_1`` on ``link1``, ``<loop>_2`` on ``link2``), as soft as its ``solref`` and ``solimp`` say (MuJoCo's defaults unless given); the URDF and SDF, trees, leave them open (report.json lists them)."""
     mjcf_extras: list[MjcfSection] = []
     """Raw MJCF section elements (``<tendon>``, ``<equality>``, ``<sensor>``, ``<actuator>``, ``<contact>``, ``<custom>``... for what the recipe cannot express: tendons, loop closures, MuJoCo's other sensors) copied verbatim into the MJCF: each one's children are appended to that section of the generated file. Names in them are the MJCF's: bodies are links, joints are joints, and every frame link (no mass, no shape, fixed) is also a site of its name. Each must be well-formed XML and MuJoCo must load the MJCF with them (else the MJCF is not written); the other formats do not get them (report.json says so); ``${...}`` in them is not evaluated."""
     metadata: Metadata = Metadata()

@@ -188,6 +188,29 @@ loops:
     assert np.abs(d.efc_pos[rows[3:]]).max() == pytest.approx(math.sin(0.25))  # the weld's frames 0.5 rad apart
 
 
+def test_loop_softness_is_mujocos_solref_solimp_and_torquescale(tmp_path):
+    robot = _robot(tmp_path, LOOP + """
+loops:
+  close: {link1: arm, link2: base, solref: [0.005, 1], solimp: [0.95, 0.99, 0.001]}
+  hold: {type: weld, link1: arm, link2: base, torquescale: 2.5}
+""")
+    xml = render_mjcf(robot)
+    assert ('    <connect name="close" site1="close_1" site2="close_2" solref="0.005 1" solimp="0.95 0.99 0.001"/>\n'
+            '    <weld name="hold" site1="hold_1" site2="hold_2" torquescale="2.5"/>\n') in xml
+    m = mj.load().MjModel.from_xml_string(xml)
+    np.testing.assert_array_equal(m.eq_solref, [[0.005, 1], [0.02, 1]])
+    np.testing.assert_array_equal(m.eq_solimp[0], [0.95, 0.99, 0.001, 0.5, 2])  # the rest MuJoCo's defaults
+    assert m.eq_data[1][10] == 2.5
+
+
+def test_torquescale_is_a_welds(tmp_path):
+    recipe = write_recipe(tmp_path, LOOP + "loops:\n  close: {link1: arm, link2: base, torquescale: 2}\n")
+    with pytest.raises(RobotkitError) as err:
+        build([recipe], tmp_path / "out")
+    assert err.value.lines() == [
+        f"{recipe}:23: loops.close: torquescale is a weld's: a connect holds points, not frames"]
+
+
 def test_loop_names_links_of_the_robot(tmp_path):
     recipe = write_recipe(tmp_path, LOOP + """
 loops:

@@ -51,12 +51,12 @@ def test_tendons_actuators_equalities_sensors_custom_word_for_word(converted):
         'gainprm="3" biasprm="0" gear="1" ctrllimited="true" ctrlrange="-1 1" forcelimited="false" '
         'actlimited="false"/>\n'
         '</actuator>',
-        # the loop (with a softness of its own: not the recipe's loops): MuJoCo found its point on the
+        # the loop (inactive: not the recipe's loops): MuJoCo found its point on the
         # lever with the crank at its ref (20 degrees), where the rebuild's zero configuration is not:
         # two frame links at its two points, as sites;
         # the couplings: from the rebuild's zero configuration (the lever's ref 10 degrees)
         '<equality>\n'
-        '  <connect name="loop" site1="loop_anchor1" site2="loop_anchor2" solref="0.01 1"/>\n'
+        '  <connect name="loop" site1="loop_anchor1" site2="loop_anchor2" active="false" solref="0.01 1"/>\n'
         '  <joint name="cubic" joint1="slide" joint2="lever" polycoef="-0.0017506458289285372 0.010091385225936013 '
         '-0.0005235987755982989 0.001 0"/>\n'
         '  <weld name="hold" body1="lever" body2="base" anchor="0 0 0" relpose="-0.2 0 -0.15000000000000002 1 0 0 0" '
@@ -118,12 +118,14 @@ def test_ledger_word_for_word(converted):
     ]
 
 
-def test_loops_with_default_softness_are_the_recipes_loops(converted):
-    """Each end in its link's frame: the pendulum's hinge off its body's origin moves its link frame."""
+def test_active_loops_are_the_recipes_loops_softness_and_all(converted):
+    """Each end in its link's frame: the pendulum's hinge off its body's origin moves its link frame;
+    a softness other than MuJoCo's default is the loop's own (solimp: MuJoCo's default here)."""
     assert converted[0]["loops"] == {
         "pin": {"link1": "pend", "origin1": {"xyz": [0.0, 0.0, -0.12000000000000001]}, "link2": "base",
                 "origin2": {"xyz": [-0.1, 0.0, 0.10000000000000003]}},
-        "glue": {"type": "weld", "link1": "tray", "origin1": {"xyz": [0.0, -0.1, -0.1]}, "link2": "base"}}
+        "glue": {"type": "weld", "link1": "tray", "origin1": {"xyz": [0.0, -0.1, -0.1]}, "link2": "base",
+                 "solref": [0.01, 1.0], "torquescale": 3.0}}
 
 
 @pytest.fixture(scope="module")
@@ -145,7 +147,9 @@ def test_rebuild_with_its_extras_agrees_with_the_original(rebuilt):
     assert {k for k, v in result.verdict.worst.items() if v[1]} >= {"tendon", "sensor", "equality"}
     m = mj.load().MjModel.from_xml_path(str(folder / "copy" / "mjcf" / "extras.xml"))
     assert (m.ntendon, m.neq, m.nu, m.nsensor, m.nnumeric, m.ntext) == (2, 6, 4, 4, 1, 1)
-    assert '<connect name="pin" site1="pin_1" site2="pin_2"/>' in (folder / "copy" / "mjcf" / "extras.xml").read_text()
+    text = (folder / "copy" / "mjcf" / "extras.xml").read_text()
+    assert '<connect name="pin" site1="pin_1" site2="pin_2"/>' in text
+    assert '<weld name="glue" site1="glue_1" site2="glue_2" torquescale="3" solref="0.01 1"/>' in text
 
 
 def _mutated(folder: Path, tmp_path: Path, old: str, new: str) -> Path:
@@ -167,6 +171,10 @@ def _mutated(folder: Path, tmp_path: Path, old: str, new: str) -> Path:
     ('polycoef="0.17453292519943295 0 0 0 0"', 'polycoef="0.17 0 0 0 0"',
      "equality 'tendons' coupling at the zero configuration: equality off by 4.53e-03 (tolerance 1e-09)"),
     ('gainprm="3"', 'gainprm="4"', "actuator 'filtered' gains, bias, dynamics, gear and ranges: actuator off by "),
+    ('torquescale="3" solref="0.01 1"', 'torquescale="3" solref="0.02 1"',
+     "equality 'glue' softness: equality off by 3.33e-03 (tolerance 1e-09)"),
+    ('torquescale="3" solref="0.01 1"', 'torquescale="2" solref="0.01 1"',
+     "equality 'glue' softness: equality off by 3.33e-01 (tolerance 1e-09)"),
     ('<subtreecom name="com" body="base"/>', '<subtreecom name="com" body="lever"/>',
      "sensor 'com' at the zero configuration: sensor off by "),
 ])

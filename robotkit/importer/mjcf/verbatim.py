@@ -6,8 +6,8 @@ resolved as MuJoCo resolved them), in the rebuilt model's names: bodies are thei
 (``tree.link_of``), joints the recipe's (``tree.joint_map``), sites their frame links
 (``tree.sites``: the rebuilt MJCF gives every frame link a site of its name), actuators the
 rebuilt ones (``<joint>_<interface>``) or the verbatim ones.  Points in a body's frame move to its
-link's frame (``tree.offset``).  Active connect and weld constraints with MuJoCo's default
-softness are the recipe's ``loops`` instead (:func:`_loops`).  Kept: tendons (fixed, and spatial
+link's frame (``tree.offset``).  Active connect and weld constraints between two links are the
+recipe's ``loops`` instead, softness and all (:func:`_loops`).  Kept: tendons (fixed, and spatial
 through sites and pulleys), the other equality constraints but the mimic joints (connect, weld,
 joint, tendon), actuators the
 recipe's actuators do not hold (``tree.refused``), sensors other than the IMUs', custom numerics
@@ -365,16 +365,15 @@ LOOP = "the recipe's loop '{name}': URDF and SDF are trees, which leave it open"
 
 
 def _loops(src, tree, names: Names, ledger) -> dict:
-    """The recipe's ``loops``: the active connect and weld constraints with MuJoCo's default
-    softness (a weld: and torque scale) between two imported bodies or sites (the others are
-    verbatim: the recipe has no constraint softness), each end in its link's frame."""
+    """The recipe's ``loops``: the active connect and weld constraints between two imported
+    bodies or sites, each end in its link's frame, with their softness (solref, solimp, a weld's
+    torque scale) where it is not MuJoCo's default (the others are verbatim)."""
     m, specs, out = src.model, list(src.spec.equalities), {}
     sites = int(mj.load().mjtObj.mjOBJ_SITE)
     for e in range(m.neq):
         kind = EQ_KINDS.get(int(m.eq_type[e]))
         data = np.asarray(m.eq_data[e], float)
-        if (kind not in ("connect", "weld") or not m.eq_active0[e] or not np.allclose(m.eq_solref[e], SOLREF)
-                or not np.allclose(m.eq_solimp[e], SOLIMP) or (kind == "weld" and data[10] != 1)):
+        if kind not in ("connect", "weld") or not m.eq_active0[e]:
             continue
         a, b = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
         try:
@@ -398,11 +397,23 @@ def _loops(src, tree, names: Names, ledger) -> dict:
             loop[f"link{k}"] = link
             if o:
                 loop[f"origin{k}"] = o
-        out[name] = loop
+        out[name] = loop | _loop_softness(m, e, kind)
         names.looped.add(e)
         tree.verbatim.setdefault("equality", {})[e] = name
         ledger.add(src.where(specs[e]) if e < len(specs) else src.where(),
                    f"equality {kind}" + (f" '{eq}'" if eq else f" #{e}"), OTHERS, LOOP.format(name=name))
+    return out
+
+
+def _loop_softness(m, e: int, kind: str) -> dict:
+    """A loop's softness where it is not MuJoCo's default: solref, solimp, a weld's torquescale."""
+    out = {}
+    if not np.allclose(m.eq_solref[e], SOLREF, rtol=0, atol=0):
+        out["solref"] = [float(v) for v in m.eq_solref[e]]
+    if not np.allclose(m.eq_solimp[e], SOLIMP, rtol=0, atol=0):
+        out["solimp"] = [float(v) for v in m.eq_solimp[e]]
+    if kind == "weld" and float(m.eq_data[e][10]) != 1:
+        out["torquescale"] = float(m.eq_data[e][10])
     return out
 
 

@@ -53,7 +53,9 @@ def equalities(check, om, rm, tree) -> set[int]:
         where = f"equality '{om.eq(e).name or name}'"
         same = [int(om.eq_type[e]) == int(rm.eq_type[r]), bool(om.eq_active0[e]) == bool(rm.eq_active0[r])]
         check("equality", float(not all(same)), f"{where} type and state")
-        mine, theirs = (np.concatenate([m.eq_solref[i], m.eq_solimp[i]]) for m, i in ((om, e), (rm, r)))
+        # a weld's torque scale with its softness (eq_data[10]: how its rotation counts)
+        mine, theirs = (np.concatenate([m.eq_solref[i], m.eq_solimp[i], m.eq_data[i][10:11] * (m.eq_type[i] == WELD)])
+                        for m, i in ((om, e), (rm, r)))
         check("equality", float(np.abs(mine - theirs).max() / max(np.abs(mine).max(), 1e-300)), f"{where} softness")
     return set(kept)
 
