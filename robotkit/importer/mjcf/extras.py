@@ -155,6 +155,23 @@ def ledger_rest(src, tree, ledger) -> None:
                        + _ball_links(tree, int(m.jnt_bodyid[j])) + "; "
                        "its armature, damping and friction act on each angle, not on the angular velocity"
                        + (" (its cone limit as each angle's range)" if m.jnt_limited[j] else ""))
+    _gravcomp(src, ledger)
+
+
+def _gravcomp(src, ledger) -> None:
+    """A body's gravity compensation (``gravcomp``) and a joint's through its actuators
+    (``actuatorgravcomp``): the recipe has neither (the build's tuner alone sets them)."""
+    m = src.model
+    for b in range(1, m.nbody):
+        if m.body_gravcomp[b]:
+            ledger.add(src.where_named("body", m.body(b).name), f"body '{m.body(b).name}'", "all",
+                       f"gravity compensation dropped (gravcomp {float(m.body_gravcomp[b]):g}): the recipe has no "
+                       "gravity compensation")
+    for j in range(m.njnt):
+        if m.jnt_actgravcomp[j]:
+            ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}'", "all",
+                       "gravity compensation through its actuators dropped (actuatorgravcomp): the recipe has no "
+                       "gravity compensation")
 
 
 def _ball_links(tree, b: int) -> str:

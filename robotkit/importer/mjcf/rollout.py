@@ -10,11 +10,12 @@ else: the rebuilt model runs with the original's simulation options (timestep, i
 gravity, fluid density...); the original's dropped equality constraints are off (the mimic
 joints have the rebuilt's softness; those kept verbatim in ``mjcf_extras`` act in both as
 written), its dropped tendons and its joint springs have no stiffness, damping or friction, its
-joints' limits and friction loss have the rebuilt's softness, and its dropped actuators no force
-(those kept verbatim get the same control in both).  A model with a ball joint has no rollout:
-the three joints through chain links part from the ball (:func:`robotkit.importer.mjcf.verify.verify`
-says so).  Contacts are off in both: the robot alone has no floor, and the contact parameters the
-recipe cannot hold are on the ledger."""
+bodies and joints no gravity compensation, its joints' limits and friction loss have the
+rebuilt's softness, and its dropped actuators no force (those kept verbatim get the same
+control in both).  A model with a ball joint has no rollout: the three joints through chain
+links part from the ball (:func:`robotkit.importer.mjcf.verify.verify` says so).  Contacts are
+off in both: the robot alone has no floor, and the contact parameters the recipe cannot hold
+are on the ledger."""
 
 from __future__ import annotations
 
@@ -60,6 +61,7 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
             r = rebuilt_eq[tree.mimics[e]]
             om.eq_solref[e], om.eq_solimp[e] = rm.eq_solref[r], rm.eq_solimp[r]
     om.jnt_stiffness[:] = 0
+    om.body_gravcomp[:], om.jnt_actgravcomp[:] = 0, 0  # the recipe has no gravity compensation (on the ledger)
     for j, names in tree.joint_map.items():  # limit and friction softness: the rebuilt's (MuJoCo's defaults)
         if int(om.jnt_type[j]) in (SLIDE, HINGE):
             r = rm.joint(names[0]).id
