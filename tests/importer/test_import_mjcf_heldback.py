@@ -88,3 +88,33 @@ def test_gravity_compensation_is_on_the_ledger_and_out_of_the_rollout(tmp_path):
     assert result.verdict.ok, result.verdict.lines()
     assert result.verdict.lines()[0] == ("verified in MuJoCo against the original at 21 configurations and 1 rollout: "
                                          "every quantity agrees")
+
+
+NARROWED = """<mujoco model="leg">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="hip">
+      <geom type="box" size="0.05 0.05 0.05" mass="3"/>
+      <body name="thigh" pos="0 0 -0.1">
+        <joint name="haa" axis="1 0 0" range="-0.72 0.49" damping="1"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.03" mass="2"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <position name="haa" joint="haa" kp="100" ctrlrange="-6.28 6.28" forcerange="-80 80"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_rollout_drives_within_the_ctrlrange_the_rebuild_has(tmp_path):
+    """ANYmal C's position actuators take controls of +-6.28 rad on joints of narrower range: the
+    recipe writes the joint's range as the control range (on the ledger), so the verification's
+    rollout draws its controls within both (drawn within the original's alone, the original
+    pushes into its limit with its full 80 N and the rollout disagreed by 0.9 m)."""
+    (tmp_path / "leg.xml").write_text(NARROWED)
+    result = import_mjcf(tmp_path / "leg.xml", tmp_path / "out" / "leg.yaml", build=build_mjcf)
+    assert result.ledger[1:] == [
+        "leg.xml:13: actuator 'haa': all: ctrlrange [-6.28, 6.28] written as the joint's range [-0.72, 0.49]"]
+    assert result.verdict.ok, result.verdict.lines()

@@ -1,9 +1,10 @@
 """The rollout of the verification: from each keyframe of the original (its zero configuration
 when it has none), :data:`SECONDS` of simulation of the original and of the rebuilt MJCF under
 the same control sequence (each kept actuator's control drawn within the original's
-``ctrlrange``, held for :data:`HOLD` s; a motor whose gear the recipe moved into its control
-gets the control times that gear), every original body's frame compared with its link's at
-the end of every hold.
+``ctrlrange`` and the rebuilt's, which the ledger says may be narrowed to its joint's range,
+held for :data:`HOLD` s; a motor whose gear the recipe moved into its control gets the control
+times that gear), every original body's frame compared with its link's at the end of every
+hold.
 
 What is on the ledger is taken out of both first, so that the rollout compares everything
 else: the rebuilt model runs with the original's simulation options (timestep, integrator,
@@ -86,9 +87,13 @@ def _controls(om, rm, kept: dict[int, int], rng) -> list[tuple[np.ndarray, np.nd
         uo, ur = np.zeros(om.nu), np.zeros(rm.nu)
         for a, r in kept.items():
             lo, hi = om.actuator_ctrlrange[a] if om.actuator_ctrllimited[a] else (-1.0, 1.0)
-            uo[a] = rng.uniform(lo, hi)
             motor = int(om.actuator_biastype[a]) == 0
             same = om.actuator_gear[a][0] == rm.actuator_gear[r][0]  # a verbatim actuator's (its gear may be 0)
+            if rm.actuator_ctrllimited[r] and (same or not motor):  # a ctrlrange narrowed to the joint's range
+                lo, hi = max(lo, rm.actuator_ctrlrange[r][0]), min(hi, rm.actuator_ctrlrange[r][1])  # (on the ledger)
+                if lo > hi:
+                    lo, hi = om.actuator_ctrlrange[a]
+            uo[a] = rng.uniform(lo, hi)
             ur[r] = uo[a] * float(om.actuator_gear[a][0]) / float(rm.actuator_gear[r][0]) if motor and not same else uo[a]
         out.append((uo, ur))
     return out
