@@ -118,3 +118,28 @@ def test_rollout_drives_within_the_ctrlrange_the_rebuild_has(tmp_path):
     assert result.ledger[1:] == [
         "leg.xml:13: actuator 'haa': all: ctrlrange [-6.28, 6.28] written as the joint's range [-0.72, 0.49]"]
     assert result.verdict.ok, result.verdict.lines()
+
+
+MOCAP = """<mujoco model="reach">
+  <worldbody>
+    <body name="arm">
+      <joint name="j" axis="0 0 1"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02" mass="1"/>
+    </body>
+    <body name="target" mocap="true" pos="0.3 0 0.2">
+      <geom type="sphere" size="0.02" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_mocap_body_is_on_the_ledger(tmp_path):
+    """A mocap body (ALOHA's and the arms' teleoperation targets): the recipe's link is fixed
+    where the file puts it, and the ledger says the mocap is dropped."""
+    (tmp_path / "reach.xml").write_text(MOCAP)
+    recipe, ledger, _, _ = convert(tmp_path / "reach.xml", tmp_path / "out" / "reach.yaml")
+    assert recipe["joints"]["target_fixed"] == {"type": "fixed", "parent": "world", "child": "target",
+                                                "origin": {"xyz": [0.3, 0, 0.2]}}
+    assert ledger.lines()[1:] == ["reach.xml:7: body 'target' (mocap): all: mocap dropped: a link fixed where the "
+                                  "file puts it (the recipe has no mocap bodies)"]

@@ -155,14 +155,18 @@ def ledger_rest(src, tree, ledger) -> None:
                        + _ball_links(tree, int(m.jnt_bodyid[j])) + "; "
                        "its armature, damping and friction act on each angle, not on the angular velocity"
                        + (" (its cone limit as each angle's range)" if m.jnt_limited[j] else ""))
-    _gravcomp(src, ledger)
+    _bodies(src, ledger)
 
 
-def _gravcomp(src, ledger) -> None:
-    """A body's gravity compensation (``gravcomp``) and a joint's through its actuators
-    (``actuatorgravcomp``): the recipe has neither (the build's tuner alone sets them)."""
+def _bodies(src, ledger) -> None:
+    """A mocap body (the recipe's link is fixed), a body's gravity compensation (``gravcomp``)
+    and a joint's through its actuators (``actuatorgravcomp``): the recipe has none of them (the
+    build's tuner alone sets gravity compensation)."""
     m = src.model
     for b in range(1, m.nbody):
+        if m.body_mocapid[b] >= 0:
+            ledger.add(src.where_named("body", m.body(b).name), f"body '{m.body(b).name}' (mocap)", "all",
+                       "mocap dropped: a link fixed where the file puts it (the recipe has no mocap bodies)")
         if m.body_gravcomp[b]:
             ledger.add(src.where_named("body", m.body(b).name), f"body '{m.body(b).name}'", "all",
                        f"gravity compensation dropped (gravcomp {float(m.body_gravcomp[b]):g}): the recipe has no "
