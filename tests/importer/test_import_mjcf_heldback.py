@@ -4,6 +4,8 @@ with its known answer (ledger lines word for word)."""
 
 from __future__ import annotations
 
+import yaml
+
 from robotkit.commands.import_ import build_mjcf
 from robotkit.importer import import_mjcf
 from robotkit.importer.mjcf import convert
@@ -143,3 +145,40 @@ def test_mocap_body_is_on_the_ledger(tmp_path):
                                                 "origin": {"xyz": [0.3, 0, 0.2]}}
     assert ledger.lines()[1:] == ["reach.xml:7: body 'target' (mocap): all: mocap dropped: a link fixed where the "
                                   "file puts it (the recipe has no mocap bodies)"]
+
+
+SITE_LOOP = """<mujoco model="linkage">
+  <compiler angle="radian"/>
+  <worldbody>
+    <site name="anchor" pos="0.4 0 0"/>
+    <body name="crank">
+      <joint name="c" axis="0 1 0" range="-1 1"/>
+      <geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01" mass="0.2"/>
+      <body name="rod" pos="0.2 0 0">
+        <joint name="r" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01" mass="0.2"/>
+        <site name="rod_end" pos="0.2 0 0"/>
+      </body>
+    </body>
+  </worldbody>
+  <equality>
+    <connect site1="rod_end" site2="anchor"/>
+  </equality>
+  <actuator>
+    <position name="c" joint="c" kp="20" ctrlrange="-1 1"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_loop_between_sites_closes_on_the_sites_bodies(tmp_path):
+    """A connect between two sites (MuJoCo 3's form, as in newer Menagerie linkages): the recipe's
+    loop closes on the links of the sites' bodies at the sites' points, not on the sites' frame
+    links, which are massless: MuJoCo's constraint softness weighs the constrained bodies, and the
+    loop on massless links moved otherwise (the rollout disagreed by 0.2 m)."""
+    (tmp_path / "linkage.xml").write_text(SITE_LOOP)
+    result = import_mjcf(tmp_path / "linkage.xml", tmp_path / "out" / "linkage.yaml", build=build_mjcf)
+    recipe = yaml.safe_load(result.recipe_path.read_text())
+    assert recipe["loops"] == {"loop0": {"link1": "rod", "origin1": {"xyz": [0.2, 0, 0]},
+                                         "link2": "world", "origin2": {"xyz": [0.4, 0, 0]}}}
+    assert result.verdict.ok, result.verdict.lines()

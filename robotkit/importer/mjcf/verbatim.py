@@ -367,7 +367,9 @@ LOOP = "the recipe's loop '{name}': URDF and SDF are trees, which leave it open"
 def _loops(src, tree, names: Names, ledger) -> dict:
     """The recipe's ``loops``: the active connect and weld constraints with MuJoCo's default
     softness (a weld: and torque scale) between two imported bodies or sites (the others are
-    verbatim: the recipe has no constraint softness), each end in its link's frame."""
+    verbatim: the recipe has no constraint softness), each end in its link's frame: a site's
+    on its body's link, not on the site's frame link (massless: MuJoCo's constraint softness
+    weighs the constrained bodies, and a soft loop on massless links moves otherwise)."""
     m, specs, out = src.model, list(src.spec.equalities), {}
     sites = int(mj.load().mjtObj.mjOBJ_SITE)
     for e in range(m.neq):
@@ -378,8 +380,10 @@ def _loops(src, tree, names: Names, ledger) -> dict:
             continue
         a, b = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
         try:
-            if int(m.eq_objtype[e]) == sites:
-                ends = [(names.site(a), None), (names.site(b), None)]
+            if int(m.eq_objtype[e]) == sites:  # each site's frame on its body's link (MuJoCo weighs the bodies)
+                ends = [(names.body(int(m.site_bodyid[s])),
+                         origin(m.site_pos[s] - names.offset(int(m.site_bodyid[s])),
+                                quat_matrix(m.site_quat[s]) if kind == "weld" else np.eye(3))) for s in (a, b)]
             elif kind == "connect":
                 ends = [(names.body(a), origin(data[:3] - names.offset(a), np.eye(3))),
                         (names.body(b), origin(data[3:6] - names.offset(b), np.eye(3)))]
