@@ -182,3 +182,48 @@ def test_loop_between_sites_closes_on_the_sites_bodies(tmp_path):
     assert recipe["loops"] == {"loop0": {"link1": "rod", "origin1": {"xyz": [0.2, 0, 0]},
                                          "link2": "world", "origin2": {"xyz": [0.4, 0, 0]}}}
     assert result.verdict.ok, result.verdict.lines()
+
+
+BODY_SENSORS = """<mujoco model="leg">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="thigh">
+      <joint name="hip" axis="0 1 0" range="-1 1"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.02" mass="1"/>
+      <body name="shin" pos="0 0 -0.3">
+        <joint name="knee" axis="0 1 0" range="-1 1"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.3" size="0.02" mass="0.5"/>
+        <site name="knee_site"/>
+        <site name="foot" pos="0 0 -0.3" size="0.03"/>
+      </body>
+    </body>
+  </worldbody>
+  <sensor>
+    <force name="knee_force" site="knee_site"/>
+    <torque name="knee_torque" site="knee_site"/>
+    <touch name="foot_touch" site="foot"/>
+    <gyro name="shin_gyro" site="knee_site"/>
+  </sensor>
+</mujoco>
+"""
+
+
+def test_force_torque_and_touch_sensors_on_a_site_are_dropped_saying_why(tmp_path):
+    """The fruit fly's tarsus force sensors and its claws' touch sensors read the site's body (the
+    force from its parent, its geoms' contacts); the rebuild holds each site on a frame link of
+    its own (a massless body without geoms), where they read nothing: dropped, on the ledger (kept
+    verbatim, the force sensor disagreed by 4e-2 and the touch sensor would read no contact); a
+    gyro, which reads the site's motion, is kept."""
+    (tmp_path / "leg.xml").write_text(BODY_SENSORS)
+    result = import_mjcf(tmp_path / "leg.xml", tmp_path / "out" / "leg.yaml", build=build_mjcf)
+    assert [line for line in result.ledger if "sensor" in line] == [
+        "leg.xml:16: sensor 'knee_force': all: dropped: it reads the force between site 'knee_site''s body and its "
+        "parent, and the rebuild holds the site on a frame link of its own (a massless body)",
+        "leg.xml:17: sensor 'knee_torque': all: dropped: it reads the force between site 'knee_site''s body and its "
+        "parent, and the rebuild holds the site on a frame link of its own (a massless body)",
+        "leg.xml:18: sensor 'foot_touch': all: dropped: it reads the contacts of site 'foot''s body, and the rebuild "
+        "holds the site on a frame link of its own (a body without geoms)",
+        "leg.xml:19: sensor 'shin_gyro': urdf, sdf: dropped: the recipe has no gyro sensors (kept verbatim in "
+        "mjcf_extras for the MJCF)",
+    ]
+    assert result.verdict.ok, result.verdict.lines()

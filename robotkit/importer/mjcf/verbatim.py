@@ -452,10 +452,18 @@ def _sensors(src, tree, names: Names):
 
 
 SITE_SENSORS = ("touch", "accelerometer", "velocimeter", "gyro", "force", "torque", "magnetometer", "rangefinder")
+BODY_SENSORS = ("touch", "force", "torque")
+"""Site sensors that read the site's body (its contacts, the force from its parent), not the site's motion."""
 
 
 def _sensor_target(m, i: int, tag: str, names: Names) -> dict:
     obj, ref = int(m.sensor_objid[i]), int(m.sensor_refid[i])
+    if tag in BODY_SENSORS:  # the rebuild's site is on a frame link: a body of its own, massless, without geoms
+        site = m.site(obj).name
+        raise Dropped(f"it reads the contacts of site '{site}''s body, and the rebuild holds the site on a frame link "
+                      "of its own (a body without geoms)" if tag == "touch" else
+                      f"it reads the force between site '{site}''s body and its parent, and the rebuild holds the site "
+                      "on a frame link of its own (a massless body)")
     if tag in SITE_SENSORS:
         return {"site": names.site(obj)}
     for prefix, attr, name in (("joint", "joint", names.joint), ("tendon", "tendon", names.tendon),
