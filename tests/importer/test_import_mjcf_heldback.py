@@ -227,3 +227,61 @@ def test_force_torque_and_touch_sensors_on_a_site_are_dropped_saying_why(tmp_pat
         "mjcf_extras for the MJCF)",
     ]
     assert result.verdict.ok, result.verdict.lines()
+
+
+WING = """<mujoco model="wing">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="thorax">
+      <geom type="box" size="0.01 0.01 0.01" mass="0.001"/>
+      <body name="wing" pos="0.01 0 0">
+        <joint name="yaw" axis="0 0 1" range="-1 1"/>
+        <joint name="roll" axis="1 0 0" range="-1 1"/>
+        <geom type="box" size="0.0005 0.02 0.005" pos="0 0.02 0" mass="8e-6"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_chain_link_of_a_body_of_micrograms_gets_the_least_mass_a_recipe_takes(tmp_path):
+    """The fruit fly's wing (8e-6 kg, three hinges) is too light to give its chain links their
+    point mass, and a millionth of the lightest body (8e-12 kg) is below the least mass a recipe
+    takes: the link gets that least mass, 1e-9 kg, added and stated (it was a refusal: 'the
+    imported recipe would be invalid')."""
+    (tmp_path / "wing.xml").write_text(WING)
+    result = import_mjcf(tmp_path / "wing.xml", tmp_path / "out" / "wing.yaml")
+    assert result.ledger[0] == (
+        "wing.xml:6: body 'wing' (joint chain): all: approximated: chain link 'wing_yaw' carries an added point mass "
+        "of 1e-09 kg (the least mass a recipe takes), not taken from the body: the body is too light to give it (what "
+        "would be left is not a physical body); Gazebo (libsdformat's URDF reader) drops a link of 1e-06 kg or less "
+        "with everything below it")
+    assert yaml.safe_load(result.recipe_path.read_text())["links"]["wing_yaw"]["inertial"]["mass"] == 1e-9
+
+
+CM_UNITS = """<mujoco model="pendulum_cm">
+  <compiler angle="radian"/>
+  <option gravity="0 0 -981"/>
+  <worldbody>
+    <body name="arm">
+      <joint name="swing" axis="0 1 0" range="-1 1" damping="0.1"/>
+      <geom type="capsule" fromto="0 0 0 10 0 0" size="1" mass="2"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <position name="swing" joint="swing" kp="3000" ctrlrange="-1 1"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_verification_compares_under_the_original_gravity(tmp_path):
+    """A model in centimetres (the fruit fly's gravity is -981): the rebuilt MJCF has the standard
+    gravity (on the ledger), and the verification compares the gravity forces under the original's,
+    as its rollout runs with all the original's options (they disagreed by 99 %)."""
+    (tmp_path / "pendulum.xml").write_text(CM_UNITS)
+    result = import_mjcf(tmp_path / "pendulum.xml", tmp_path / "out" / "pendulum.yaml", build=build_mjcf)
+    assert result.ledger[0] == ("pendulum.xml:3: option gravity: all: 0 0 -981 dropped: the rebuilt MJCF has 0 0 -9.81 "
+                                "(the recipe has no simulation options)")
+    assert result.verdict.ok, result.verdict.lines()
