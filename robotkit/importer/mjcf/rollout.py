@@ -8,7 +8,7 @@ hold.
 
 What is on the ledger is taken out of both first, so that the rollout compares everything
 else: the rebuilt model runs with the original's simulation options (timestep, integrator,
-gravity, fluid density...); the original's dropped equality constraints are off (the mimic
+gravity...); the original's dropped equality constraints are off (the mimic
 joints have the rebuilt's softness; those kept verbatim in ``mjcf_extras`` act in both as
 written), its dropped tendons and its joint springs have no stiffness, damping or friction, its
 bodies and joints no gravity compensation, its joints' limits and friction loss have the
@@ -16,7 +16,8 @@ rebuilt's softness, and its dropped actuators no force (those kept verbatim get 
 control in both).  A model with a ball joint has no rollout: the three joints through chain
 links part from the ball (:func:`robotkit.importer.mjcf.verify.verify` says so).  Contacts are
 off in both: the robot alone has no floor, and the contact parameters the recipe cannot hold
-are on the ledger."""
+are on the ledger; so is the medium (fluid density, viscosity, wind: the rebuild has none, and
+its forces act on each body's equivalent inertia box, which a body's joint chain splits)."""
 
 from __future__ import annotations
 
@@ -53,6 +54,7 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
             setattr(rm.opt, name, copy.copy(value))
     for m in (om, rm):
         m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        m.opt.density, m.opt.viscosity, m.opt.wind[:] = 0.0, 0.0, 0.0  # no medium: see the module docstring
     rebuilt_eq = {(rm.joint(int(rm.eq_obj1id[e])).name, rm.joint(int(rm.eq_obj2id[e])).name): e
                   for e in range(rm.neq) if int(rm.eq_type[e]) == 2 and int(rm.eq_obj2id[e]) >= 0}
     for e in range(om.neq):
