@@ -319,3 +319,31 @@ def test_rollout_runs_without_the_medium_the_rebuild_lacks(tmp_path):
     assert [line.split(": all: ")[0] for line in result.ledger if "option" in line] == [
         "swimmer.xml:3: option density", "swimmer.xml:3: option viscosity", "swimmer.xml:3: option integrator"]
     assert result.verdict.ok, result.verdict.lines()
+
+
+IMU_CUTOFF = """<mujoco model="torso">
+  <worldbody>
+    <body name="torso">
+      <freejoint/>
+      <geom type="box" size="0.1 0.1 0.2" mass="10"/>
+      <site name="imu" pos="0.03 0 0.1"/>
+    </body>
+  </worldbody>
+  <sensor>
+    <gyro name="imu_gyro" site="imu" noise="5e-4" cutoff="54.9"/>
+    <accelerometer name="imu_accel" site="imu" noise="1e-4" cutoff="157"/>
+  </sensor>
+</mujoco>
+"""
+
+
+def test_imu_cutoff_is_on_the_ledger(tmp_path):
+    """Apptronik Apollo's IMU: a gyro and an accelerometer with noise and a cutoff; the recipe's
+    imu sensor keeps the noise and has no cutoff: each cutoff is a ledger line (it went unsaid)."""
+    (tmp_path / "torso.xml").write_text(IMU_CUTOFF)
+    recipe, ledger, _, _ = convert(tmp_path / "torso.xml", tmp_path / "out" / "torso.yaml")
+    assert recipe["sensors"]["imu"]["imu"] == {"gyro_noise": 5e-4, "accel_noise": 1e-4}
+    assert [line for line in ledger.lines() if "cutoff" in line] == [
+        "torso.xml:10: sensor 'imu_gyro' (gyro): all: cutoff 54.9 dropped: the recipe's imu sensor has no cutoff",
+        "torso.xml:11: sensor 'imu_accel' (accel): all: cutoff 157 dropped: the recipe's imu sensor has no cutoff",
+    ]
