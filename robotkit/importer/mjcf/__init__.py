@@ -100,7 +100,8 @@ def import_mjcf(path: str | os.PathLike, out_recipe: str | os.PathLike, build=No
         tmp.unlink(missing_ok=True)
         raise
     os.replace(tmp, out)
-    return Imported(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *files], notes, root)
+    return Imported(out, recipe["robot"], ledger.lines(), verdict, [str(src.path), *map(str, src.includes()), *files],
+                    notes, root)
 
 
 def _chain_comment(src, tree, link: str) -> str:

@@ -14,8 +14,8 @@ of mass and inertia tensor moved so that the two together are the original body
 
 A link after which a joint slides (no point stays fixed), after hinges whose axes do not meet,
 or of a body too light to give the mass (what is left would not be a physical body) keeps a
-millionth of the lightest body's mass, added (robotkit.importer.mjcf.tree.CHAIN_MASS): stated
-on the ledger."""
+millionth of the lightest body's mass (not below the least mass a recipe takes: a fruit fly's
+bodies weigh micrograms), added (robotkit.importer.mjcf.tree.CHAIN_MASS): stated on the ledger."""
 
 from __future__ import annotations
 
@@ -24,6 +24,7 @@ import numpy as np
 from robotkit.importer.inertials import POINT_MASS_FLOOR
 from robotkit.importer.mjcf.frames import clean
 from robotkit.model.inertia_policy import MIN_MOMENT, defects, mujoco_ready
+from robotkit.recipe.schema import MIN_MASS
 
 CHAIN_POINT_MASS = POINT_MASS_FLOOR
 """kg: the point mass a chain link takes from its body (libsdformat keeps a link above 1e-6 kg)."""
@@ -146,13 +147,14 @@ def place_chain_masses(src, tree, ledger) -> None:
 
 def _ledger(src, tree, ledger, b: int, light: list[str], why: str) -> None:
     mass = float(tree.links[light[0]]["inertial"]["mass"])
+    share = "a millionth of the lightest body" if mass > MIN_MASS else "the least mass a recipe takes"
     dropped = ("; Gazebo (libsdformat's URDF reader) drops a link of 1e-06 kg or less with everything below it"
                if mass <= 1e-6 else "")
     name = src.model.body(b).name
     links = ", ".join(f"'{n}'" for n in light)
     ledger.add(src.where_named("body", name), f"body '{tree.link_of[b]}' (joint chain)", "all",
                f"approximated: chain link{'s' if len(light) > 1 else ''} {links} carr{'y' if len(light) > 1 else 'ies'} "
-               f"an added point mass of {mass:.3g} kg (a millionth of the lightest body), not taken from the body: "
+               f"an added point mass of {mass:.3g} kg ({share}), not taken from the body: "
                f"{why}{dropped}")
 
 

@@ -127,6 +127,22 @@ def add_equalities(src, tree, recipe: dict, ledger) -> None:
                                "dropped: the rebuilt MJCF has MuJoCo's defaults (the recipe has no constraint softness)")
                 continue
         # the others are kept verbatim if they can be (robotkit.importer.mjcf.verbatim), on the ledger
+    _chained(src, tree, ledger)
+
+
+def _chained(src, tree, ledger) -> None:
+    """A mimic of a mimic (Stretch's telescoping arm: l0 follows l1, which follows l2...): kept
+    (the MJCF's equalities are a chain, and the rebuild's dynamics with them), and stated for the
+    URDF and SDF: Drake and Gazebo do not follow a chain of mimic joints (robotkit check's consumers)."""
+    specs = list(src.spec.equalities)
+    for e, (child, leader) in tree.mimics.items():
+        up = tree.joints[leader].get("mimic")
+        if up:
+            name = src.model.eq(e).name
+            ledger.add(src.where(specs[e]) if e < len(specs) else src.where(),
+                       f"equality joint '{name}'" if name else f"equality joint #{e}", "urdf, sdf",
+                       f"joint '{child}' mimics '{leader}', itself a mimic of '{up['joint']}': Drake and Gazebo do not "
+                       "follow a chain of mimic joints")
 
 
 def _one_dof(m, a: int, b: int) -> bool:
@@ -157,6 +173,27 @@ def ledger_rest(src, tree, ledger) -> None:
                        + _ball_links(tree, int(m.jnt_bodyid[j])) + "; "
                        "its armature, damping and friction act on each angle, not on the angular velocity"
                        + (" (its cone limit as each angle's range)" if m.jnt_limited[j] else ""))
+    _bodies(src, ledger)
+
+
+def _bodies(src, ledger) -> None:
+    """A mocap body (the recipe's link is fixed), a body's gravity compensation (``gravcomp``)
+    and a joint's through its actuators (``actuatorgravcomp``): the recipe has none of them (the
+    build's tuner alone sets gravity compensation)."""
+    m = src.model
+    for b in range(1, m.nbody):
+        if m.body_mocapid[b] >= 0:
+            ledger.add(src.where_named("body", m.body(b).name), f"body '{m.body(b).name}' (mocap)", "all",
+                       "mocap dropped: a link fixed where the file puts it (the recipe has no mocap bodies)")
+        if m.body_gravcomp[b]:
+            ledger.add(src.where_named("body", m.body(b).name), f"body '{m.body(b).name}'", "all",
+                       f"gravity compensation dropped (gravcomp {float(m.body_gravcomp[b]):g}): the recipe has no "
+                       "gravity compensation")
+    for j in range(m.njnt):
+        if m.jnt_actgravcomp[j]:
+            ledger.add(src.where_named("joint", m.joint(j).name), f"joint '{m.joint(j).name}'", "all",
+                       "gravity compensation through its actuators dropped (actuatorgravcomp): the recipe has no "
+                       "gravity compensation")
 
 
 def _ball_links(tree, b: int) -> str:

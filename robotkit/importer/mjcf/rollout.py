@@ -1,20 +1,23 @@
 """The rollout of the verification: from each keyframe of the original (its zero configuration
 when it has none), :data:`SECONDS` of simulation of the original and of the rebuilt MJCF under
 the same control sequence (each kept actuator's control drawn within the original's
-``ctrlrange``, held for :data:`HOLD` s; a motor whose gear the recipe moved into its control
-gets the control times that gear), every original body's frame compared with its link's at
-the end of every hold.
+``ctrlrange`` and the rebuilt's, which the ledger says may be narrowed to its joint's range,
+held for :data:`HOLD` s; a motor whose gear the recipe moved into its control gets the control
+times that gear), every original body's frame compared with its link's at the end of every
+hold.
 
 What is on the ledger is taken out of both first, so that the rollout compares everything
 else: the rebuilt model runs with the original's simulation options (timestep, integrator,
-gravity, fluid density...); the original's dropped equality constraints are off (the mimic
+gravity...); the original's dropped equality constraints are off (the mimic
 joints have the rebuilt's softness; those kept verbatim in ``mjcf_extras`` act in both as
 written), its dropped tendons and its joint springs have no stiffness, damping or friction, its
-joints' limits and friction loss have the rebuilt's softness, and its dropped actuators no force
-(those kept verbatim get the same control in both).  A model with a ball joint has no rollout:
-the three joints through chain links part from the ball (:func:`robotkit.importer.mjcf.verify.verify`
-says so).  Contacts are off in both: the robot alone has no floor, and the contact parameters the
-recipe cannot hold are on the ledger."""
+bodies and joints no gravity compensation, its joints' limits and friction loss have the
+rebuilt's softness, and its dropped actuators no force (those kept verbatim get the same
+control in both).  A model with a ball joint has no rollout: the three joints through chain
+links part from the ball (:func:`robotkit.importer.mjcf.verify.verify` says so).  Contacts are
+off in both: the robot alone has no floor, and the contact parameters the recipe cannot hold
+are on the ledger; so is the medium (fluid density, viscosity, wind: the rebuild has none, and
+its forces act on each body's equivalent inertia box, which a body's joint chain splits)."""
 
 from __future__ import annotations
 
@@ -51,6 +54,7 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
             setattr(rm.opt, name, copy.copy(value))
     for m in (om, rm):
         m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        m.opt.density, m.opt.viscosity, m.opt.wind[:] = 0.0, 0.0, 0.0  # no medium: see the module docstring
     rebuilt_eq = {(rm.joint(int(rm.eq_obj1id[e])).name, rm.joint(int(rm.eq_obj2id[e])).name): e
                   for e in range(rm.neq) if int(rm.eq_type[e]) == 2 and int(rm.eq_obj2id[e]) >= 0}
     for e in range(om.neq):
@@ -60,6 +64,7 @@ def _neutralised(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int
             r = rebuilt_eq[tree.mimics[e]]
             om.eq_solref[e], om.eq_solimp[e] = rm.eq_solref[r], rm.eq_solimp[r]
     om.jnt_stiffness[:] = 0
+    om.body_gravcomp[:], om.jnt_actgravcomp[:] = 0, 0  # the recipe has no gravity compensation (on the ledger)
     for j, names in tree.joint_map.items():  # limit and friction softness: the rebuilt's (MuJoCo's defaults)
         if int(om.jnt_type[j]) in (SLIDE, HINGE):
             r = rm.joint(names[0]).id
@@ -84,9 +89,13 @@ def _controls(om, rm, kept: dict[int, int], rng) -> list[tuple[np.ndarray, np.nd
         uo, ur = np.zeros(om.nu), np.zeros(rm.nu)
         for a, r in kept.items():
             lo, hi = om.actuator_ctrlrange[a] if om.actuator_ctrllimited[a] else (-1.0, 1.0)
-            uo[a] = rng.uniform(lo, hi)
             motor = int(om.actuator_biastype[a]) == 0
             same = om.actuator_gear[a][0] == rm.actuator_gear[r][0]  # a verbatim actuator's (its gear may be 0)
+            if rm.actuator_ctrllimited[r] and (same or not motor):  # a ctrlrange narrowed to the joint's range
+                lo, hi = max(lo, rm.actuator_ctrlrange[r][0]), min(hi, rm.actuator_ctrlrange[r][1])  # (on the ledger)
+                if lo > hi:
+                    lo, hi = om.actuator_ctrlrange[a]
+            uo[a] = rng.uniform(lo, hi)
             ur[r] = uo[a] * float(om.actuator_gear[a][0]) / float(rm.actuator_gear[r][0]) if motor and not same else uo[a]
         out.append((uo, ur))
     return out

@@ -1,7 +1,7 @@
 """MuJoCo sensors the recipe has a type for: a gyro and an accelerometer on one site are the
-recipe's ``imu`` sensor on that site's frame (its noise kept); the rebuilt MJCF names them
-``<imu>_gyro`` and ``<imu>_accel`` on a site ``<imu>_site``, which the ledger says.  Every other
-sensor is on the ledger (:func:`robotkit.importer.mjcf.extras.ledger_rest`)."""
+recipe's ``imu`` sensor on that site's frame (its noise kept, a cutoff on the ledger); the
+rebuilt MJCF names them ``<imu>_gyro`` and ``<imu>_accel`` on a site ``<imu>_site``, which the
+ledger says.  Every other sensor is on the ledger (:func:`robotkit.importer.mjcf.extras.ledger_rest`)."""
 
 from __future__ import annotations
 
@@ -43,6 +43,9 @@ def add_imus(src, tree, recipe: dict, ledger) -> None:
             where = src.where(specs[i]) if i < len(specs) else src.where()
             ledger.add(where, f"sensor '{m.sensor(i).name}' ({suffix})", "mjcf",
                        f"the recipe's imu sensor '{name}': written as '{name}_{suffix}' on site '{name}_site'")
+            if float(m.sensor_cutoff[i]):
+                ledger.add(where, f"sensor '{m.sensor(i).name}' ({suffix})", "all",
+                           f"cutoff {float(m.sensor_cutoff[i]):g} dropped: the recipe's imu sensor has no cutoff")
     for name in sensors:
         del tree.links[name]
     if sensors:

@@ -10,11 +10,19 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from robotkit import mj
+from robotkit import mj, urdfxml
 from robotkit.errors import Problem, RobotkitError
 
 _LINE = re.compile(r"line (\d+)")
 _TINYXML_LINE = re.compile(r"Line number=(\d+)")
+_SECTIONS = {"actuator", "sensor", "tendon", "equality", "keyframe", "contact"}
+"""Sections whose elements are named by their section (an actuator is <position>, <motor>...)."""
+_TAGS = {"freejoint": "joint"}
+_KINDS = {"MjsBody": "body", "MjsJoint": "joint", "MjsGeom": "geom", "MjsSite": "site", "MjsCamera": "camera",
+          "MjsLight": "light", "MjsFrame": "frame", "MjsMesh": "mesh", "MjsMaterial": "material",
+          "MjsTexture": "texture", "MjsActuator": "actuator", "MjsSensor": "sensor", "MjsTendon": "tendon",
+          "MjsEquality": "equality", "MjsKey": "keyframe", "MjsExclude": "contact", "MjsPair": "contact"}
+"""The section or tag of each MjSpec element class (its key in :meth:`Source.named_lines`)."""
 
 
 @dataclass
@@ -25,42 +33,67 @@ class Source:
     textured_noted: set = field(default_factory=set)
     _lines: dict | None = None
 
-    def line(self, element) -> int | None:
-        """The source line MuJoCo recorded for a spec element (``info``: 'line 26'), else the
-        line of the element of that name in the file's own text (a light scan)."""
+    def located(self, element) -> tuple[str, int | None]:
+        """(file label, line) of a spec element: the line MuJoCo recorded (``info``: 'line 26';
+        'line 0' for an element read from an ``<include>``d file), else the line of the element
+        of its kind and name in the text of the main file or of a file it includes (a light scan)."""
         found = _LINE.search(getattr(element, "info", "") or "")
-        if found:
-            return int(found.group(1))
+        if found and int(found.group(1)):
+            return self.path.name, int(found.group(1))
         name = getattr(element, "name", "")
-        return self.named_lines().get(name) if name else None
+        kind = _KINDS.get(type(element).__name__, "")
+        return self.named_lines().get((kind, name), (self.path.name, None)) if name else (self.path.name, None)
 
-    def named_lines(self) -> dict[str, int]:
-        """Line of each named element of the main file (the first of a name)."""
+    def named_lines(self) -> dict:
+        """(file label, line) of each element of the main file and the files it includes, in the
+        order MuJoCo reads them, the first of a name: by ``(kind, name)`` (kind: the element's
+        section for actuators, sensors, tendons, equalities, keys and contacts, else its tag) and
+        by ``<tag>``."""
         if self._lines is None:
-            from robotkit import urdfxml
-
-            try:
-                root = urdfxml.parse_text(self.path.read_text(encoding="utf-8")).getroot()
-                self._lines = {}
+            self._lines = {}
+            for label, root in self._texts():
                 for e in root.iter():
                     if urdfxml.is_element(e):
-                        self._lines.setdefault(f"<{e.tag}>", e.sourceline)
+                        parent = e.getparent()
+                        kind = parent.tag if parent is not None and parent.tag in _SECTIONS else _TAGS.get(e.tag, e.tag)
+                        self._lines.setdefault(f"<{e.tag}>", (label, e.sourceline))
                         if e.get("name"):
-                            self._lines.setdefault(e.get("name"), e.sourceline)
-            except (OSError, UnicodeDecodeError, urdfxml.MalformedXML):
-                self._lines = {}
+                            self._lines.setdefault((kind, e.get("name")), (label, e.sourceline))
         return self._lines
 
-    def where(self, element=None) -> str:
-        """``file:line`` of an element (the file alone when MuJoCo gives no line)."""
-        line = self.line(element) if element is not None else None
-        return f"{self.path.name}:{line}" if line else self.path.name
+    def includes(self) -> list[Path]:
+        """The files the main file ``<include>``s (and those they include), each once."""
+        return [self.path.parent / label for label, _ in self._texts()[1:]]
 
+    def _texts(self) -> list:
+        """(label, parsed root) of the main file, then of each file it includes (a label relative
+        to the main file's folder, where MuJoCo looks for it), each once; an unreadable one skipped."""
+        texts: list = []
+        pending, seen = [self.path.resolve()], set()
+        while pending:
+            path = pending.pop(0)
+            if path in seen:
+                continue
+            seen.add(path)
+            try:
+                root = urdfxml.parse_text(path.read_text(encoding="utf-8")).getroot()
+            except (OSError, UnicodeDecodeError, urdfxml.MalformedXML):
+                continue
+            texts.append((self.path.name if path == self.path.resolve() else
+                          Path(os.path.relpath(path, self.path.parent)).as_posix(), root))
+            pending += [(self.path.parent / e.get("file")).resolve() for e in root.iter("include") if e.get("file")]
+        return texts
+
+    def where(self, element=None) -> str:
+        """``file:line`` of an element (the file alone when its line is unknown)."""
+        label, line = self.located(element) if element is not None else (self.path.name, None)
+        return f"{label}:{line}" if line else label
 
     def where_tag(self, tag: str) -> str:
-        """``file:line`` of the file's first ``<tag>`` element (the file alone without one)."""
-        line = self.named_lines().get(f"<{tag}>")
-        return f"{self.path.name}:{line}" if line else self.path.name
+        """``file:line`` of the first ``<tag>`` element of the file or of its includes (the file
+        alone without one)."""
+        label, line = self.named_lines().get(f"<{tag}>", (self.path.name, None))
+        return f"{label}:{line}" if line else label
 
     def where_named(self, kind: str, name: str) -> str:
         """``file:line`` of the spec element ``kind`` (body, geom, material...) called ``name``."""

@@ -19,6 +19,7 @@ import numpy as np
 from robotkit.importer.mjcf.frames import clean, origin, quat_matrix
 from robotkit.importer.names import valid_frame_name
 from robotkit.model.inertia_policy import MIN_MOMENT
+from robotkit.recipe.schema import MIN_MASS
 
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 WORLD = "world"
@@ -29,8 +30,8 @@ motor reaches (the recipe has no unlimited form, and 0 is a passive joint: robot
 it so, and Gazebo clamps a commanded force to 0)."""
 CHAIN_MASS = 1e-6
 """The mass of a chain's link that cannot take its mass from its body (robotkit.importer.mjcf.chainmass),
-as a fraction of the lightest body's (MuJoCo refuses a moving body without mass): a point mass,
-added, on the ledger."""
+as a fraction of the lightest body's (MuJoCo refuses a moving body without mass), not below the
+least mass a recipe takes: a point mass, added, on the ledger."""
 
 
 @dataclass
@@ -89,7 +90,7 @@ def build_tree(src, ledger) -> Tree:
     lightest = min((float(x) for x in m.body_mass[1:] if x > 0), default=1.0)
     for b in range(1, m.nbody):
         if b not in tree.link_of:
-            _body(src, tree, b, bodies, jnames, lightest * CHAIN_MASS)
+            _body(src, tree, b, bodies, jnames, max(lightest * CHAIN_MASS, MIN_MASS))
     return tree
 
 

@@ -366,8 +366,10 @@ LOOP = "the recipe's loop '{name}': URDF and SDF are trees, which leave it open"
 
 def _loops(src, tree, names: Names, ledger) -> dict:
     """The recipe's ``loops``: the active connect and weld constraints between two imported
-    bodies or sites, each end in its link's frame, with their softness (solref, solimp, a weld's
-    torque scale) where it is not MuJoCo's default (the others are verbatim)."""
+    bodies or sites, with their softness (solref, solimp, a weld's torque scale) where it is not
+    MuJoCo's default (the others are verbatim), each end in its link's frame: a site's on its
+    body's link, not on the site's frame link (massless: MuJoCo's constraint softness weighs the
+    constrained bodies, and a soft loop on massless links moves otherwise)."""
     m, specs, out = src.model, list(src.spec.equalities), {}
     sites = int(mj.load().mjtObj.mjOBJ_SITE)
     for e in range(m.neq):
@@ -377,8 +379,10 @@ def _loops(src, tree, names: Names, ledger) -> dict:
             continue
         a, b = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
         try:
-            if int(m.eq_objtype[e]) == sites:
-                ends = [(names.site(a), None), (names.site(b), None)]
+            if int(m.eq_objtype[e]) == sites:  # each site's frame on its body's link (MuJoCo weighs the bodies)
+                ends = [(names.body(int(m.site_bodyid[s])),
+                         origin(m.site_pos[s] - names.offset(int(m.site_bodyid[s])),
+                                quat_matrix(m.site_quat[s]) if kind == "weld" else np.eye(3))) for s in (a, b)]
             elif kind == "connect":
                 ends = [(names.body(a), origin(data[:3] - names.offset(a), np.eye(3))),
                         (names.body(b), origin(data[3:6] - names.offset(b), np.eye(3)))]
@@ -459,10 +463,18 @@ def _sensors(src, tree, names: Names):
 
 
 SITE_SENSORS = ("touch", "accelerometer", "velocimeter", "gyro", "force", "torque", "magnetometer", "rangefinder")
+BODY_SENSORS = ("touch", "force", "torque")
+"""Site sensors that read the site's body (its contacts, the force from its parent), not the site's motion."""
 
 
 def _sensor_target(m, i: int, tag: str, names: Names) -> dict:
     obj, ref = int(m.sensor_objid[i]), int(m.sensor_refid[i])
+    if tag in BODY_SENSORS:  # the rebuild's site is on a frame link: a body of its own, massless, without geoms
+        site = m.site(obj).name
+        raise Dropped(f"it reads the contacts of site '{site}''s body, and the rebuild holds the site on a frame link "
+                      "of its own (a body without geoms)" if tag == "touch" else
+                      f"it reads the force between site '{site}''s body and its parent, and the rebuild holds the site "
+                      "on a frame link of its own (a massless body)")
     if tag in SITE_SENSORS:
         return {"site": names.site(obj)}
     for prefix, attr, name in (("joint", "joint", names.joint), ("tendon", "tendon", names.tendon),

@@ -68,6 +68,7 @@ class Verdict:
 def verify(src, tree, rebuilt_path) -> Verdict:
     mujoco = mj.load()
     om, rm = src.model, mujoco.MjModel.from_xml_path(str(rebuilt_path))
+    rm.opt.gravity[:] = om.opt.gravity  # the original's (a gravity the rebuild lacks is on the ledger)
     od, rd = mujoco.MjData(om), mujoco.MjData(rm)
     verdict = Verdict(worst={k: (0.0, "") for k in TOL})
     configs = _configurations(om)
