@@ -45,7 +45,7 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
     for name, j in m.joints.items():
         left = joint_leftovers(j.el)
         if left and name in tree.joint_map:
-            ledger.add(src.where("joint", name.split("/")[-1]), f"joint '{name}'", "all",
+            ledger.add(src.where("joint", name), f"joint '{name}'", "all",
                        f"dropped (no place in the recipe): {', '.join(left)}")
     for nested in src.model.iter("model"):
         for plugin in children(nested, "plugin") if nested is not src.model else ():

@@ -36,9 +36,23 @@ class Source:
         """``file:line`` of the element ``<kind name="name">`` in the original file (inside link
         ``link`` when given); the file alone when it is not there (it came from an include)."""
         name = self.renamed.get(name, name) if kind == "joint" else name
-        start = self.line_of("link", link) if link else 1
-        line = self.line_of(kind, name, start or 1) if name else None
+        start = self.find("link", link) if link else 1
+        line = self.find(kind, name, start or 1) if name else None
         return f"{self.path}:{line}" if line else str(self.path)
+
+    def find(self, kind: str, name: str, start: int = 1) -> int | None:
+        """The line of ``<kind name="name">``; a nested model's ``model/name`` (its ``model::name``)
+        inside ``<model name="model">`` when no element has the whole name (iris's link
+        'iris/imu_link' is one name); None when it is not in the file (it came from an include)."""
+        line = self.line_of(kind, name, start)
+        parts = name.split("/")
+        if line is not None or len(parts) == 1:
+            return line
+        for model in parts[:-1]:
+            start = self.line_of("model", model, start)
+            if start is None:
+                return None
+        return self.line_of(kind, parts[-1], start)
 
     def line_of(self, kind: str, name: str | None, start: int = 1) -> int | None:
         pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name or '')}[\"']")

@@ -13,7 +13,7 @@ free``)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -56,8 +56,14 @@ def build_tree(src, m, ledger) -> Tree:
     parent_of: dict[str, object] = {}
     for j in m.joints.values():
         why = _unmapped(j, m, parent_of)
+        turned = _turned(j, m, parent_of) if why.startswith("dropped: it closes a loop") else None
+        if turned is not None:
+            ledger.add(src.where("joint", j.name), f"joint '{j.name}' ({j.type})", "all", f"written from "
+                       f"'{j.child}' to '{j.parent}' (its child already has joint '{parent_of[j.child].name}'; a joint "
+                       "that cannot move is the same either way)")
+            j, why = turned, ""
         if why:
-            ledger.add(src.where("joint", j.name.split("/")[-1]), f"joint '{j.name}' ({j.type})", "all", why)
+            ledger.add(src.where("joint", j.name), f"joint '{j.name}' ({j.type})", "all", why)
             continue
         parent_of[j.child] = j
     roots = [n for n in m.links if n not in parent_of]
@@ -97,6 +103,20 @@ def _unmapped(j, m, parent_of) -> str:
     return ""
 
 
+def _turned(j, m, parent_of):
+    """Joint ``j``, which closes a loop, with its parent and child swapped when it cannot move and
+    its parent is still a free body (turtlebot: the included kinect's link fixed to the rack that
+    the included create carries): the same model as one tree; None otherwise."""
+    if j.parent not in m.links or j.parent in parent_of or not (j.type == "fixed" or _locked(j)):
+        return None
+    up = j.child
+    while up in parent_of:
+        up = parent_of[up].parent
+        if up == j.parent:
+            return None
+    return replace(j, parent=j.child, child=j.parent, T=m.links[j.parent].T)
+
+
 def _free(taken, base: str) -> str:
     name, n = base, 2
     while name in taken:
@@ -121,7 +141,7 @@ def _joint(src, tree: Tree, j, chain_mass: float, ledger) -> None:
         tree.joints[j.name] = _fixed(tree, j.parent, j.child)
         tree.joint_map[j.name] = [j.name]
         return
-    where = src.where("joint", j.name.split("/")[-1])
+    where = src.where("joint", j.name)
     R = j.T[:3, :3]
     if j.type in CHAINS:
         n = CHAINS[j.type]
@@ -176,7 +196,7 @@ def take_chain_masses(src, tree: Tree, ledger) -> None:
             why = ("it is too light to give it (what would be left is not a physical body)" if carve(inertial, [])
                    else "its inertial is the build's to compute from its geometry" if inertial
                    else "it has no mass to give")
-            ledger.add(src.where("link", child.split("/")[-1]), f"link '{child}' (joint chain)", "all",
+            ledger.add(src.where("link", child), f"link '{child}' (joint chain)", "all",
                        f"approximated: chain link{'s' if len(links) > 1 else ''} {named} "
                        f"carr{'y' if len(links) > 1 else 'ies'} an added point mass of {mass:.3g} kg, not taken from "
                        f"the link: {why}")
