@@ -112,3 +112,104 @@ def test_names_with_a_slash_are_found_in_the_file(rig):
     assert f"{sdf}:31: joint 'rig/imu_joint' (revolute): all: a fixed joint: its limits are equal (it cannot " \
            "move)" in result.ledger
     assert _joints(recipe)["rig/imu_joint"]["child"] == "rig/imu_link"
+
+
+def _stiff_link(name: str, z: float) -> str:
+    return f"""    <link name="{name}">
+      <pose>0 0 {z} 0 0 0</pose>
+      {INERTIAL.format(m=1, i=0.01)}
+      <collision name="c">
+        <geometry><box><size>0.1 0.1 0.1</size></box></geometry>
+        <surface><contact><ode><kp>10000000000000.000000</kp><kd>100000000000.000000</kd><max_vel>-1</max_vel>
+        </ode></contact></surface>
+      </collision>
+    </link>
+"""
+
+
+STIFF = f"""<?xml version="1.0"?>
+<sdf version="1.5">
+  <model name="stiff">
+{_stiff_link("a", 0)}{_stiff_link("b", 0.2)}{_stiff_link("c", 0.4)}    <joint name="ab" type="revolute"><parent>a</parent><child>b</child>
+      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+    <joint name="bc" type="revolute"><parent>b</parent><child>c</child>
+      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+  </model>
+</sdf>
+"""
+
+
+def test_contact_stiffness_above_the_recipes_largest_is_written_as_that(tmp_path):
+    """youbot's kp of 1e13 (SDF's default is 1e12) made the recipe invalid: the import refused the
+    model.  Written 1e12, stated once for every link that has it; what the links drop alike is
+    one ledger line too (youbot: 21 lines of the same)."""
+    result, recipe, sdf = _imported(tmp_path, STIFF)
+    assert result.verdict.ok, result.verdict.lines()
+    base = recipe.get("defaults", {}).get("link", {})
+    assert {name: {**base, **link}["contact"] for name, link in recipe["links"].items()} == {
+        name: {"kp": 1e12, "kd": 1e11} for name in "abc"}
+    assert result.ledger == [
+        f"{sdf}:4: contact kp 1e+13 of links 'a', 'b', 'c': all: approximated: written 1e+12, the largest the "
+        "recipe takes",
+        f"{sdf}:4: links 'a', 'b', 'c': all: dropped (no place in the recipe): its collisions' <max_vel> (the "
+        "recipe's contact is a link's mu1, mu2, kp, kd)"]
+
+
+FRAMES = """<?xml version="1.0"?>
+<sdf version="1.8">
+  <model name="frames">
+    <link name="base"><pose>0 0 1 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+    <link name="arm"><pose>0 0 2 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+    <frame name="mount" attached_to="arm"><pose>0.5 0 0 0 0 0</pose></frame>
+    <joint name="hinge" type="revolute">
+      <pose>0 0.1 0 0 0 0</pose>
+      <parent>base</parent><child>mount</child>
+      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis>
+    </joint>
+    <frame name="on_joint" attached_to="hinge"><pose>0 0 0.3 0 0 0</pose></frame>
+    <frame name="on_frame" attached_to="on_joint"/>
+    <frame name="on_model"><pose>0 0 0.2 0 0 0</pose></frame>
+    <model name="tool">
+      <pose>0 0 3 0 0 0</pose>
+      <link name="tip"><inertial><mass>1</mass></inertial></link>
+    </model>
+    <joint name="tool_joint" type="fixed"><parent>arm</parent><child>tool</child></joint>
+    <joint name="back" type="fixed"><parent>tool::tip</parent><child>base</child></joint>
+  </model>
+</sdf>
+"""
+
+
+def test_sdf_1_7_frames_as_joint_ends_and_frames_on_joints_frames_and_models(tmp_path):
+    """SDF 1.7's frame semantics (libsdformat's own test models: joint_child_frame,
+    model_frame_attached_to_joint, joint_nested_parent_child): a joint's child may be a frame or a
+    nested model, a frame may be attached to a joint, a frame or (no attached_to) its model; each
+    is the link it is attached to.  They were dropped, leaving free bodies.  A joint closing a
+    loop through other joints is dropped (it made the recipe a cycle: exit 2), and the
+    verification follows the joints the recipe keeps."""
+    result, recipe, sdf = _imported(tmp_path, FRAMES)
+    assert result.verdict.ok and result.verdict.configurations == 11, result.verdict.lines()
+    assert result.ledger == [f"{sdf}:20: joint 'back' (fixed): all: dropped: it closes a loop (link 'tool/tip' "
+                             "already hangs from link 'base')"]
+    joints = _joints(recipe)
+    ends = {name: (j["parent"], j["child"], j.get("origin", {}).get("xyz")) for name, j in joints.items()}
+    assert ends == {"hinge": ("base", "arm", [0.5, 0.1, 1]), "tool_joint": ("arm", "tool/tip", [-0.5, -0.1, 1]),
+                    "mount_frame": ("arm", "mount", [0, -0.1, 0]), "on_joint_frame": ("arm", "on_joint", pytest.approx(
+                        [0, 0, 0.3], abs=1e-15)), "on_frame_frame": ("arm", "on_frame", pytest.approx(
+                            [0, 0, 0.3], abs=1e-15)), "on_model_frame": ("base", "on_model", [0, 0, -0.8])}
+    assert recipe.get("base") == "free" and "floating" not in {j["type"] for j in joints.values()}
+
+
+def test_model_settings_at_sdfs_defaults_are_no_loss_and_the_others_have_their_line(tmp_path):
+    """demo_joint_stiffness sets <allow_auto_disable>1</allow_auto_disable>, SDF's default: it was
+    on the ledger as dropped, and an element without a name had no line."""
+    result, _, sdf = _imported(tmp_path, """<?xml version="1.0"?>
+<sdf version="1.6">
+  <model name="m">
+    <link name="base"><inertial><mass>1</mass></inertial></link>
+    <allow_auto_disable>1</allow_auto_disable>
+    <enable_wind>true</enable_wind>
+  </model>
+</sdf>
+""")
+    assert result.ledger == [f"{sdf}:6: model <enable_wind>: all: dropped: no place in the recipe"]

@@ -51,7 +51,7 @@ def convert(path, out: Path):
     repaired: dict = {}
     files = add_shapes(src, m, tree, out, ledger, materials, repaired)
     take_chain_masses(src, tree, ledger)
-    surfaces = add_contacts(m, tree)
+    surfaces = add_contacts(src, m, tree, ledger)
     recipe: dict = {"robot": package_name(m.name)}
     meta = _metadata(src.config)
     if meta:

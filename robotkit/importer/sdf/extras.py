@@ -23,6 +23,7 @@ MODEL_KEPT = {"pose", "static", "link", "joint", "frame", "plugin", "model"}
 
 def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
     extras: list[str] = []
+    left: dict[tuple[str, ...], list[str]] = {}
     for name, link in m.links.items():
         O = np.linalg.inv(tree.offset(name, link.T))
         for sensor in children(link.el, "sensor"):
@@ -30,7 +31,13 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
             ledger.add(src.where("sensor", sensor.get("name"), name), f"sensor '{sensor.get('name')}' "
                        f"({sensor.get('type')}) of link '{name}'", "MJCF",
                        "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
-        _other(src, link.el, name, ledger, surfaces.get(name, []))
+        dropped = _other(link.el, surfaces.get(name, []))
+        if dropped:
+            left.setdefault(tuple(dropped), []).append(name)
+    for dropped, links in left.items():  # one line for the links that drop the same (youbot's 21 surfaces)
+        named = ", ".join(f"'{n}'" for n in links)
+        ledger.add(src.where("link", links[0]), f"link{'s' if len(links) > 1 else ''} {named}", "all",
+                   f"dropped (no place in the recipe): {', '.join(dropped)}")
     _scripts(src, m, ledger)
     for plugin in m.plugins:
         extras.append(_block(plugin, None, None))
@@ -39,7 +46,7 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
                    "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
     for el in (c for c in src.model if is_element(c) and c.tag not in MODEL_KEPT):
         if not (el.tag in ("self_collide", "allow_auto_disable", "enable_wind") and (el.text or "").strip() in
-                ("false", "0", "true" if el.tag == "allow_auto_disable" else "-")):
+                ("false", "0", *(("true", "1") if el.tag == "allow_auto_disable" else ()))):
             ledger.add(src.where(el.tag, el.get("name")), f"model <{el.tag}>", "all", "dropped: no place in the recipe")
     _frames(src, m, tree, ledger)
     for name, j in m.joints.items():
@@ -77,9 +84,8 @@ def _block(el, O, link: str | None) -> str:
     return etree.tostring(block, encoding="unicode").strip()
 
 
-def _other(src, el, name: str, ledger, dropped: list) -> None:
-    """One line per link for what it holds that the recipe has no place for (``dropped``: of its
-    collisions' surfaces)."""
+def _other(el, dropped: list) -> list[str]:
+    """What a link holds that the recipe has no place for (``dropped``: of its collisions' surfaces)."""
     dropped = list(dropped) + shape_leftovers(el)
     for child in el:
         if not is_element(child) or child.tag in LINK_KEPT:
@@ -87,9 +93,7 @@ def _other(src, el, name: str, ledger, dropped: list) -> None:
         value = {"1": "true", "0": "false"}.get((child.text or "").strip().lower(), (child.text or "").strip().lower())
         if LINK_DEFAULTS.get(child.tag) != value:
             dropped.insert(0, f"<{child.tag}> {value}".strip())
-    if dropped:
-        ledger.add(src.where("link", name), f"link '{name}'", "all",
-                   f"dropped (no place in the recipe): {', '.join(dropped)}")
+    return dropped
 
 
 def _scripts(src, m, ledger) -> None:

@@ -55,17 +55,43 @@ def read_model(el, file: str) -> Model:
     frames.add("world", MODEL, np.linalg.inv(top))
     m = Model(el.get("name") or "model", (el.findtext("static") or "").strip().lower() in ("true", "1"))
     pending: list = []
-    _scope(el, "", m, frames, pending)
+    attached = {MODEL: _canonical(el, "")}
+    _scope(el, "", m, frames, pending, attached)
     for kind, name, node in pending:
         if kind == "link":
             m.links[name] = _link(name, node, frames.get(name))
         elif kind == "joint":
             m.joints[name] = _joint(name, node, frames)
+            attached[name] = m.joints[name].child
         else:
             m.frames[name] = node, frames.get(name)
+    for j in m.joints.values():
+        j.parent, j.child = _link_of(j.parent, m, attached), _link_of(j.child, m, attached)
+    m.frames = {name: (_link_of(a, m, attached), T) for name, (a, T) in m.frames.items()}
     m.plugins = children(el, "plugin")
     _flat_names(m)
     return m
+
+
+def _canonical(model, scope: str) -> str:
+    """The frame a model is attached to: its canonical link (its ``canonical_link``, else its first
+    link, else its first nested model's), as libsdformat's frame semantics have it."""
+    if model.get("canonical_link"):
+        return scope + model.get("canonical_link")
+    links = children(model, "link")
+    if links:
+        return scope + links[0].get("name", "")
+    nested = children(model, "model")
+    return _canonical(nested[0], f"{scope}{nested[0].get('name', '')}::") if nested else scope[:-2] or MODEL
+
+
+def _link_of(name: str, m: Model, attached: dict, seen: tuple = ()) -> str:
+    """The link a frame is attached to (SDF 1.7: a joint's parent or child, or a frame's
+    attached_to, may be a frame, a joint or a nested model): itself when it is a link, world, or
+    nothing it can be followed to."""
+    if name in m.links or name == "world" or name not in attached or name in seen:
+        return name
+    return _link_of(attached[name], m, attached, seen + (name,))
 
 
 def _flat_names(m: Model) -> None:
@@ -80,7 +106,7 @@ def _flat_names(m: Model) -> None:
     m.frames = {flat(k): (flat(a), T) for k, (a, T) in m.frames.items()}
 
 
-def _scope(el, scope: str, m: Model, frames: Frames, pending: list) -> None:
+def _scope(el, scope: str, m: Model, frames: Frames, pending: list, attached: dict) -> None:
     here = scope[:-2] if scope else MODEL
     for link in children(el, "link"):
         name = scope + link.get("name", "")
@@ -95,14 +121,16 @@ def _scope(el, scope: str, m: Model, frames: Frames, pending: list) -> None:
     for frame in children(el, "frame"):
         name = scope + frame.get("name", "")
         base, T = pose_of(frame)
-        attached = scoped(scope, frame.get("attached_to"), here)
-        frames.add(name, scoped(scope, base, attached), T)
-        pending.append(("frame", name, attached))
+        to = scoped(scope, frame.get("attached_to"), here)
+        frames.add(name, scoped(scope, base, to), T)
+        pending.append(("frame", name, to))
+        attached[name] = to
     for nested in children(el, "model"):
         name = scope + nested.get("name", "")
         base, T = pose_of(nested)
         frames.add(name, scoped(scope, base, here), T)
-        _scope(nested, name + "::", m, frames, pending)
+        attached[name] = _canonical(nested, name + "::")
+        _scope(nested, name + "::", m, frames, pending, attached)
 
 
 def _link(name: str, el, T) -> Link:

@@ -37,7 +37,7 @@ class Source:
         ``link`` when given); the file alone when it is not there (it came from an include)."""
         name = self.renamed.get(name, name) if kind == "joint" else name
         start = self.find("link", link) if link else 1
-        line = self.find(kind, name, start or 1) if name else None
+        line = self.find(kind, name, start or 1) if name else self.tag_line(kind, start or 1)
         return f"{self.path}:{line}" if line else str(self.path)
 
     def find(self, kind: str, name: str, start: int = 1) -> int | None:
@@ -53,6 +53,11 @@ class Source:
             if start is None:
                 return None
         return self.line_of(kind, parts[-1], start)
+
+    def tag_line(self, kind: str, start: int = 1) -> int | None:
+        """The line of the first ``<kind>`` from ``start`` (an element without a name)."""
+        pattern = re.compile(rf"<{kind}[\s/>]")
+        return next((i for i, line in enumerate(self.lines[start - 1:], start) if pattern.search(line)), None)
 
     def line_of(self, kind: str, name: str | None, start: int = 1) -> int | None:
         pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name or '')}[\"']")

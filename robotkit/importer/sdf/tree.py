@@ -44,6 +44,7 @@ class Tree:
     base: str = "fixed"
     notes: dict = field(default_factory=dict)  # joint -> comment above it
     link_notes: dict = field(default_factory=dict)
+    used: dict = field(default_factory=dict)  # SDF link -> the SDF joint (turned round or not) the tree hangs it by
 
     def offset(self, link, T) -> np.ndarray:
         """The recipe frame of SDF link ``link`` in its own SDF frame ``T``."""
@@ -66,6 +67,7 @@ def build_tree(src, m, ledger) -> Tree:
             ledger.add(src.where("joint", j.name), f"joint '{j.name}' ({j.type})", "all", why)
             continue
         parent_of[j.child] = j
+    tree.used = parent_of
     roots = [n for n in m.links if n not in parent_of]
     world = m.static or any(j.parent == WORLD for j in parent_of.values())
     if world:
@@ -98,6 +100,13 @@ def _unmapped(j, m, parent_of) -> str:
         return f"dropped: its parent '{j.parent}' is not a link of the model"
     if j.child in parent_of:
         return f"dropped: it closes a loop (link '{j.child}' already has joint '{parent_of[j.child].name}')"
+    up = j.parent
+    while up in parent_of:
+        up = parent_of[up].parent
+        if up == j.child:
+            return f"dropped: it closes a loop (link '{j.parent}' already hangs from link '{j.child}')"
+    if j.parent == j.child:
+        return f"dropped: its parent and child are one link ('{j.child}')"
     if j.type not in ("fixed", "revolute", "continuous", "prismatic", "screw") and j.type not in CHAINS:
         return "dropped: the recipe has no such joint"
     return ""

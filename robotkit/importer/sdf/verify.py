@@ -56,7 +56,7 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
     verdict = Verdict(worst={k: (0.0, "") for k in TOL})
     pairs = [(j, names[0]) for j, names in tree.joint_map.items() if len(names) == 1
              and original.joints[j].type in ("revolute", "continuous", "prismatic") and names[0] in rebuilt.joints]
-    root = _root(original)
+    root = _root(original, tree.used.values())
     _joints(verdict, original, rebuilt, tree, (original.links[root].T @ tree.offset(root, original.links[root].T),
                                                 rebuilt.links[root].T))
     rng = np.random.default_rng(SEED)
@@ -67,16 +67,16 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
         configs.append((f"random configuration {i + 1}", q))
     names = dict(pairs)
     for label, q in configs:
-        po = _relative(poses(original, q), root, tree.offset(root, original.links[root].T))
+        po = _relative(poses(original, q, tree.used.values()), root, tree.offset(root, original.links[root].T))
         pr = _relative(poses(rebuilt, {names[j]: v for j, v in q.items()}), root, np.eye(4))
         _links(verdict, original, rebuilt, tree, repaired, po, pr, label)
     verdict.configurations = len(configs)
     return verdict
 
 
-def _root(model) -> str:
+def _root(model, joints) -> str:
     """The first link no joint from another link moves (a link jointed to the world counts)."""
-    inner = {j.child for j in model.joints.values() if j.parent in model.links}
+    inner = {j.child for j in joints if j.parent in model.links}
     return next((n for n in model.links if n not in inner), next(iter(model.links)))
 
 
@@ -110,9 +110,10 @@ def _joints(verdict: Verdict, original, rebuilt, tree, roots) -> None:
             _check(verdict, "axis", float(np.abs(Ro.T @ oj.axes[0] - Rr.T @ rj.axes[0]).max()), f"joint '{j}' axis")
 
 
-def poses(model, q: dict) -> dict:
-    """Every link's pose in the model frame with joint values ``q`` (others at zero)."""
-    parent_of = {j.child: j for j in model.joints.values() if j.type != "gearbox"}
+def poses(model, q: dict, joints=None) -> dict:
+    """Every link's pose in the model frame with joint values ``q`` (others at zero), along
+    ``joints`` (the original's: those the import's tree follows, not the loops it drops)."""
+    parent_of = {j.child: j for j in (model.joints.values() if joints is None else joints) if j.type != "gearbox"}
     done: dict = {}
 
     def pose(link, seen=()):
