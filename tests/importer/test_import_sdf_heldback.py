@@ -19,9 +19,12 @@ INERTIAL = "<inertial><mass>{m}</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy><izz>
 
 
 def _imported(tmp_path, text: str, name: str = "m"):
-    (tmp_path / f"{name}.sdf").write_text(text)
-    result = import_sdf(tmp_path / f"{name}.sdf", tmp_path / "out" / f"{name}.yaml", build=build_sdf)
-    return result, yaml.safe_load(result.recipe_path.read_text()), str(tmp_path / f"{name}.sdf")
+    """The import of SDF ``text`` written to ``tmp_path/name/model.sdf`` (its model path
+    ``tmp_path``): (result, recipe, the file's path)."""
+    (tmp_path / name).mkdir(exist_ok=True)
+    (tmp_path / name / "model.sdf").write_text(text)
+    result = import_sdf(tmp_path / name / "model.sdf", tmp_path / "out" / f"{name}.yaml", build=build_sdf)
+    return result, yaml.safe_load(result.recipe_path.read_text()), str(tmp_path / name / "model.sdf")
 
 
 def _joints(recipe: dict) -> dict:
@@ -131,9 +134,11 @@ STIFF = f"""<?xml version="1.0"?>
 <sdf version="1.5">
   <model name="stiff">
 {_stiff_link("a", 0)}{_stiff_link("b", 0.2)}{_stiff_link("c", 0.4)}    <joint name="ab" type="revolute"><parent>a</parent><child>b</child>
-      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis>
+      <physics><ode><implicit_spring_damper>1</implicit_spring_damper></ode></physics></joint>
     <joint name="bc" type="revolute"><parent>b</parent><child>c</child>
-      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis>
+      <physics><ode><implicit_spring_damper>1</implicit_spring_damper></ode></physics></joint>
   </model>
 </sdf>
 """
@@ -141,8 +146,8 @@ STIFF = f"""<?xml version="1.0"?>
 
 def test_contact_stiffness_above_the_recipes_largest_is_written_as_that(tmp_path):
     """youbot's kp of 1e13 (SDF's default is 1e12) made the recipe invalid: the import refused the
-    model.  Written 1e12, stated once for every link that has it; what the links drop alike is
-    one ledger line too (youbot: 21 lines of the same)."""
+    model.  Written 1e12, stated once for every link that has it; what the links (joints) drop
+    alike is one ledger line too (youbot: 21 lines of the same; cessna: 10 joints' <physics>)."""
     result, recipe, sdf = _imported(tmp_path, STIFF)
     assert result.verdict.ok, result.verdict.lines()
     base = recipe.get("defaults", {}).get("link", {})
@@ -152,7 +157,8 @@ def test_contact_stiffness_above_the_recipes_largest_is_written_as_that(tmp_path
         f"{sdf}:4: contact kp 1e+13 of links 'a', 'b', 'c': all: approximated: written 1e+12, the largest the "
         "recipe takes",
         f"{sdf}:4: links 'a', 'b', 'c': all: dropped (no place in the recipe): its collisions' <max_vel> (the "
-        "recipe's contact is a link's mu1, mu2, kp, kd)"]
+        "recipe's contact is a link's mu1, mu2, kp, kd)",
+        f"{sdf}:31: joints 'ab', 'bc': all: dropped (no place in the recipe): <physics>"]
 
 
 FRAMES = """<?xml version="1.0"?>
@@ -213,3 +219,37 @@ def test_model_settings_at_sdfs_defaults_are_no_loss_and_the_others_have_their_l
 </sdf>
 """)
     assert result.ledger == [f"{sdf}:6: model <enable_wind>: all: dropped: no place in the recipe"]
+
+
+def test_joint_ends_named_with_the_models_own_name_first(tmp_path):
+    """ArduPilot's Gazebo models fix their IMU to 'dolly_ardupilot::dolly::base_link': Gazebo
+    classic finds it, libsdformat does not.  Dropped, it left the robot a second free body; read
+    as Gazebo reads it, stated (a child so named, whose frame the joint's pose is relative to, too)."""
+    (tmp_path / "dolly").mkdir()
+    (tmp_path / "dolly" / "model.config").write_text(
+        '<model><name>dolly</name><sdf version="1.7">model.sdf</sdf></model>')
+    (tmp_path / "dolly" / "model.sdf").write_text(f"""<sdf version="1.7"><model name="dolly">
+  <link name="base_link"><pose>0 0 0.1 0 0 0</pose>{INERTIAL.format(m=1, i=0.01)}</link>
+</model></sdf>""")
+    result, recipe, sdf = _imported(tmp_path, f"""<sdf version="1.7">
+<model name="dolly_ardupilot">
+  <include><uri>model://dolly</uri></include>
+  <link name="imu_link"><pose>0 0 0.2 0 0 0</pose>{INERTIAL.format(m=0.01, i=1e-6)}</link>
+  <link name="tag"><pose>0 0 0.3 0 0 0</pose>{INERTIAL.format(m=0.01, i=1e-6)}</link>
+  <joint name="imu_joint" type="fixed">
+    <parent>dolly_ardupilot::dolly::base_link</parent><child>imu_link</child>
+  </joint>
+  <joint name="tag_joint" type="fixed">
+    <pose relative_to="dolly_ardupilot::dolly::base_link">0 0 0.2 0 0 0</pose>
+    <parent>imu_link</parent><child>tag</child>
+  </joint>
+</model></sdf>
+""", "dolly_ardupilot")
+    assert result.verdict.ok, result.verdict.lines()
+    assert result.ledger == [
+        f"{sdf}:6: joint 'imu_joint': all: 'dolly_ardupilot::dolly::base_link' read as 'dolly::base_link' (the "
+        "model's own name first: Gazebo classic finds it, libsdformat does not)"]
+    joints = _joints(recipe)
+    assert (joints["imu_joint"]["parent"], joints["imu_joint"]["origin"]) == ("dolly/base_link", {"xyz": [0, 0, 0.1]})
+    assert joints["tag_joint"]["origin"] == {"xyz": pytest.approx([0, 0, 0.1], abs=1e-15)}
+    assert recipe.get("base") == "free" and "floating" not in {j["type"] for j in joints.values()}

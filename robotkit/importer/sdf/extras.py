@@ -34,10 +34,7 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
         dropped = _other(link.el, surfaces.get(name, []))
         if dropped:
             left.setdefault(tuple(dropped), []).append(name)
-    for dropped, links in left.items():  # one line for the links that drop the same (youbot's 21 surfaces)
-        named = ", ".join(f"'{n}'" for n in links)
-        ledger.add(src.where("link", links[0]), f"link{'s' if len(links) > 1 else ''} {named}", "all",
-                   f"dropped (no place in the recipe): {', '.join(dropped)}")
+    _grouped(src, ledger, "link", left)
     _scripts(src, m, ledger)
     for plugin in m.plugins:
         extras.append(_block(plugin, None, None))
@@ -49,11 +46,12 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
                 ("false", "0", *(("true", "1") if el.tag == "allow_auto_disable" else ()))):
             ledger.add(src.where(el.tag, el.get("name")), f"model <{el.tag}>", "all", "dropped: no place in the recipe")
     _frames(src, m, tree, ledger)
+    joints: dict[tuple[str, ...], list[str]] = {}
     for name, j in m.joints.items():
         left = joint_leftovers(j.el)
         if left and name in tree.joint_map:
-            ledger.add(src.where("joint", name), f"joint '{name}'", "all",
-                       f"dropped (no place in the recipe): {', '.join(left)}")
+            joints.setdefault(tuple(left), []).append(name)
+    _grouped(src, ledger, "joint", joints)
     for nested in src.model.iter("model"):
         for plugin in children(nested, "plugin") if nested is not src.model else ():
             ledger.add(str(src.path), f"plugin '{plugin.get('name')}' of included model '{nested.get('name')}'",
@@ -82,6 +80,15 @@ def _block(el, O, link: str | None) -> str:
     block.append(el)
     etree.indent(block, space="  ")
     return etree.tostring(block, encoding="unicode").strip()
+
+
+def _grouped(src, ledger, kind: str, groups: dict) -> None:
+    """One ledger line for the links (joints) that drop the same (youbot's 21 surfaces, cessna's
+    10 joints' <physics>), at the first one's line."""
+    for dropped, names in groups.items():
+        named = ", ".join(f"'{n}'" for n in names)
+        ledger.add(src.where(kind, names[0]), f"{kind}{'s' if len(names) > 1 else ''} {named}", "all",
+                   f"dropped (no place in the recipe): {', '.join(dropped)}")
 
 
 def _other(el, dropped: list) -> list[str]:

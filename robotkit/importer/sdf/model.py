@@ -43,6 +43,7 @@ class Model:
     joints: dict = field(default_factory=dict)
     frames: dict = field(default_factory=dict)  # name -> (attached_to link, pose in the model frame)
     plugins: list = field(default_factory=list)
+    prefixed: list = field(default_factory=list)  # (joint, its end as written, as read): see _own
 
 
 def children(el, tag: str) -> list:
@@ -50,10 +51,10 @@ def children(el, tag: str) -> list:
 
 
 def read_model(el, file: str) -> Model:
-    frames = Frames(file)
+    m = Model(el.get("name") or "model", (el.findtext("static") or "").strip().lower() in ("true", "1"))
+    frames = Frames(file, m.name)
     _, top = pose_of(el)
     frames.add("world", MODEL, np.linalg.inv(top))
-    m = Model(el.get("name") or "model", (el.findtext("static") or "").strip().lower() in ("true", "1"))
     pending: list = []
     attached = {MODEL: _canonical(el, "")}
     _scope(el, "", m, frames, pending, attached)
@@ -66,7 +67,7 @@ def read_model(el, file: str) -> Model:
         else:
             m.frames[name] = node, frames.get(name)
     for j in m.joints.values():
-        j.parent, j.child = _link_of(j.parent, m, attached), _link_of(j.child, m, attached)
+        j.parent, j.child = (_link_of(_own(j, end, m, attached), m, attached) for end in (j.parent, j.child))
     m.frames = {name: (_link_of(a, m, attached), T) for name, (a, T) in m.frames.items()}
     m.plugins = children(el, "plugin")
     _flat_names(m)
@@ -83,6 +84,18 @@ def _canonical(model, scope: str) -> str:
         return scope + links[0].get("name", "")
     nested = children(model, "model")
     return _canonical(nested[0], f"{scope}{nested[0].get('name', '')}::") if nested else scope[:-2] or MODEL
+
+
+def _own(j, name: str, m: Model, attached: dict) -> str:
+    """A joint's end named with the model's own name first (ArduPilot's models:
+    'dolly_ardupilot::dolly::base_link'), which Gazebo classic finds and libsdformat does not: the
+    name without it, noted in ``m.prefixed``."""
+    known = lambda n: n in m.links or n in attached  # noqa: E731
+    head = f"{m.name}::"
+    if known(name) or not name.startswith(head) or not known(name[len(head):]):
+        return name
+    m.prefixed.append((j.name, name, name[len(head):]))
+    return name[len(head):]
 
 
 def _link_of(name: str, m: Model, attached: dict, seen: tuple = ()) -> str:

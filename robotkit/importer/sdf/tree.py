@@ -53,6 +53,10 @@ class Tree:
 
 def build_tree(src, m, ledger) -> Tree:
     tree = Tree()
+    for joint, written, read in m.prefixed:
+        ledger.add(src.where("joint", joint.replace("::", "/")), f"joint '{joint.replace('::', '/')}'", "all",
+                   f"'{written}' read as '{read}' (the model's own name first: Gazebo classic finds it, "
+                   "libsdformat does not)")
     lightest = min((lk.mass for lk in m.links.values() if lk.mass > 0), default=1.0)
     parent_of: dict[str, object] = {}
     for j in m.joints.values():
