@@ -224,7 +224,8 @@ def test_model_settings_at_sdfs_defaults_are_no_loss_and_the_others_have_their_l
 def test_joint_ends_named_with_the_models_own_name_first(tmp_path):
     """ArduPilot's Gazebo models fix their IMU to 'dolly_ardupilot::dolly::base_link': Gazebo
     classic finds it, libsdformat does not.  Dropped, it left the robot a second free body; read
-    as Gazebo reads it, stated (a child so named, whose frame the joint's pose is relative to, too)."""
+    as Gazebo reads it, stated (a child so named, whose frame the joint's pose is relative to, too).
+    A plugin naming a nested model's element names it as the recipe does ('/' for '::')."""
     (tmp_path / "dolly").mkdir()
     (tmp_path / "dolly" / "model.config").write_text(
         '<model><name>dolly</name><sdf version="1.7">model.sdf</sdf></model>')
@@ -243,12 +244,24 @@ def test_joint_ends_named_with_the_models_own_name_first(tmp_path):
     <pose relative_to="dolly_ardupilot::dolly::base_link">0 0 0.2 0 0 0</pose>
     <parent>imu_link</parent><child>tag</child>
   </joint>
+  <plugin name="ardupilot_plugin" filename="libArduPilotPlugin.so">
+    <imuName>dolly_ardupilot::imu_link::imu_sensor</imuName>
+    <control channel="0"><jointName>dolly_ardupilot::dolly::base_link</jointName></control>
+    <link_name>dolly::base_link</link_name>
+  </plugin>
 </model></sdf>
 """, "dolly_ardupilot")
     assert result.verdict.ok, result.verdict.lines()
     assert result.ledger == [
         f"{sdf}:6: joint 'imu_joint': all: 'dolly_ardupilot::dolly::base_link' read as 'dolly::base_link' (the "
-        "model's own name first: Gazebo classic finds it, libsdformat does not)"]
+        "model's own name first: Gazebo classic finds it, libsdformat does not)",
+        f"{sdf}:13: plugin 'ardupilot_plugin' (libArduPilotPlugin.so): MJCF: dropped (kept verbatim in a <gazebo> "
+        "block of urdf_extras, for model.sdf and the URDF); the names in it of 2 nested model elements written as "
+        "the recipe's (a::b as a/b)"]
+    plugin = recipe["urdf_extras"][0]
+    assert "<imuName>dolly_ardupilot::imu_link::imu_sensor</imuName>" in plugin
+    assert "<jointName>dolly_ardupilot::dolly/base_link</jointName>" in plugin
+    assert "<link_name>dolly/base_link</link_name>" in plugin
     joints = _joints(recipe)
     assert (joints["imu_joint"]["parent"], joints["imu_joint"]["origin"]) == ("dolly/base_link", {"xyz": [0, 0, 0.1]})
     assert joints["tag_joint"]["origin"] == {"xyz": pytest.approx([0, 0, 0.1], abs=1e-15)}

@@ -36,11 +36,7 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
             left.setdefault(tuple(dropped), []).append(name)
     _grouped(src, ledger, "link", left)
     _scripts(src, m, ledger)
-    for plugin in m.plugins:
-        extras.append(_block(plugin, None, None))
-        ledger.add(src.where("plugin", plugin.get("name")), f"plugin '{plugin.get('name')}' "
-                   f"({plugin.get('filename')})", "MJCF",
-                   "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
+    _plugins(src, m, extras, ledger)
     for el in (c for c in src.model if is_element(c) and c.tag not in MODEL_KEPT):
         if not (el.tag in ("self_collide", "allow_auto_disable", "enable_wind") and (el.text or "").strip() in
                 ("false", "0", *(("true", "1") if el.tag == "allow_auto_disable" else ()))):
@@ -62,6 +58,38 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
                    "in a world (the recipe describes the robot; a world places it)")
     if extras:
         recipe["urdf_extras"] = extras
+
+
+def _plugins(src, m, extras: list, ledger) -> None:
+    """The model's plugins, verbatim but for the names of nested models' elements, which the
+    recipe writes with '/' (ArduPilot's 'dolly_ardupilot::dolly::back_motor_joint' names the
+    joint the rebuild calls 'dolly/back_motor_joint'), stated."""
+    names = set(m.links) | set(m.joints) | set(m.frames)
+    for plugin in m.plugins:
+        plugin = copy.deepcopy(plugin)
+        renamed = _flat_references(plugin, names, m.name)
+        extras.append(_block(plugin, None, None))
+        said = (f"; the names in it of {renamed} nested model element{'s' if renamed > 1 else ''} written as the "
+                "recipe's (a::b as a/b)") if renamed else ""
+        ledger.add(src.where("plugin", plugin.get("name")), f"plugin '{plugin.get('name')}' "
+                   f"({plugin.get('filename')})", "MJCF",
+                   f"dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF){said}")
+
+
+def _flat_references(el, names: set, own: str) -> int:
+    """Each text of ``el`` naming a nested model's element ('a::b', after the model's own name if
+    it begins with it) written 'a/b' (the rest after it kept: 'a::b::sensor' as 'a/b::sensor');
+    how many."""
+    count = 0
+    for leaf in el.iter():
+        text = (leaf.text or "").strip() if isinstance(leaf.tag, str) and not len(leaf) else ""
+        head = f"{own}::" if text.startswith(f"{own}::") else ""
+        parts = text[len(head):].split("::")
+        k = next((k for k in range(len(parts), 1, -1) if "/".join(parts[:k]) in names), 0)
+        if k:
+            leaf.text = head + "::".join(["/".join(parts[:k]), *parts[k:]])
+            count += 1
+    return count
 
 
 def _block(el, O, link: str | None) -> str:
