@@ -266,3 +266,21 @@ def test_joint_ends_named_with_the_models_own_name_first(tmp_path):
     assert (joints["imu_joint"]["parent"], joints["imu_joint"]["origin"]) == ("dolly/base_link", {"xyz": [0, 0, 0.1]})
     assert joints["tag_joint"]["origin"] == {"xyz": pytest.approx([0, 0, 0.1], abs=1e-15)}
     assert recipe.get("base") == "free" and "floating" not in {j["type"] for j in joints.values()}
+
+
+def test_model_jointed_to_the_world_keeps_where_it_stands(tmp_path):
+    """double_pendulum_inertia_ratio hangs from the world, its model turned 45 degrees about x:
+    where it stands is how gravity pulls it.  The model's <pose> was dropped (the pendulum hung
+    straight); it is kept in the joint to the world, and nothing is on the ledger."""
+    result, recipe, _ = _imported(tmp_path, f"""<sdf version="1.4"><model name="pendulum">
+  <pose>0 0 0.9 0.785398163397448 0 0</pose>
+  <link name="upper"><pose>0 0 -0.05 0 0 0</pose>{INERTIAL.format(m=0.5, i=0.001)}</link>
+  <joint name="upper_joint" type="revolute"><pose>0 0 0.05 0 0 0</pose>
+    <parent>world</parent><child>upper</child><axis><xyz>1 0 0</xyz></axis></joint>
+</model></sdf>""")
+    assert result.verdict.ok, result.verdict.lines()
+    assert result.ledger == []
+    joint = _joints(recipe)["upper_joint"]
+    assert (joint["type"], joint["parent"], joint["axis"]) == ("continuous", "world", [1, 0, 0])
+    assert joint["origin"] == {"xyz": pytest.approx([0, 0, 0.9], abs=1e-15),
+                               "rpy": pytest.approx([0.785398163397448, 0, 0], abs=1e-15)}

@@ -53,7 +53,7 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
             ledger.add(str(src.path), f"plugin '{plugin.get('name')}' of included model '{nested.get('name')}'",
                        "all", "dropped (its names are the included model's)")
     _, P = pose_of(src.model)
-    if not np.allclose(P, np.eye(4), rtol=0, atol=0):
+    if not np.allclose(P, np.eye(4), rtol=0, atol=0) and not tree.world_pose:
         ledger.add(src.where("model", m.name), f"model '{m.name}' <pose>", "all", "dropped: where the model stands "
                    "in a world (the recipe describes the robot; a world places it)")
     if extras:

@@ -44,6 +44,7 @@ class Model:
     frames: dict = field(default_factory=dict)  # name -> (attached_to link, pose in the model frame)
     plugins: list = field(default_factory=list)
     prefixed: list = field(default_factory=list)  # (joint, its end as written, as read): see _own
+    world: np.ndarray = field(default_factory=lambda: np.eye(4))  # the world frame in the model frame
 
 
 def children(el, tag: str) -> list:
@@ -70,6 +71,7 @@ def read_model(el, file: str) -> Model:
         j.parent, j.child = (_link_of(_own(j, end, m, attached), m, attached) for end in (j.parent, j.child))
     m.frames = {name: (_link_of(a, m, attached), T) for name, (a, T) in m.frames.items()}
     m.plugins = children(el, "plugin")
+    m.world = frames.get("world")
     _flat_names(m)
     return m
 

@@ -45,6 +45,7 @@ class Tree:
     notes: dict = field(default_factory=dict)  # joint -> comment above it
     link_notes: dict = field(default_factory=dict)
     used: dict = field(default_factory=dict)  # SDF link -> the SDF joint (turned round or not) the tree hangs it by
+    world_pose: bool = False  # the model's <pose> kept in its joints to the world
 
     def offset(self, link, T) -> np.ndarray:
         """The recipe frame of SDF link ``link`` in its own SDF frame ``T``."""
@@ -73,10 +74,12 @@ def build_tree(src, m, ledger) -> Tree:
         parent_of[j.child] = j
     tree.used = parent_of
     roots = [n for n in m.links if n not in parent_of]
-    world = m.static or any(j.parent == WORLD for j in parent_of.values())
-    if world:
+    jointed = [j.name for j in parent_of.values() if j.parent == WORLD]
+    world = m.static or bool(jointed)
+    if world:  # jointed to the world, where the model stands is physics (gravity on a pendulum): kept
         tree.links[WORLD] = {}
-        tree.frame[WORLD] = np.eye(4)
+        tree.frame[WORLD] = m.world if jointed else np.eye(4)
+        tree.world_pose = bool(jointed) and not np.allclose(m.world, np.eye(4), rtol=0, atol=0)
     else:
         tree.base = "free"
     for name, link in m.links.items():
