@@ -284,3 +284,33 @@ def test_model_jointed_to_the_world_keeps_where_it_stands(tmp_path):
     assert (joint["type"], joint["parent"], joint["axis"]) == ("continuous", "world", [1, 0, 0])
     assert joint["origin"] == {"xyz": pytest.approx([0, 0, 0.9], abs=1e-15),
                                "rpy": pytest.approx([0.785398163397448, 0, 0], abs=1e-15)}
+
+
+def test_ledger_lines_of_an_included_models_elements_name_its_file(tmp_path):
+    """turtlebot includes create: what create's file holds (a joint renamed, its sensors, its
+    inertial repaired) was put at turtlebot's file, without a line."""
+    (tmp_path / "cart").mkdir()
+    (tmp_path / "cart" / "model.config").write_text('<model><name>cart</name><sdf version="1.6">cart.sdf</sdf></model>')
+    cart = tmp_path / "cart" / "cart.sdf"
+    cart.write_text(f"""<sdf version="1.6"><model name="cart">
+  <link name="body">{INERTIAL.format(m=1, i=0.01)}
+    <sensor name="imu" type="imu"><update_rate>10</update_rate></sensor>
+  </link>
+  <link name="wheel"><pose>0 0.2 0 0 0 0</pose>{INERTIAL.format(m=0.1, i=0.001)}
+    <visual name="v"><geometry><ellipsoid><radii>0.1 0.1 0.05</radii></ellipsoid></geometry></visual>
+  </link>
+  <joint name="wheel" type="revolute"><parent>body</parent><child>wheel</child>
+    <axis><xyz>0 1 0</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+</model></sdf>""")
+    result, _, sdf = _imported(tmp_path, """<sdf version="1.6"><model name="train">
+  <include><uri>model://cart</uri><name>front</name></include>
+  <include><uri>model://cart</uri><name>back</name><pose>-1 0 0 0 0 0</pose></include>
+  <joint name="hitch" type="fixed"><parent>front::body</parent><child>back::body</child></joint>
+</model></sdf>""", "train")
+    assert result.verdict.ok, result.verdict.lines()
+    assert [line for line in result.ledger if "front/" in line] == [
+        f"{cart}:8: joint 'front/wheel': all: renamed 'front/wheel_joint' (a link has its name: libsdformat "
+        "refuses the pair)",
+        f"{cart}:6: visual 'v' of link 'front/wheel' (ellipsoid): all: approximated: the box of its half-axes 0.1 0.1 0.05",
+        f"{cart}:3: sensor 'imu' (imu) of link 'front/body': MJCF: dropped (kept verbatim in a <gazebo> block of "
+        "urdf_extras, for model.sdf and the URDF)"]

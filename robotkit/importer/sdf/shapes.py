@@ -55,7 +55,7 @@ def _shape(src, el, O, out: Path, ledger, files: list, kind: str) -> list[dict]:
     _, P = pose_of(el)
     T = O @ P
     shape = next((g for g in (geometry if geometry is not None else []) if isinstance(g.tag, str)), None)
-    label = f"{kind} '{el.get('name', '')}' of link '{el.getparent().get('name', '')}'"
+    label = f"{kind} '{el.get('name', '')}' of link '{src.link_of(el)}'"
     if shape is None:
         return []
     num = lambda tag, d="0": [float(x) for x in (shape.findtext(tag) or d).split()]  # noqa: E731
@@ -70,12 +70,12 @@ def _shape(src, el, O, out: Path, ledger, files: list, kind: str) -> list[dict]:
             _at({"sphere": {"radius": r}}, _moved(e[:3])) for e in ends]
     if shape.tag == "ellipsoid":
         radii = num("radii", "1 1 1")
-        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (ellipsoid)", "all",
+        ledger.add(src.where_el(kind, el), f"{label} (ellipsoid)", "all",
                    "approximated: the box of its half-axes " + " ".join(f"{r:g}" for r in radii))
         return [_at({"box": {"size": [2 * r for r in radii]}}, T)]
     if shape.tag == "mesh":
         return _mesh(src, el, shape, T, out, ledger, files, label, kind)
-    ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} ({shape.tag})", "all", "dropped: the recipe has no such shape")
+    ledger.add(src.where_el(kind, el), f"{label} ({shape.tag})", "all", "dropped: the recipe has no such shape")
     return []
 
 
@@ -103,10 +103,10 @@ def _mesh(src, el, shape, T, out: Path, ledger, files, label: str, kind: str) ->
     uri = (shape.findtext("uri") or "").strip()
     file = mesh_file(src, uri)
     if file is None or not file.is_file():
-        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (mesh {uri})", "all", "dropped: its file is not found")
+        ledger.add(src.where_el(kind, el), f"{label} (mesh {uri})", "all", "dropped: its file is not found")
         return []
     if shape.find("submesh") is not None:
-        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (mesh {uri})", "all",
+        ledger.add(src.where_el(kind, el), f"{label} (mesh {uri})", "all",
                    "approximated: the whole mesh file (the recipe names no submesh)")
     files.append(str(file.resolve()))
     out_shape = {"mesh": Path(os.path.relpath(file.resolve(), out.parent)).as_posix()}
@@ -126,7 +126,7 @@ def _material(src, el, materials: dict, ledger) -> str | None:
         return None
     if text is None and script not in src.unknown_scripts:
         src.unknown_scripts.add(script)
-        ledger.add(src.where("visual", el.get("name"), el.getparent().get("name")), f"material script '{script}'",
+        ledger.add(src.where_el("visual", el), f"material script '{script}'",
                    "URDF, MJCF", "approximated: white (a Gazebo material script without a colour; model.sdf names it)")
     rgba = [float(v) for v in (text or "1 1 1 1").split()] + [1.0]
     rgba = [min(max(v, 0.0), 1.0) for v in rgba[:4]]
