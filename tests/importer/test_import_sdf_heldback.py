@@ -314,3 +314,16 @@ def test_ledger_lines_of_an_included_models_elements_name_its_file(tmp_path):
         f"{cart}:6: visual 'v' of link 'front/wheel' (ellipsoid): all: approximated: the box of its half-axes 0.1 0.1 0.05",
         f"{cart}:3: sensor 'imu' (imu) of link 'front/body': MJCF: dropped (kept verbatim in a <gazebo> block of "
         "urdf_extras, for model.sdf and the URDF)"]
+
+
+def test_mass_without_inertia_says_sdfs_default_moments_above_the_link(tmp_path):
+    """kinect (0.1 kg) gives no <inertia>: SDF's 1 kg m^2, which Gazebo simulates and the recipe
+    keeps; `robotkit check` calls it implausible, so the recipe says where it comes from."""
+    result, recipe, _ = _imported(tmp_path, """<sdf version="1.5"><model name="kinect">
+  <link name="link"><inertial><mass>0.1</mass></inertial>
+    <collision name="c"><geometry><box><size>0.07 0.28 0.07</size></box></geometry></collision></link>
+</model></sdf>""")
+    assert result.verdict.ok and result.ledger == [], result.ledger
+    assert recipe["links"]["link"]["inertial"] == {"mass": 0.1, "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}
+    assert ("  # the SDF gives its mass and no <inertia>: SDF's default moments, 1 kg m^2 about each axis, as\n"
+            "  # Gazebo simulates it\n  link:\n") in result.recipe_path.read_text()

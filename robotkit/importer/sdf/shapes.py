@@ -47,6 +47,10 @@ def add_shapes(src, m, tree, out: Path, ledger, materials: dict, repaired: dict)
         if collision != bare:
             entry["collision"] = (collision if len(collision) > 1 else collision[0]) if collision else "none"
         _inertial(src, name, link, O, entry, collision, visual, ledger, repaired)
+        given = link.el.find("inertial")
+        if given is not None and given.find("inertia") is None and link.mass > 0 and name not in repaired:
+            tree.link_notes[name] = ("the SDF gives its mass and no <inertia>: SDF's default moments, 1 kg m^2 "
+                                     "about each axis, as Gazebo simulates it")
     return files
 
 
