@@ -15,6 +15,11 @@ from robotkit.importer import import_sdf
 
 pytestmark = pytest.mark.skipif(shutil.which("ign") is None, reason="needs libsdformat's ign sdf")
 
+TETRAHEDRON = "solid t\n" + "".join(
+    f"facet normal 0 0 0\nouter loop\n{''.join(f'vertex {v}' + chr(10) for v in face)}endloop\nendfacet\n"
+    for face in (("0 0 0", "0 0.1 0", "0.1 0 0"), ("0 0 0", "0.1 0 0", "0 0 0.1"), ("0 0 0", "0 0 0.1", "0 0.1 0"),
+                 ("0.1 0 0", "0 0.1 0", "0 0 0.1"))) + "endsolid t\n"
+"""A closed tetrahedron, an ASCII STL."""
 INERTIAL = "<inertial><mass>{m}</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy><izz>{i}</izz></inertia></inertial>"
 
 
@@ -327,3 +332,36 @@ def test_mass_without_inertia_says_sdfs_default_moments_above_the_link(tmp_path)
     assert recipe["links"]["link"]["inertial"] == {"mass": 0.1, "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}
     assert ("  # the SDF gives its mass and no <inertia>: SDF's default moments, 1 kg m^2 about each axis, as\n"
             "  # Gazebo simulates it\n  link:\n") in result.recipe_path.read_text()
+
+
+def test_shapes_without_thickness_and_massless_links(tmp_path):
+    """libsdformat validates a box 0 thick, a sphere of radius 0, a mesh scaled by 0 (Gazebo loads
+    them); the recipe refused them (exit 2).  Written at the recipe's least length, stated.  A
+    link of mass 0 fixed to a moving one is a <frame> of the rebuilt model.sdf: the verification
+    compares its pose there (it said 'missing in the rebuild')."""
+    (tmp_path / "m").mkdir()
+    (tmp_path / "m" / "part.stl").write_text(TETRAHEDRON)
+    result, recipe, sdf = _imported(tmp_path, f"""<sdf version="1.6"><model name="m">
+  <link name="base">{INERTIAL.format(m=1, i=0.01)}
+    <collision name="plate"><geometry><box><size>0.1 0.1 0</size></box></geometry></collision>
+    <visual name="dot"><geometry><sphere><radius>0</radius></sphere></geometry></visual>
+    <visual name="flat"><geometry><mesh><uri>part.stl</uri><scale>0 1 1</scale></mesh></geometry></visual>
+  </link>
+  <link name="arm"><pose>0 0 0.5 0 0 0</pose>{INERTIAL.format(m=1, i=0.01)}</link>
+  <link name="tool"><pose>0.2 0 0.5 0 0 0</pose><inertial><mass>0</mass></inertial></link>
+  <joint name="hinge" type="revolute"><parent>base</parent><child>arm</child>
+    <axis><xyz>0 1 0</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+  <joint name="tool_joint" type="fixed"><parent>arm</parent><child>tool</child></joint>
+</model></sdf>""")
+    assert result.verdict.ok and result.verdict.configurations == 11, result.verdict.lines()
+    assert result.ledger == [
+        f"{sdf}:4: visual 'dot' of link 'base' (sphere): all: approximated: its length 0 written 1e-06 m, the "
+        "least the recipe takes",
+        f"{sdf}:5: visual 'flat' of link 'base' (mesh part.stl): all: approximated: its scale 0 1 1 written with "
+        "1e-06 for 0",
+        f"{sdf}:3: collision 'plate' of link 'base' (box): all: approximated: its length 0 written 1e-06 m, the "
+        "least the recipe takes"]
+    base = recipe["links"]["base"]
+    assert base["collision"] == {"box": {"size": [0.1, 0.1, 1e-6]}}
+    assert [base["visual"][0], base["visual"][1]["scale"]] == [{"sphere": {"radius": 1e-6}}, [1e-6, 1, 1]]
+    assert "inertial" not in recipe["links"]["tool"]

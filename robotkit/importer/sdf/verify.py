@@ -68,7 +68,7 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
     names = dict(pairs)
     for label, q in configs:
         po = _relative(poses(original, q, tree.used.values()), root, tree.offset(root, original.links[root].T))
-        pr = _relative(poses(rebuilt, {names[j]: v for j, v in q.items()}), root, np.eye(4))
+        pr = _relative(_framed(rebuilt, poses(rebuilt, {names[j]: v for j, v in q.items()})), root, np.eye(4))
         _links(verdict, original, rebuilt, tree, repaired, po, pr, label)
     verdict.configurations = len(configs)
     return verdict
@@ -102,6 +102,8 @@ def _joints(verdict: Verdict, original, rebuilt, tree, roots) -> None:
         if len(names) != 1 or oj.type not in KIND:
             continue
         rj = rebuilt.joints.get(names[0])
+        if rj is None and oj.type == "fixed" and _massless_frame(oj.child, original, rebuilt):
+            continue  # the child is a <frame> of the rebuild: its pose is compared
         if rj is None or KIND.get(rj.type) != KIND[oj.type]:
             verdict.failures.append(f"joint '{j}': {oj.type} in the original, "
                                     f"{rj.type if rj else 'missing'} in the rebuild")
@@ -148,6 +150,20 @@ def _motion(j, v: float) -> np.ndarray:
     return M
 
 
+def _framed(model, done: dict) -> dict:
+    """Link poses ``done`` with the model's <frame>s added where their links are (model.sdf
+    writes a massless link fixed to another as a frame)."""
+    for name, (attached, T) in model.frames.items():
+        if attached in done and attached in model.links and name not in done:
+            done[name] = done[attached] @ np.linalg.inv(model.links[attached].T) @ T
+    return done
+
+
+def _massless_frame(name: str, original, rebuilt) -> bool:
+    """Whether the original's link ``name`` is massless and the rebuild has it as a <frame>."""
+    return name in original.links and original.links[name].mass == 0 and name in rebuilt.frames
+
+
 def _links(verdict, original, rebuilt, tree, repaired, po, pr, label: str) -> None:
     """Each original link against its rebuilt link with the point masses its joint's chain links
     took from it (robotkit.importer.sdf.tree.take_chain_masses), all in model axes."""
@@ -157,6 +173,9 @@ def _links(verdict, original, rebuilt, tree, repaired, po, pr, label: str) -> No
     for name, lo in original.links.items():
         lr = rebuilt.links.get(name)
         where = f"link '{name}' at {label}"
+        if lr is None and _massless_frame(name, original, rebuilt):
+            _check(verdict, "pose", float(np.abs(po[name] @ tree.offset(name, lo.T) - pr[name]).max()), where)
+            continue
         if lr is None:
             verdict.failures.append(f"link '{name}' missing in the rebuild")
             continue
