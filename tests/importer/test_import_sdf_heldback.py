@@ -365,3 +365,27 @@ def test_shapes_without_thickness_and_massless_links(tmp_path):
     assert base["collision"] == {"box": {"size": [0.1, 0.1, 1e-6]}}
     assert [base["visual"][0], base["visual"][1]["scale"]] == [{"sphere": {"radius": 1e-6}}, [1e-6, 1, 1]]
     assert "inertial" not in recipe["links"]["tool"]
+
+
+def test_names_the_recipe_refuses_are_renamed_and_values_above_its_largest_written_so(tmp_path):
+    """libsdformat takes a link 'base link', a joint '1 hinge' and a frame 'tool tip', and a
+    damping of 1e13; the recipe refused them all (exit 2).  Renamed as a ROS frame name holds
+    them, the damping written 1e12, each stated at the original's line."""
+    result, recipe, sdf = _imported(tmp_path, f"""<sdf version="1.7"><model name="m">
+  <link name="base link">{INERTIAL.format(m=1, i=0.01)}</link>
+  <link name="arm"><pose>0 0 0.5 0 0 0</pose>{INERTIAL.format(m=1, i=0.01)}</link>
+  <joint name="1 hinge" type="revolute"><parent>base link</parent><child>arm</child>
+    <axis><xyz>0 1 0</xyz><limit><lower>-1</lower><upper>1</upper></limit>
+      <dynamics><damping>1e13</damping></dynamics></axis></joint>
+  <frame name="tool tip" attached_to="arm"><pose>0.1 0 0 0 0 0</pose></frame>
+</model></sdf>""")
+    assert result.verdict.ok and result.verdict.configurations == 11, result.verdict.lines()
+    why = "(a recipe name holds letters, digits, '_', '-' and '.', a letter or '_' first, with '/' between parts)"
+    assert result.ledger == [
+        f"{sdf}:2: link 'base link': all: renamed 'base_link' {why}",
+        f"{sdf}:4: joint '1 hinge': all: renamed '_1_hinge' {why}",
+        f"{sdf}:7: frame 'tool tip': all: renamed 'tool_tip' {why}",
+        f"{sdf}:4: joint '_1_hinge' damping 1e+13: all: approximated: written 1e+12, the largest the recipe takes"]
+    joints = _joints(recipe)
+    assert (joints["_1_hinge"]["parent"], joints["_1_hinge"]["dynamics"]) == ("base_link", {"damping": 1e12})
+    assert (joints["tool_tip_frame"]["parent"], joints["tool_tip_frame"]["child"]) == ("arm", "tool_tip")

@@ -25,6 +25,7 @@ from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
 from robotkit.importer.sdf.contacts import add_contacts
 from robotkit.importer.sdf.extras import add_extras
 from robotkit.importer.sdf.model import read_model
+from robotkit.importer.sdf.names import recipe_names
 from robotkit.importer.sdf.shapes import add_shapes
 from robotkit.importer.sdf.source import read
 from robotkit.importer.sdf.tree import build_tree, take_chain_masses
@@ -46,6 +47,7 @@ def convert(path, out: Path):
     except ValueError as exc:  # a number that is none, in a file libsdformat refused
         why = f"libsdformat refuses it ({src.refused}), and its XML holds " if src.refused else "it holds "
         raise RobotkitError(Problem(f"{why}a value that is not a number: {exc}", file=str(src.path))) from None
+    recipe_names(src, m, ledger)
     tree = build_tree(src, m, ledger)
     materials: dict = {}
     repaired: dict = {}

@@ -70,11 +70,17 @@ class Source:
     renamed: dict = field(default_factory=dict)  # new joint name -> the file's
     unknown_scripts: set = field(default_factory=set)  # Gazebo material names without a known colour
     includes: dict = field(default_factory=dict)  # an included model's name ('a/b' nested) -> its Lines
+    renamed_as: dict = field(default_factory=lambda: {"link": {}, "joint": {}, "frame": {}})  # new -> the file's
+
+    def original(self, kind: str, name: str | None) -> str | None:
+        """The name the file gives the link, joint or frame the import calls ``name``."""
+        name = self.renamed_as.get(kind, {}).get(name, name)
+        return self.renamed.get(name, name) if kind == "joint" else name
 
     def where(self, kind: str, name: str | None, link: str | None = None) -> str:
         """``file:line`` of the element ``<kind name="name">`` (inside link ``link`` when given):
         in the original file, or the file of the included model it came from."""
-        name = self.renamed.get(name, name) if kind == "joint" else name
+        name, link = self.original(kind, name), self.original("link", link)
         text, key = Lines(self.path, self.lines), link or name or ""
         for prefix in sorted(self.includes, key=len, reverse=True):
             if key.startswith(prefix + "/"):

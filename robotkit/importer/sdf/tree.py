@@ -21,6 +21,7 @@ from robotkit.importer.inertials import POINT_MASS_FLOOR
 from robotkit.importer.mjcf.chainmass import carve, point_inertial
 from robotkit.importer.mjcf.frames import clean, origin
 from robotkit.importer.mjcf.tree import CHAIN_MASS, UNLIMITED, UNLIMITED_SLIDE, WORLD
+from robotkit.recipe.schema import MAX_VALUE
 
 HUGE = 1e10
 """A revolute joint's limit beyond this (SDF's default is ±1e16) means none: continuous."""
@@ -264,6 +265,10 @@ def _motion(src, tree: Tree, j, axis, k: int, ledger, name: str) -> dict:
     dyn = el.find("dynamics") if el is not None else None
     values = {"damping": num(dyn, "damping") or 0.0, "friction": num(dyn, "friction") or 0.0}
     values = {key: v for key, v in values.items() if v > 0}
+    for key in [k for k, v in values.items() if v > MAX_VALUE]:
+        ledger.add(src.where("joint", j.name), f"joint '{j.name}' {key} {values[key]:g}", "all",
+                   f"approximated: written {MAX_VALUE:g}, the largest the recipe takes")
+        values[key] = MAX_VALUE
     if values:
         out["dynamics"] = values
     return out
