@@ -25,6 +25,7 @@ from robotkit.importer.recipe_writer import dump_recipe, name_mesh_folders
 from robotkit.importer.sdf.contacts import add_contacts
 from robotkit.importer.sdf.extras import add_extras
 from robotkit.importer.sdf.model import read_model
+from robotkit.importer.sdf.names import recipe_names
 from robotkit.importer.sdf.shapes import add_shapes
 from robotkit.importer.sdf.source import read
 from robotkit.importer.sdf.tree import build_tree, take_chain_masses
@@ -40,22 +41,19 @@ def convert(path, out: Path):
     if src.refused:
         ledger.add(str(src.path), "the file", "all", f"libsdformat refuses it ({src.refused}): read from its own "
                    "XML, as Gazebo classic loads it")
-    renamed = joints_apart_from_links([c for c in src.model if is_element(c)])
-    src.renamed = {new: old for old, new in renamed.items()}
-    for old, new in renamed.items():
-        ledger.add(src.where("joint", old), f"joint '{old}'", "all", f"renamed '{new}' (a link has its name: "
-                   "libsdformat refuses the pair)")
+    _joints_apart_from_links(src, src.model, "", ledger)
     try:
         m = read_model(src.model, str(src.path))
     except ValueError as exc:  # a number that is none, in a file libsdformat refused
         why = f"libsdformat refuses it ({src.refused}), and its XML holds " if src.refused else "it holds "
         raise RobotkitError(Problem(f"{why}a value that is not a number: {exc}", file=str(src.path))) from None
+    recipe_names(src, m, ledger)
     tree = build_tree(src, m, ledger)
     materials: dict = {}
     repaired: dict = {}
     files = add_shapes(src, m, tree, out, ledger, materials, repaired)
     take_chain_masses(src, tree, ledger)
-    surfaces = add_contacts(m, tree)
+    surfaces = add_contacts(src, m, tree, ledger)
     recipe: dict = {"robot": package_name(m.name)}
     meta = _metadata(src.config)
     if meta:
@@ -69,6 +67,18 @@ def convert(path, out: Path):
         recipe["materials"] = materials
     recipe["links"], recipe["joints"] = tree.links, tree.joints
     return recipe, ledger, src, m, tree, repaired, files
+
+
+def _joints_apart_from_links(src, model, scope: str, ledger) -> None:
+    """Joints named like a link of their model, in the model and in each nested model (turtlebot
+    includes create, whose joint 'left_wheel' moves its link 'left_wheel'), renamed, stated."""
+    renamed = joints_apart_from_links([c for c in model if is_element(c)])
+    for old, new in renamed.items():
+        src.renamed[scope + new] = scope + old
+        ledger.add(src.where("joint", scope + old), f"joint '{scope + old}'", "all", f"renamed '{scope + new}' (a "
+                   "link has its name: libsdformat refuses the pair)")
+    for nested in (c for c in model if is_element(c) and c.tag == "model"):
+        _joints_apart_from_links(src, nested, f"{scope}{nested.get('name', '')}/", ledger)
 
 
 def _metadata(config: dict) -> dict:

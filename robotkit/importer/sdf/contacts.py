@@ -7,6 +7,7 @@ line per link."""
 from __future__ import annotations
 
 from robotkit.importer.sdf.model import children
+from robotkit.recipe.schema import MAX_VALUE
 
 MAPPED = {"friction/ode/mu": "mu1", "friction/ode/mu2": "mu2", "contact/ode/kp": "kp", "contact/ode/kd": "kd"}
 DEFAULTS = {"slip1": 0.0, "slip2": 0.0, "fdir1": (0.0, 0.0, 0.0), "max_vel": 0.01, "min_depth": 0.0,
@@ -18,9 +19,12 @@ DEFAULTS = {"slip1": 0.0, "slip2": 0.0, "fdir1": (0.0, 0.0, 0.0), "max_vel": 0.0
 nothing is lost."""
 
 
-def add_contacts(m, tree) -> dict[str, list[str]]:
-    """Each link's ``contact``; link -> what of its surfaces is dropped (for its ledger line)."""
+def add_contacts(src, m, tree, ledger) -> dict[str, list[str]]:
+    """Each link's ``contact``; link -> what of its surfaces is dropped (for its ledger line).  A
+    value above the recipe's largest (youbot's kp of 1e13) is written as that (1e12, SDF's own
+    default kp: both a rigid contact), one ledger line per value."""
     dropped: dict[str, list[str]] = {}
+    capped: dict[tuple[str, float], list[str]] = {}
     for name, link in m.links.items():
         found, other = [], []
         for c in children(link.el, "collision"):
@@ -36,11 +40,19 @@ def add_contacts(m, tree) -> dict[str, list[str]]:
             bad = {k: v for k, v in values.items() if v < 0 or (k == "kp" and v == 0)}
             other += [f"{k} {v:g} (negative)" for k, v in bad.items()]
             kept = {k: v for k, v in values.items() if k not in bad}
+            for k, v in kept.items():
+                if v > MAX_VALUE:
+                    capped.setdefault((k, v), []).append(name)
+                    kept[k] = MAX_VALUE
             if kept:
                 tree.links[name]["contact"] = kept
         if other:
             dropped[name] = [f"its collisions' {', '.join(dict.fromkeys(other))} (the recipe's contact is a link's "
                              "mu1, mu2, kp, kd)"]
+    for (key, value), links in capped.items():
+        named = ", ".join(f"'{n}'" for n in links)
+        ledger.add(src.where("link", links[0]), f"contact {key} {value:g} of link{'s' if len(links) > 1 else ''} "
+                   f"{named}", "all", f"approximated: written {MAX_VALUE:g}, the largest the recipe takes")
     return dropped
 
 

@@ -23,6 +23,7 @@ MODEL_KEPT = {"pose", "static", "link", "joint", "frame", "plugin", "model"}
 
 def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
     extras: list[str] = []
+    left: dict[tuple[str, ...], list[str]] = {}
     for name, link in m.links.items():
         O = np.linalg.inv(tree.offset(name, link.T))
         for sensor in children(link.el, "sensor"):
@@ -30,33 +31,65 @@ def add_extras(src, m, tree, recipe: dict, ledger, surfaces: dict) -> None:
             ledger.add(src.where("sensor", sensor.get("name"), name), f"sensor '{sensor.get('name')}' "
                        f"({sensor.get('type')}) of link '{name}'", "MJCF",
                        "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
-        _other(src, link.el, name, ledger, surfaces.get(name, []))
+        dropped = _other(link.el, surfaces.get(name, []))
+        if dropped:
+            left.setdefault(tuple(dropped), []).append(name)
+    _grouped(src, ledger, "link", left)
     _scripts(src, m, ledger)
-    for plugin in m.plugins:
-        extras.append(_block(plugin, None, None))
-        ledger.add(src.where("plugin", plugin.get("name")), f"plugin '{plugin.get('name')}' "
-                   f"({plugin.get('filename')})", "MJCF",
-                   "dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF)")
+    _plugins(src, m, extras, ledger)
     for el in (c for c in src.model if is_element(c) and c.tag not in MODEL_KEPT):
         if not (el.tag in ("self_collide", "allow_auto_disable", "enable_wind") and (el.text or "").strip() in
-                ("false", "0", "true" if el.tag == "allow_auto_disable" else "-")):
+                ("false", "0", *(("true", "1") if el.tag == "allow_auto_disable" else ()))):
             ledger.add(src.where(el.tag, el.get("name")), f"model <{el.tag}>", "all", "dropped: no place in the recipe")
     _frames(src, m, tree, ledger)
+    joints: dict[tuple[str, ...], list[str]] = {}
     for name, j in m.joints.items():
         left = joint_leftovers(j.el)
         if left and name in tree.joint_map:
-            ledger.add(src.where("joint", name.split("/")[-1]), f"joint '{name}'", "all",
-                       f"dropped (no place in the recipe): {', '.join(left)}")
+            joints.setdefault(tuple(left), []).append(name)
+    _grouped(src, ledger, "joint", joints)
     for nested in src.model.iter("model"):
         for plugin in children(nested, "plugin") if nested is not src.model else ():
             ledger.add(str(src.path), f"plugin '{plugin.get('name')}' of included model '{nested.get('name')}'",
                        "all", "dropped (its names are the included model's)")
     _, P = pose_of(src.model)
-    if not np.allclose(P, np.eye(4), rtol=0, atol=0):
+    if not np.allclose(P, np.eye(4), rtol=0, atol=0) and not tree.world_pose:
         ledger.add(src.where("model", m.name), f"model '{m.name}' <pose>", "all", "dropped: where the model stands "
                    "in a world (the recipe describes the robot; a world places it)")
     if extras:
         recipe["urdf_extras"] = extras
+
+
+def _plugins(src, m, extras: list, ledger) -> None:
+    """The model's plugins, verbatim but for the names of nested models' elements, which the
+    recipe writes with '/' (ArduPilot's 'dolly_ardupilot::dolly::back_motor_joint' names the
+    joint the rebuild calls 'dolly/back_motor_joint'), stated."""
+    names = set(m.links) | set(m.joints) | set(m.frames)
+    for plugin in m.plugins:
+        plugin = copy.deepcopy(plugin)
+        renamed = _flat_references(plugin, names, m.name)
+        extras.append(_block(plugin, None, None))
+        said = (f"; the names in it of {renamed} nested model element{'s' if renamed > 1 else ''} written as the "
+                "recipe's (a::b as a/b)") if renamed else ""
+        ledger.add(src.where("plugin", plugin.get("name")), f"plugin '{plugin.get('name')}' "
+                   f"({plugin.get('filename')})", "MJCF",
+                   f"dropped (kept verbatim in a <gazebo> block of urdf_extras, for model.sdf and the URDF){said}")
+
+
+def _flat_references(el, names: set, own: str) -> int:
+    """Each text of ``el`` naming a nested model's element ('a::b', after the model's own name if
+    it begins with it) written 'a/b' (the rest after it kept: 'a::b::sensor' as 'a/b::sensor');
+    how many."""
+    count = 0
+    for leaf in el.iter():
+        text = (leaf.text or "").strip() if isinstance(leaf.tag, str) and not len(leaf) else ""
+        head = f"{own}::" if text.startswith(f"{own}::") else ""
+        parts = text[len(head):].split("::")
+        k = next((k for k in range(len(parts), 1, -1) if "/".join(parts[:k]) in names), 0)
+        if k:
+            leaf.text = head + "::".join(["/".join(parts[:k]), *parts[k:]])
+            count += 1
+    return count
 
 
 def _block(el, O, link: str | None) -> str:
@@ -77,9 +110,17 @@ def _block(el, O, link: str | None) -> str:
     return etree.tostring(block, encoding="unicode").strip()
 
 
-def _other(src, el, name: str, ledger, dropped: list) -> None:
-    """One line per link for what it holds that the recipe has no place for (``dropped``: of its
-    collisions' surfaces)."""
+def _grouped(src, ledger, kind: str, groups: dict) -> None:
+    """One ledger line for the links (joints) that drop the same (youbot's 21 surfaces, cessna's
+    10 joints' <physics>), at the first one's line."""
+    for dropped, names in groups.items():
+        named = ", ".join(f"'{n}'" for n in names)
+        ledger.add(src.where(kind, names[0]), f"{kind}{'s' if len(names) > 1 else ''} {named}", "all",
+                   f"dropped (no place in the recipe): {', '.join(dropped)}")
+
+
+def _other(el, dropped: list) -> list[str]:
+    """What a link holds that the recipe has no place for (``dropped``: of its collisions' surfaces)."""
     dropped = list(dropped) + shape_leftovers(el)
     for child in el:
         if not is_element(child) or child.tag in LINK_KEPT:
@@ -87,9 +128,7 @@ def _other(src, el, name: str, ledger, dropped: list) -> None:
         value = {"1": "true", "0": "false"}.get((child.text or "").strip().lower(), (child.text or "").strip().lower())
         if LINK_DEFAULTS.get(child.tag) != value:
             dropped.insert(0, f"<{child.tag}> {value}".strip())
-    if dropped:
-        ledger.add(src.where("link", name), f"link '{name}'", "all",
-                   f"dropped (no place in the recipe): {', '.join(dropped)}")
+    return dropped
 
 
 def _scripts(src, m, ledger) -> None:

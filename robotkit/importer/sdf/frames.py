@@ -44,8 +44,9 @@ class Frames:
     """Every named frame of a model (links, joints, frames, nested models) and its pose in the
     model frame, resolved on demand."""
 
-    def __init__(self, file: str):
+    def __init__(self, file: str, own: str = ""):
         self.file = file
+        self.own = f"{own}::" if own else ""  # the model's own name, which Gazebo classic lets names begin with
         self.spec: dict[str, tuple[str, np.ndarray]] = {MODEL: ("", np.eye(4))}
         self.done: dict[str, np.ndarray] = {MODEL: np.eye(4)}
 
@@ -55,6 +56,8 @@ class Frames:
     def get(self, name: str, seen: tuple = ()) -> np.ndarray:
         if name in self.done:
             return self.done[name]
+        if name not in self.spec and self.own and name.startswith(self.own) and name[len(self.own):] in self.spec:
+            return self.get(name[len(self.own):], seen)
         if name not in self.spec:
             raise RobotkitError(Problem(f"a pose relative to '{name}', which is no frame of the model", file=self.file))
         if name in seen:

@@ -43,6 +43,8 @@ class Model:
     joints: dict = field(default_factory=dict)
     frames: dict = field(default_factory=dict)  # name -> (attached_to link, pose in the model frame)
     plugins: list = field(default_factory=list)
+    prefixed: list = field(default_factory=list)  # (joint, its end as written, as read): see _own
+    world: np.ndarray = field(default_factory=lambda: np.eye(4))  # the world frame in the model frame
 
 
 def children(el, tag: str) -> list:
@@ -50,22 +52,61 @@ def children(el, tag: str) -> list:
 
 
 def read_model(el, file: str) -> Model:
-    frames = Frames(file)
+    m = Model(el.get("name") or "model", (el.findtext("static") or "").strip().lower() in ("true", "1"))
+    frames = Frames(file, m.name)
     _, top = pose_of(el)
     frames.add("world", MODEL, np.linalg.inv(top))
-    m = Model(el.get("name") or "model", (el.findtext("static") or "").strip().lower() in ("true", "1"))
     pending: list = []
-    _scope(el, "", m, frames, pending)
+    attached = {MODEL: _canonical(el, "")}
+    _scope(el, "", m, frames, pending, attached)
     for kind, name, node in pending:
         if kind == "link":
             m.links[name] = _link(name, node, frames.get(name))
         elif kind == "joint":
             m.joints[name] = _joint(name, node, frames)
+            attached[name] = m.joints[name].child
         else:
             m.frames[name] = node, frames.get(name)
+    for j in m.joints.values():
+        j.parent, j.child = (_link_of(_own(j, end, m, attached), m, attached) for end in (j.parent, j.child))
+    m.frames = {name: (_link_of(a, m, attached), T) for name, (a, T) in m.frames.items()}
     m.plugins = children(el, "plugin")
+    m.world = frames.get("world")
     _flat_names(m)
     return m
+
+
+def _canonical(model, scope: str) -> str:
+    """The frame a model is attached to: its canonical link (its ``canonical_link``, else its first
+    link, else its first nested model's), as libsdformat's frame semantics have it."""
+    if model.get("canonical_link"):
+        return scope + model.get("canonical_link")
+    links = children(model, "link")
+    if links:
+        return scope + links[0].get("name", "")
+    nested = children(model, "model")
+    return _canonical(nested[0], f"{scope}{nested[0].get('name', '')}::") if nested else scope[:-2] or MODEL
+
+
+def _own(j, name: str, m: Model, attached: dict) -> str:
+    """A joint's end named with the model's own name first (ArduPilot's models:
+    'dolly_ardupilot::dolly::base_link'), which Gazebo classic finds and libsdformat does not: the
+    name without it, noted in ``m.prefixed``."""
+    known = lambda n: n in m.links or n in attached  # noqa: E731
+    head = f"{m.name}::"
+    if known(name) or not name.startswith(head) or not known(name[len(head):]):
+        return name
+    m.prefixed.append((j.name, name, name[len(head):]))
+    return name[len(head):]
+
+
+def _link_of(name: str, m: Model, attached: dict, seen: tuple = ()) -> str:
+    """The link a frame is attached to (SDF 1.7: a joint's parent or child, or a frame's
+    attached_to, may be a frame, a joint or a nested model): itself when it is a link, world, or
+    nothing it can be followed to."""
+    if name in m.links or name == "world" or name not in attached or name in seen:
+        return name
+    return _link_of(attached[name], m, attached, seen + (name,))
 
 
 def _flat_names(m: Model) -> None:
@@ -80,7 +121,7 @@ def _flat_names(m: Model) -> None:
     m.frames = {flat(k): (flat(a), T) for k, (a, T) in m.frames.items()}
 
 
-def _scope(el, scope: str, m: Model, frames: Frames, pending: list) -> None:
+def _scope(el, scope: str, m: Model, frames: Frames, pending: list, attached: dict) -> None:
     here = scope[:-2] if scope else MODEL
     for link in children(el, "link"):
         name = scope + link.get("name", "")
@@ -95,14 +136,16 @@ def _scope(el, scope: str, m: Model, frames: Frames, pending: list) -> None:
     for frame in children(el, "frame"):
         name = scope + frame.get("name", "")
         base, T = pose_of(frame)
-        attached = scoped(scope, frame.get("attached_to"), here)
-        frames.add(name, scoped(scope, base, attached), T)
-        pending.append(("frame", name, attached))
+        to = scoped(scope, frame.get("attached_to"), here)
+        frames.add(name, scoped(scope, base, to), T)
+        pending.append(("frame", name, to))
+        attached[name] = to
     for nested in children(el, "model"):
         name = scope + nested.get("name", "")
         base, T = pose_of(nested)
         frames.add(name, scoped(scope, base, here), T)
-        _scope(nested, name + "::", m, frames, pending)
+        attached[name] = _canonical(nested, name + "::")
+        _scope(nested, name + "::", m, frames, pending, attached)
 
 
 def _link(name: str, el, T) -> Link:

@@ -19,6 +19,7 @@ from robotkit.importer.names import material_name
 from robotkit.importer.sdf.frames import pose_of
 from robotkit.importer.sdf.model import children
 from robotkit.importer.sdf.tree import origin_of
+from robotkit.recipe.schema import MIN_LENGTH
 
 PRIMITIVES = ("box", "cylinder", "sphere")
 GAZEBO_COLOURS = {"Gazebo/White": "1 1 1", "Gazebo/Grey": "0.7 0.7 0.7", "Gazebo/DarkGrey": "0.175 0.175 0.175",
@@ -47,18 +48,45 @@ def add_shapes(src, m, tree, out: Path, ledger, materials: dict, repaired: dict)
         if collision != bare:
             entry["collision"] = (collision if len(collision) > 1 else collision[0]) if collision else "none"
         _inertial(src, name, link, O, entry, collision, visual, ledger, repaired)
+        given = link.el.find("inertial")
+        if given is not None and given.find("inertia") is None and link.mass > 0 and name not in repaired:
+            tree.link_notes[name] = ("the SDF gives its mass and no <inertia>: SDF's default moments, 1 kg m^2 "
+                                     "about each axis, as Gazebo simulates it")
     return files
 
 
-def _shape(src, el, O, out: Path, ledger, files: list, kind: str) -> list[dict]:
+def _shape(src, el, O, out_path: Path, ledger, files: list, kind: str) -> list[dict]:
     geometry = el.find("geometry")
     _, P = pose_of(el)
     T = O @ P
     shape = next((g for g in (geometry if geometry is not None else []) if isinstance(g.tag, str)), None)
-    label = f"{kind} '{el.get('name', '')}' of link '{el.getparent().get('name', '')}'"
+    label = f"{kind} '{el.get('name', '')}' of link '{src.link_of(el)}'"
     if shape is None:
         return []
-    num = lambda tag, d="0": [float(x) for x in (shape.findtext(tag) or d).split()]  # noqa: E731
+    thin: list[float] = []
+
+    def num(tag: str, d: str = "0") -> list[float]:
+        """The numbers of ``tag``; a length under the recipe's least (a box 0 thick, which
+        libsdformat and Gazebo take) written as that, noted in ``thin``."""
+        values = [float(x) for x in (shape.findtext(tag) or d).split()]
+        thin.extend(v for v in values if 0 <= v < MIN_LENGTH)
+        return [MIN_LENGTH if 0 <= v < MIN_LENGTH else v for v in values]
+
+    out = _primitive(src, el, shape, T, num, ledger, label, kind)
+    if thin:
+        ledger.add(src.where_el(kind, el), f"{label} ({shape.tag})", "all", f"approximated: its length"
+                   f"{'s' if len(thin) > 1 else ''} {', '.join(f'{v:g}' for v in thin)} written {MIN_LENGTH:g} m, "
+                   "the least the recipe takes")
+    if out is not None:
+        return out
+    if shape.tag == "mesh":
+        return _mesh(src, el, shape, T, out_path, ledger, files, label, kind)
+    ledger.add(src.where_el(kind, el), f"{label} ({shape.tag})", "all", "dropped: the recipe has no such shape")
+    return []
+
+
+def _primitive(src, el, shape, T, num, ledger, label: str, kind: str) -> list[dict] | None:
+    """A box, cylinder, sphere, capsule or ellipsoid as the recipe's shapes; None for another."""
     if shape.tag in PRIMITIVES:
         spec = {"box": lambda: {"size": num("size", "1 1 1")}, "sphere": lambda: {"radius": num("radius", "1")[0]},
                 "cylinder": lambda: {"radius": num("radius", "1")[0], "length": num("length", "1")[0]}}
@@ -70,13 +98,10 @@ def _shape(src, el, O, out: Path, ledger, files: list, kind: str) -> list[dict]:
             _at({"sphere": {"radius": r}}, _moved(e[:3])) for e in ends]
     if shape.tag == "ellipsoid":
         radii = num("radii", "1 1 1")
-        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (ellipsoid)", "all",
+        ledger.add(src.where_el(kind, el), f"{label} (ellipsoid)", "all",
                    "approximated: the box of its half-axes " + " ".join(f"{r:g}" for r in radii))
         return [_at({"box": {"size": [2 * r for r in radii]}}, T)]
-    if shape.tag == "mesh":
-        return _mesh(src, el, shape, T, out, ledger, files, label, kind)
-    ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} ({shape.tag})", "all", "dropped: the recipe has no such shape")
-    return []
+    return None
 
 
 def _moved(p) -> np.ndarray:
@@ -103,14 +128,18 @@ def _mesh(src, el, shape, T, out: Path, ledger, files, label: str, kind: str) ->
     uri = (shape.findtext("uri") or "").strip()
     file = mesh_file(src, uri)
     if file is None or not file.is_file():
-        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (mesh {uri})", "all", "dropped: its file is not found")
+        ledger.add(src.where_el(kind, el), f"{label} (mesh {uri})", "all", "dropped: its file is not found")
         return []
     if shape.find("submesh") is not None:
-        ledger.add(src.where(kind, el.get("name"), el.getparent().get("name")), f"{label} (mesh {uri})", "all",
+        ledger.add(src.where_el(kind, el), f"{label} (mesh {uri})", "all",
                    "approximated: the whole mesh file (the recipe names no submesh)")
     files.append(str(file.resolve()))
     out_shape = {"mesh": Path(os.path.relpath(file.resolve(), out.parent)).as_posix()}
     scale = [float(v) for v in (shape.findtext("scale") or "1 1 1").split()]
+    if 0.0 in scale:  # a mesh flattened: libsdformat and Gazebo take it, the recipe does not
+        ledger.add(src.where_el(kind, el), f"{label} (mesh {uri})", "all", f"approximated: its scale "
+                   f"{' '.join(f'{v:g}' for v in scale)} written with {MIN_LENGTH:g} for 0")
+        scale = [v or MIN_LENGTH for v in scale]
     if scale != [1.0, 1.0, 1.0]:
         out_shape["scale"] = scale[0] if len(set(scale)) == 1 else scale
     return [_at(out_shape, T)]
@@ -126,7 +155,7 @@ def _material(src, el, materials: dict, ledger) -> str | None:
         return None
     if text is None and script not in src.unknown_scripts:
         src.unknown_scripts.add(script)
-        ledger.add(src.where("visual", el.get("name"), el.getparent().get("name")), f"material script '{script}'",
+        ledger.add(src.where_el("visual", el), f"material script '{script}'",
                    "URDF, MJCF", "approximated: white (a Gazebo material script without a colour; model.sdf names it)")
     rgba = [float(v) for v in (text or "1 1 1 1").split()] + [1.0]
     rgba = [min(max(v, 0.0), 1.0) for v in rgba[:4]]

@@ -21,6 +21,44 @@ ENV_KEYS = ("SDF_PATH", "GAZEBO_MODEL_PATH", "IGN_GAZEBO_RESOURCE_PATH", "GZ_SIM
 
 
 @dataclass
+class Lines:
+    """A file's text, searched for an element's line (``file:line`` on the ledger)."""
+
+    path: Path
+    lines: list[str]
+
+    def where(self, kind: str, name: str | None, link: str | None = None) -> str:
+        """``file:line`` of the element ``<kind name="name">`` (inside link ``link`` when given);
+        the file alone when it is not there."""
+        start = self.find("link", link) if link else 1
+        line = self.find(kind, name, start or 1) if name else self.tag_line(kind, start or 1)
+        return f"{self.path}:{line}" if line else str(self.path)
+
+    def find(self, kind: str, name: str, start: int = 1) -> int | None:
+        """The line of ``<kind name="name">``; a nested model's ``model/name`` (its ``model::name``)
+        inside ``<model name="model">`` when no element has the whole name (iris's link
+        'iris/imu_link' is one name); None when it is not in the file."""
+        line = self.line_of(kind, name, start)
+        parts = name.split("/")
+        if line is not None or len(parts) == 1:
+            return line
+        for model in parts[:-1]:
+            start = self.line_of("model", model, start)
+            if start is None:
+                return None
+        return self.line_of(kind, parts[-1], start)
+
+    def tag_line(self, kind: str, start: int = 1) -> int | None:
+        """The line of the first ``<kind>`` from ``start`` (an element without a name)."""
+        pattern = re.compile(rf"<{kind}[\s/>]")
+        return next((i for i, line in enumerate(self.lines[start - 1:], start) if pattern.search(line)), None)
+
+    def line_of(self, kind: str, name: str | None, start: int = 1) -> int | None:
+        pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name or '')}[\"']")
+        return next((i for i, line in enumerate(self.lines[start - 1:], start) if pattern.search(line)), None)
+
+
+@dataclass
 class Source:
     path: Path
     model: object  # the <model> element (lxml)
@@ -31,18 +69,59 @@ class Source:
     model_path: Path | None = None
     renamed: dict = field(default_factory=dict)  # new joint name -> the file's
     unknown_scripts: set = field(default_factory=set)  # Gazebo material names without a known colour
+    includes: dict = field(default_factory=dict)  # an included model's name ('a/b' nested) -> its Lines
+    renamed_as: dict = field(default_factory=lambda: {"link": {}, "joint": {}, "frame": {}})  # new -> the file's
+
+    def original(self, kind: str, name: str | None) -> str | None:
+        """The name the file gives the link, joint or frame the import calls ``name``."""
+        name = self.renamed_as.get(kind, {}).get(name, name)
+        return self.renamed.get(name, name) if kind == "joint" else name
 
     def where(self, kind: str, name: str | None, link: str | None = None) -> str:
-        """``file:line`` of the element ``<kind name="name">`` in the original file (inside link
-        ``link`` when given); the file alone when it is not there (it came from an include)."""
-        name = self.renamed.get(name, name) if kind == "joint" else name
-        start = self.line_of("link", link) if link else 1
-        line = self.line_of(kind, name, start or 1) if name else None
-        return f"{self.path}:{line}" if line else str(self.path)
+        """``file:line`` of the element ``<kind name="name">`` (inside link ``link`` when given):
+        in the original file, or the file of the included model it came from."""
+        name, link = self.original(kind, name), self.original("link", link)
+        text, key = Lines(self.path, self.lines), link or name or ""
+        for prefix in sorted(self.includes, key=len, reverse=True):
+            if key.startswith(prefix + "/"):
+                text, cut = self.includes[prefix], len(prefix) + 1
+                link, name = (link[cut:], name) if link else (None, name[cut:] if name else name)
+                break
+        return text.where(kind, name, link)
 
-    def line_of(self, kind: str, name: str | None, start: int = 1) -> int | None:
-        pattern = re.compile(rf"<{kind}\b[^>]*\bname\s*=\s*[\"']{re.escape(name or '')}[\"']")
-        return next((i for i, line in enumerate(self.lines[start - 1:], start) if pattern.search(line)), None)
+    def where_el(self, kind: str, el) -> str:
+        """:meth:`where` of a link's visual or collision ``el``."""
+        return self.where(kind, el.get("name"), self.link_of(el))
+
+    def link_of(self, el) -> str:
+        """The name, as the model's ('a/b' in a nested model), of the link holding ``el``."""
+        link, scope, node = el.getparent(), [], el.getparent().getparent()
+        while node is not None and node is not self.model:
+            if node.tag == "model":
+                scope.insert(0, node.get("name", ""))
+            node = node.getparent()
+        return "/".join([*scope, link.get("name", "")])
+
+
+def included(model, model_path: Path | None, scope: str = "", depth: int = 0) -> dict:
+    """The models ``model`` (the original's XML) includes from the model path, and those they
+    include: their name as the model's ('a/b' nested) -> their file's Lines."""
+    out: dict = {}
+    for inc in (model.findall("include") if model_path is not None and depth < 8 else ()):
+        uri = (inc.findtext("uri") or "").strip()
+        try:
+            file = locate(model_path / uri[len("model://"):])[0] if uri.startswith("model://") else None
+            inner = _model(parse_file(file).getroot()) if file is not None and file.is_file() else None
+        except (RobotkitError, MalformedXML):
+            continue
+        name = (inc.findtext("name") or "").strip() or (inner.get("name", "") if inner is not None else "")
+        if inner is None or not name:
+            continue
+        out[scope + name] = Lines(file.absolute(), file.read_text(encoding="utf-8", errors="replace").splitlines())
+        out.update(included(inner, model_path, f"{scope}{name}/", depth + 1))
+    for nested in (model.findall("model") if depth < 8 else ()):
+        out.update(included(nested, model_path, f"{scope}{nested.get('name', '')}/", depth + 1))
+    return out
 
 
 def locate(path: str | os.PathLike) -> tuple[Path, dict]:
@@ -110,8 +189,12 @@ def read(path: str | os.PathLike) -> Source:
     model = _model(tree.getroot())
     if model is None:
         raise RobotkitError(Problem(refused or "holds no <model>", file=str(file)))
+    try:
+        mine = model if refused else _model(parse_file(file).getroot())
+    except MalformedXML:
+        mine = None
     return Source(file.absolute(), model, original.splitlines(), "xml" if refused else "libsdformat", refused,
-                  config, model_path)
+                  config, model_path, includes=included(mine, model_path) if mine is not None else {})
 
 
 def _model(root):

@@ -13,7 +13,7 @@ free``)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -21,6 +21,7 @@ from robotkit.importer.inertials import POINT_MASS_FLOOR
 from robotkit.importer.mjcf.chainmass import carve, point_inertial
 from robotkit.importer.mjcf.frames import clean, origin
 from robotkit.importer.mjcf.tree import CHAIN_MASS, UNLIMITED, UNLIMITED_SLIDE, WORLD
+from robotkit.recipe.schema import MAX_VALUE
 
 HUGE = 1e10
 """A revolute joint's limit beyond this (SDF's default is ±1e16) means none: continuous."""
@@ -44,6 +45,8 @@ class Tree:
     base: str = "fixed"
     notes: dict = field(default_factory=dict)  # joint -> comment above it
     link_notes: dict = field(default_factory=dict)
+    used: dict = field(default_factory=dict)  # SDF link -> the SDF joint (turned round or not) the tree hangs it by
+    world_pose: bool = False  # the model's <pose> kept in its joints to the world
 
     def offset(self, link, T) -> np.ndarray:
         """The recipe frame of SDF link ``link`` in its own SDF frame ``T``."""
@@ -52,19 +55,32 @@ class Tree:
 
 def build_tree(src, m, ledger) -> Tree:
     tree = Tree()
+    for joint, written, read in m.prefixed:
+        ledger.add(src.where("joint", joint.replace("::", "/")), f"joint '{joint.replace('::', '/')}'", "all",
+                   f"'{written}' read as '{read}' (the model's own name first: Gazebo classic finds it, "
+                   "libsdformat does not)")
     lightest = min((lk.mass for lk in m.links.values() if lk.mass > 0), default=1.0)
     parent_of: dict[str, object] = {}
     for j in m.joints.values():
         why = _unmapped(j, m, parent_of)
+        turned = _turned(j, m, parent_of) if why.startswith("dropped: it closes a loop") else None
+        if turned is not None:
+            ledger.add(src.where("joint", j.name), f"joint '{j.name}' ({j.type})", "all", f"written from "
+                       f"'{j.child}' to '{j.parent}' (its child already has joint '{parent_of[j.child].name}'; a joint "
+                       "that cannot move is the same either way)")
+            j, why = turned, ""
         if why:
-            ledger.add(src.where("joint", j.name.split("/")[-1]), f"joint '{j.name}' ({j.type})", "all", why)
+            ledger.add(src.where("joint", j.name), f"joint '{j.name}' ({j.type})", "all", why)
             continue
         parent_of[j.child] = j
+    tree.used = parent_of
     roots = [n for n in m.links if n not in parent_of]
-    world = m.static or any(j.parent == WORLD for j in parent_of.values())
-    if world:
+    jointed = [j.name for j in parent_of.values() if j.parent == WORLD]
+    world = m.static or bool(jointed)
+    if world:  # jointed to the world, where the model stands is physics (gravity on a pendulum): kept
         tree.links[WORLD] = {}
-        tree.frame[WORLD] = np.eye(4)
+        tree.frame[WORLD] = m.world if jointed else np.eye(4)
+        tree.world_pose = bool(jointed) and not np.allclose(m.world, np.eye(4), rtol=0, atol=0)
     else:
         tree.base = "free"
     for name, link in m.links.items():
@@ -92,9 +108,30 @@ def _unmapped(j, m, parent_of) -> str:
         return f"dropped: its parent '{j.parent}' is not a link of the model"
     if j.child in parent_of:
         return f"dropped: it closes a loop (link '{j.child}' already has joint '{parent_of[j.child].name}')"
+    up = j.parent
+    while up in parent_of:
+        up = parent_of[up].parent
+        if up == j.child:
+            return f"dropped: it closes a loop (link '{j.parent}' already hangs from link '{j.child}')"
+    if j.parent == j.child:
+        return f"dropped: its parent and child are one link ('{j.child}')"
     if j.type not in ("fixed", "revolute", "continuous", "prismatic", "screw") and j.type not in CHAINS:
         return "dropped: the recipe has no such joint"
     return ""
+
+
+def _turned(j, m, parent_of):
+    """Joint ``j``, which closes a loop, with its parent and child swapped when it cannot move and
+    its parent is still a free body (turtlebot: the included kinect's link fixed to the rack that
+    the included create carries): the same model as one tree; None otherwise."""
+    if j.parent not in m.links or j.parent in parent_of or not (j.type == "fixed" or _locked(j)):
+        return None
+    up = j.child
+    while up in parent_of:
+        up = parent_of[up].parent
+        if up == j.parent:
+            return None
+    return replace(j, parent=j.child, child=j.parent, T=m.links[j.parent].T)
 
 
 def _free(taken, base: str) -> str:
@@ -121,7 +158,7 @@ def _joint(src, tree: Tree, j, chain_mass: float, ledger) -> None:
         tree.joints[j.name] = _fixed(tree, j.parent, j.child)
         tree.joint_map[j.name] = [j.name]
         return
-    where = src.where("joint", j.name.split("/")[-1])
+    where = src.where("joint", j.name)
     R = j.T[:3, :3]
     if j.type in CHAINS:
         n = CHAINS[j.type]
@@ -176,7 +213,7 @@ def take_chain_masses(src, tree: Tree, ledger) -> None:
             why = ("it is too light to give it (what would be left is not a physical body)" if carve(inertial, [])
                    else "its inertial is the build's to compute from its geometry" if inertial
                    else "it has no mass to give")
-            ledger.add(src.where("link", child.split("/")[-1]), f"link '{child}' (joint chain)", "all",
+            ledger.add(src.where("link", child), f"link '{child}' (joint chain)", "all",
                        f"approximated: chain link{'s' if len(links) > 1 else ''} {named} "
                        f"carr{'y' if len(links) > 1 else 'ies'} an added point mass of {mass:.3g} kg, not taken from "
                        f"the link: {why}")
@@ -228,6 +265,10 @@ def _motion(src, tree: Tree, j, axis, k: int, ledger, name: str) -> dict:
     dyn = el.find("dynamics") if el is not None else None
     values = {"damping": num(dyn, "damping") or 0.0, "friction": num(dyn, "friction") or 0.0}
     values = {key: v for key, v in values.items() if v > 0}
+    for key in [k for k, v in values.items() if v > MAX_VALUE]:
+        ledger.add(src.where("joint", j.name), f"joint '{j.name}' {key} {values[key]:g}", "all",
+                   f"approximated: written {MAX_VALUE:g}, the largest the recipe takes")
+        values[key] = MAX_VALUE
     if values:
         out["dynamics"] = values
     return out

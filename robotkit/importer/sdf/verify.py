@@ -56,7 +56,7 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
     verdict = Verdict(worst={k: (0.0, "") for k in TOL})
     pairs = [(j, names[0]) for j, names in tree.joint_map.items() if len(names) == 1
              and original.joints[j].type in ("revolute", "continuous", "prismatic") and names[0] in rebuilt.joints]
-    root = _root(original)
+    root = _root(original, tree.used.values())
     _joints(verdict, original, rebuilt, tree, (original.links[root].T @ tree.offset(root, original.links[root].T),
                                                 rebuilt.links[root].T))
     rng = np.random.default_rng(SEED)
@@ -67,16 +67,16 @@ def verify(original, tree, repaired: set, rebuilt_path) -> Verdict:
         configs.append((f"random configuration {i + 1}", q))
     names = dict(pairs)
     for label, q in configs:
-        po = _relative(poses(original, q), root, tree.offset(root, original.links[root].T))
-        pr = _relative(poses(rebuilt, {names[j]: v for j, v in q.items()}), root, np.eye(4))
+        po = _relative(poses(original, q, tree.used.values()), root, tree.offset(root, original.links[root].T))
+        pr = _relative(_framed(rebuilt, poses(rebuilt, {names[j]: v for j, v in q.items()})), root, np.eye(4))
         _links(verdict, original, rebuilt, tree, repaired, po, pr, label)
     verdict.configurations = len(configs)
     return verdict
 
 
-def _root(model) -> str:
+def _root(model, joints) -> str:
     """The first link no joint from another link moves (a link jointed to the world counts)."""
-    inner = {j.child for j in model.joints.values() if j.parent in model.links}
+    inner = {j.child for j in joints if j.parent in model.links}
     return next((n for n in model.links if n not in inner), next(iter(model.links)))
 
 
@@ -102,6 +102,8 @@ def _joints(verdict: Verdict, original, rebuilt, tree, roots) -> None:
         if len(names) != 1 or oj.type not in KIND:
             continue
         rj = rebuilt.joints.get(names[0])
+        if rj is None and oj.type == "fixed" and _massless_frame(oj.child, original, rebuilt):
+            continue  # the child is a <frame> of the rebuild: its pose is compared
         if rj is None or KIND.get(rj.type) != KIND[oj.type]:
             verdict.failures.append(f"joint '{j}': {oj.type} in the original, "
                                     f"{rj.type if rj else 'missing'} in the rebuild")
@@ -110,9 +112,10 @@ def _joints(verdict: Verdict, original, rebuilt, tree, roots) -> None:
             _check(verdict, "axis", float(np.abs(Ro.T @ oj.axes[0] - Rr.T @ rj.axes[0]).max()), f"joint '{j}' axis")
 
 
-def poses(model, q: dict) -> dict:
-    """Every link's pose in the model frame with joint values ``q`` (others at zero)."""
-    parent_of = {j.child: j for j in model.joints.values() if j.type != "gearbox"}
+def poses(model, q: dict, joints=None) -> dict:
+    """Every link's pose in the model frame with joint values ``q`` (others at zero), along
+    ``joints`` (the original's: those the import's tree follows, not the loops it drops)."""
+    parent_of = {j.child: j for j in (model.joints.values() if joints is None else joints) if j.type != "gearbox"}
     done: dict = {}
 
     def pose(link, seen=()):
@@ -147,6 +150,20 @@ def _motion(j, v: float) -> np.ndarray:
     return M
 
 
+def _framed(model, done: dict) -> dict:
+    """Link poses ``done`` with the model's <frame>s added where their links are (model.sdf
+    writes a massless link fixed to another as a frame)."""
+    for name, (attached, T) in model.frames.items():
+        if attached in done and attached in model.links and name not in done:
+            done[name] = done[attached] @ np.linalg.inv(model.links[attached].T) @ T
+    return done
+
+
+def _massless_frame(name: str, original, rebuilt) -> bool:
+    """Whether the original's link ``name`` is massless and the rebuild has it as a <frame>."""
+    return name in original.links and original.links[name].mass == 0 and name in rebuilt.frames
+
+
 def _links(verdict, original, rebuilt, tree, repaired, po, pr, label: str) -> None:
     """Each original link against its rebuilt link with the point masses its joint's chain links
     took from it (robotkit.importer.sdf.tree.take_chain_masses), all in model axes."""
@@ -156,6 +173,9 @@ def _links(verdict, original, rebuilt, tree, repaired, po, pr, label: str) -> No
     for name, lo in original.links.items():
         lr = rebuilt.links.get(name)
         where = f"link '{name}' at {label}"
+        if lr is None and _massless_frame(name, original, rebuilt):
+            _check(verdict, "pose", float(np.abs(po[name] @ tree.offset(name, lo.T) - pr[name]).max()), where)
+            continue
         if lr is None:
             verdict.failures.append(f"link '{name}' missing in the rebuild")
             continue
