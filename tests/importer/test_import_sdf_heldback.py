@@ -389,3 +389,26 @@ def test_names_the_recipe_refuses_are_renamed_and_values_above_its_largest_writt
     joints = _joints(recipe)
     assert (joints["_1_hinge"]["parent"], joints["_1_hinge"]["dynamics"]) == ("base_link", {"damping": 1e12})
     assert (joints["tool_tip_frame"]["parent"], joints["tool_tip_frame"]["child"]) == ("arm", "tool_tip")
+
+
+def test_masses_beyond_the_recipes_range_written_at_its_bound_moments_scaled(tmp_path):
+    """libsdformat and Gazebo take a 1e7 kg block and a 1e-12 kg speck; the recipe refused them
+    (it takes 1e-9 to 1e6 kg).  Written at the bound, the moments scaled by the same factor (the
+    same radius of gyration), stated; the verification compares their poses only."""
+    result, recipe, sdf = _imported(tmp_path, """<sdf version="1.6"><model name="m">
+  <link name="block"><inertial><mass>1e7</mass><inertia><ixx>1e12</ixx><iyy>2e12</iyy><izz>3e12</izz></inertia>
+    </inertial></link>
+  <link name="speck"><pose>0 0 6 0 0 0</pose>
+    <inertial><mass>1e-12</mass><inertia><ixx>1e-15</ixx><iyy>1e-15</iyy><izz>1e-15</izz></inertia></inertial></link>
+  <joint name="j" type="revolute"><parent>block</parent><child>speck</child>
+    <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>
+</model></sdf>""")
+    assert result.verdict.ok and result.verdict.configurations == 11, result.verdict.lines()
+    assert result.ledger == [
+        f"{sdf}:2: link 'block' mass 1e+07 kg: all: approximated: written 1e+06 kg, the largest the recipe takes (its "
+        "moments scaled alike)",
+        f"{sdf}:4: link 'speck' mass 1e-12 kg: all: approximated: written 1e-09 kg, the least the recipe takes (its "
+        "moments scaled alike)"]
+    assert recipe["links"]["block"]["inertial"] == {"mass": 1e6, "inertia": {"ixx": 1e11, "iyy": 2e11, "izz": 3e11}}
+    speck = recipe["links"]["speck"]["inertial"]
+    assert speck["mass"] == 1e-9 and speck["inertia"]["ixx"] == pytest.approx(1e-12, rel=1e-12)

@@ -19,7 +19,7 @@ from robotkit.importer.names import material_name
 from robotkit.importer.sdf.frames import pose_of
 from robotkit.importer.sdf.model import children
 from robotkit.importer.sdf.tree import origin_of
-from robotkit.recipe.schema import MIN_LENGTH
+from robotkit.recipe.schema import MAX_MASS, MIN_LENGTH, MIN_MASS
 
 PRIMITIVES = ("box", "cylinder", "sphere")
 GAZEBO_COLOURS = {"Gazebo/White": "1 1 1", "Gazebo/Grey": "0.7 0.7 0.7", "Gazebo/DarkGrey": "0.175 0.175 0.175",
@@ -47,7 +47,7 @@ def add_shapes(src, m, tree, out: Path, ledger, materials: dict, repaired: dict)
         bare = [{k: v for k, v in s.items() if k != "material"} for s in visual]
         if collision != bare:
             entry["collision"] = (collision if len(collision) > 1 else collision[0]) if collision else "none"
-        _inertial(src, name, link, O, entry, collision, visual, ledger, repaired)
+        _inertial(src, name, link, O, entry, collision, visual, ledger, repaired, tree.scaled)
         given = link.el.find("inertial")
         if given is not None and given.find("inertia") is None and link.mass > 0 and name not in repaired:
             tree.link_notes[name] = ("the SDF gives its mass and no <inertia>: SDF's default moments, 1 kg m^2 "
@@ -169,7 +169,7 @@ def _material(src, el, materials: dict, ledger) -> str | None:
     return key
 
 
-def _inertial(src, name, link, O, entry: dict, collision, visual, ledger, repaired: dict) -> None:
+def _inertial(src, name, link, O, entry: dict, collision, visual, ledger, repaired: dict, scaled: set) -> None:
     R, com = O[:3, :3], O[:3, :3] @ link.com + O[:3, 3]
     I = R @ link.inertia @ R.T
     given = {"mass": link.mass, "com": [float(v) for v in com], "inertia": {
@@ -180,6 +180,14 @@ def _inertial(src, name, link, O, entry: dict, collision, visual, ledger, repair
     notes: dict[str, str] = {}
     if link.mass <= 0:
         return
+    bound = MIN_MASS if link.mass < MIN_MASS else MAX_MASS if link.mass > MAX_MASS else None
+    if bound is not None:  # libsdformat and Gazebo take any mass; the recipe takes 1e-9 to 1e6 kg
+        given["mass"], scale = bound, bound / link.mass
+        given["inertia"] = {k: v * scale for k, v in given["inertia"].items()}
+        scaled.add(name)
+        ledger.add(src.where("link", name), f"link '{name}' mass {link.mass:g} kg", "all", f"approximated: "
+                   f"written {bound:g} kg, the {'least' if bound == MIN_MASS else 'largest'} the recipe takes (its "
+                   "moments scaled alike)")
     spec = chosen_inertial(name, given, source, "recompute", notes)
     if spec is not None:
         entry["inertial"] = spec

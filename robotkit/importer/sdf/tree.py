@@ -47,6 +47,7 @@ class Tree:
     link_notes: dict = field(default_factory=dict)
     used: dict = field(default_factory=dict)  # SDF link -> the SDF joint (turned round or not) the tree hangs it by
     world_pose: bool = False  # the model's <pose> kept in its joints to the world
+    scaled: set = field(default_factory=set)  # links whose mass the recipe could not hold (on the ledger)
 
     def offset(self, link, T) -> np.ndarray:
         """The recipe frame of SDF link ``link`` in its own SDF frame ``T``."""
