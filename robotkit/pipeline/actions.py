@@ -28,7 +28,7 @@ from robotkit.ioutil import write_if_changed
 from robotkit.mesh.cache import Cache, Files, canonical_json, code_digest, library_versions, plain
 from robotkit.mesh.export import obj_bytes, stl_bytes
 from robotkit.mesh.inertia import hull_points, mesh_mass_properties
-from robotkit.mesh.io import load_mesh, read_vertices, volume_mesh
+from robotkit.mesh.io import load_mesh, read_vertices, remember_written_obj, volume_mesh
 from robotkit.model.robot import Inertial
 from robotkit.model.resolve import (compute_inertial, finalize, finalize_link_inertial, inertial_from_json,
                                     inertial_to_json)
@@ -105,7 +105,7 @@ def measured_mesh(source: str, scale, policy: str, name: str, where: dict) -> di
         "vertices": int(len(mesh.vertices)),
         "bbox_min": [float(v) for v in bbox_min],
         "bbox_max": [float(v) for v in bbox_max],
-        "hull": [[float(v) for v in p] for p in hull_points(mesh.vertices)],  # bounding primitives
+        "hull": np.asarray(hull_points(mesh.vertices), dtype=np.float64).tolist(),  # bounding primitives
         "volume": props.volume,
         "com": [float(v) for v in props.com],
         "inertia": [[float(v) for v in row] for row in np.asarray(props.inertia)],
@@ -246,7 +246,10 @@ def convert_mesh(source: str, target: str, scale=(1.0, 1.0, 1.0)):
     """A mesh in a format its consumers read (OBJ for collision, binary STL for MuJoCo's
     visuals), coordinates times ``scale``, byte-reproducible."""
     mesh = load_mesh(source, scale)
-    write_if_changed(target, obj_bytes(mesh) if target.lower().endswith(".obj") else stl_bytes(mesh))
+    obj = target.lower().endswith(".obj")
+    write_if_changed(target, obj_bytes(mesh) if obj else stl_bytes(mesh))
+    if obj:  # the MJCF's task reads its vertices back
+        remember_written_obj(target, mesh.vertices, mesh.faces)
 
 
 @_user_errors_fail
