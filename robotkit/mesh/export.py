@@ -54,10 +54,9 @@ def obj_bytes(mesh, name: str | None = None) -> bytes:
     """OBJ text of ``mesh`` as UTF-8 bytes (exact float64 coordinates)."""
     V = np.asarray(mesh.vertices, dtype=np.float64) + 0.0
     F = np.asarray(mesh.faces, dtype=np.int64) + 1
-    lines = ["# robotkit OBJ"]
-    if name:
-        lines.append(f"o {name}")
-    r = float.__repr__
-    lines += [f"v {r(x)} {r(y)} {r(z)}" for x, y, z in V.tolist()]
-    lines += [f"f {a} {b} {c}" for a, b, c in F.tolist()]
-    return ("\n".join(lines) + "\n").encode("utf-8")
+    head = "# robotkit OBJ\n" + (f"o {name}\n" if name else "")
+    # one %-format over every number (%r: float's repr, the shortest that reads back the same):
+    # half the time of a line at a time, the same text
+    v = ("v %r %r %r\n" * len(V)) % tuple(V.ravel().tolist())
+    f = ("f %d %d %d\n" * len(F)) % tuple(F.ravel().tolist())
+    return (head + v + f).encode("utf-8")

@@ -93,10 +93,29 @@ def _parsed(path: str, ext: str, fail) -> tuple[np.ndarray, np.ndarray]:
     parsed = np.array(loaded.vertices), np.array(loaded.faces)
     for a in parsed:
         a.flags.writeable = False
+    _keep(key, parsed)
+    return parsed
+
+
+def remember_written_obj(path: str, vertices: np.ndarray, faces: np.ndarray) -> None:
+    """Keep, as :func:`_parsed` would read it back, the OBJ file robotkit just wrote at ``path``
+    from ``vertices`` and ``faces`` (:func:`robotkit.mesh.export.obj_bytes` of a mesh
+    :func:`load_mesh` gave: its numbers exact, every vertex referenced, faces in order, no
+    texture: trimesh reads back the same arrays, -0.0 as 0.0 as written; tested), so that the
+    build's later readers of the file (an MJCF's lowest point) do not parse it again."""
+    stat = os.stat(path)
+    key = (os.path.realpath(path), stat.st_size, stat.st_mtime_ns, stat.st_ino)
+    parsed = np.asarray(vertices, dtype=np.float64) + 0.0, np.array(faces, dtype=np.int64)
+    for a in parsed:
+        a.flags.writeable = False
+    _keep(key, parsed)
+
+
+def _keep(key: tuple, parsed: tuple[np.ndarray, np.ndarray]) -> None:
     PARSED[key] = parsed
+    PARSED.move_to_end(key)
     while sum(v.nbytes + f.nbytes for v, f in PARSED.values()) > PARSED_BYTES and len(PARSED) > 1:
         PARSED.popitem(last=False)
-    return parsed
 
 
 def _dae_in_metres(path: str):

@@ -403,10 +403,15 @@ def _nested(V, F, labels, closed, vol) -> dict:
             pts = V[np.unique(fi)]
             if len(pts) > 16:
                 pts = pts[np.linspace(0, len(pts) - 1, 16).astype(int)]
-            w = _winding_numbers(pts, V[fj]) * np.sign(vol[bj])
-            if (w > 0.5).all():
-                nested[bi] = True
+            nested[bi] = _all_inside(pts, V[fj], np.sign(vol[bj]))
     return nested
+
+
+def _all_inside(points: np.ndarray, triangles: np.ndarray, sign: float) -> bool:
+    """Whether every point's winding number about ``triangles`` (times ``sign``) is above 1/2:
+    point by point, up to the first that is not (most candidate pairs fail at their first point;
+    each number is the one :func:`_winding_numbers` gives for all the points at once)."""
+    return all(_winding_numbers(points[k:k + 1], triangles)[0] * sign > 0.5 for k in range(len(points)))
 
 
 def _winding_numbers(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:

@@ -13,6 +13,7 @@ import filecmp
 import functools
 import hashlib
 import json
+import math
 import os
 import shutil
 from dataclasses import replace
@@ -28,7 +29,7 @@ from robotkit.ioutil import write_if_changed
 from robotkit.mesh.cache import Cache, Files, canonical_json, code_digest, library_versions, plain
 from robotkit.mesh.export import obj_bytes, stl_bytes
 from robotkit.mesh.inertia import hull_points, mesh_mass_properties
-from robotkit.mesh.io import load_mesh, read_vertices, volume_mesh
+from robotkit.mesh.io import load_mesh, read_vertices, remember_written_obj, volume_mesh
 from robotkit.model.robot import Inertial
 from robotkit.model.resolve import (compute_inertial, finalize, finalize_link_inertial, inertial_from_json,
                                     inertial_to_json)
@@ -57,7 +58,26 @@ def _user_errors_fail(fn):
 
 
 def dump_json(data) -> str:
-    return json.dumps(data, indent=1, sort_keys=True) + "\n"
+    """``json.dumps(data, indent=1, sort_keys=True)`` and a newline.  A top-level list of rows
+    of finite floats (a mesh's hull points) is written by one %-format, the same text: json's
+    indented encoder is pure Python, and such a list is most of a mesh record."""
+    rows = {k: v for k, v in data.items() if _float_rows(v)} if isinstance(data, dict) else {}
+    if not rows:
+        return json.dumps(data, indent=1, sort_keys=True) + "\n"
+    marks = {k: f"\0dump_json {k}\0" for k in rows}
+    text = json.dumps({k: marks.get(k, v) for k, v in data.items()}, indent=1, sort_keys=True)
+    for k, v in rows.items():
+        row = "  [\n" + ",\n".join(["   %r"] * len(v[0])) + "\n  ]"
+        text = text.replace(json.dumps(marks[k]), "[\n" + ",\n".join([row] * len(v)) % tuple(
+            x for r in v for x in r) + "\n ]", 1)
+    return text + "\n"
+
+
+def _float_rows(value) -> bool:
+    """Whether ``value`` is a non-empty list of equally long, non-empty lists of finite floats."""
+    return (isinstance(value, list) and len(value) > 0 and all(isinstance(r, list) for r in value)
+            and len(value[0]) > 0 and all(len(r) == len(value[0]) for r in value)
+            and all(type(x) is float and math.isfinite(x) for r in value for x in r))
 
 
 @_user_errors_fail
@@ -105,7 +125,7 @@ def measured_mesh(source: str, scale, policy: str, name: str, where: dict) -> di
         "vertices": int(len(mesh.vertices)),
         "bbox_min": [float(v) for v in bbox_min],
         "bbox_max": [float(v) for v in bbox_max],
-        "hull": [[float(v) for v in p] for p in hull_points(mesh.vertices)],  # bounding primitives
+        "hull": np.asarray(hull_points(mesh.vertices), dtype=np.float64).tolist(),  # bounding primitives
         "volume": props.volume,
         "com": [float(v) for v in props.com],
         "inertia": [[float(v) for v in row] for row in np.asarray(props.inertia)],
@@ -246,7 +266,10 @@ def convert_mesh(source: str, target: str, scale=(1.0, 1.0, 1.0)):
     """A mesh in a format its consumers read (OBJ for collision, binary STL for MuJoCo's
     visuals), coordinates times ``scale``, byte-reproducible."""
     mesh = load_mesh(source, scale)
-    write_if_changed(target, obj_bytes(mesh) if target.lower().endswith(".obj") else stl_bytes(mesh))
+    obj = target.lower().endswith(".obj")
+    write_if_changed(target, obj_bytes(mesh) if obj else stl_bytes(mesh))
+    if obj:  # the MJCF's task reads its vertices back
+        remember_written_obj(target, mesh.vertices, mesh.faces)
 
 
 @_user_errors_fail

@@ -140,6 +140,20 @@ def test_repair_keeps_a_cavity_inward():
     assert fixed.volume == pytest.approx(0.875, rel=1e-14)
 
 
+def test_repair_turns_outward_a_body_in_the_hole_of_a_ring_not_inside_it():
+    """A box in a torus's hole lies within the torus's bounds but outside it (the test stops at
+    its first point): not nested, so turned outward; one in the torus's tube is nested."""
+    ring = trimesh.creation.torus(major_radius=1.0, minor_radius=0.3, major_sections=48, minor_sections=24)
+    for centre, nested in (((0.0, 0.0, 0.0), 0), ((1.0, 0.0, 0.0), 1)):
+        box = trimesh.creation.box([0.1, 0.1, 0.1])
+        V = np.vstack([ring.vertices, np.asarray(box.vertices) + centre])
+        F = np.vstack([ring.faces, np.array(box.faces)[:, ::-1] + len(ring.vertices)])  # the box inward
+        fixed, report = repair(trimesh.Trimesh(V, F, process=False))
+        assert report["nested_bodies"] == nested and report["bodies_inverted"] == 1 - nested
+        # outside the ring the box adds its volume; in the tube it stays a cavity
+        assert fixed.volume == pytest.approx(ring.volume + (-0.001 if nested else 0.001), rel=1e-9)
+
+
 def test_repair_leaves_large_holes_open():
     box = trimesh.creation.box([1.0, 1.0, 1.0])
     open_box = trimesh.Trimesh(np.array(box.vertices), np.array(box.faces)[2:], process=False)  # a square hole
@@ -975,6 +989,17 @@ def test_obj_bytes_are_exact_and_reproducible():
     back = trimesh.load(io.BytesIO(data), file_type="obj", process=False)
     np.testing.assert_array_equal(back.vertices, mesh.vertices)
     np.testing.assert_array_equal(back.faces, mesh.faces)
+
+
+def test_obj_text_is_one_line_per_vertex_and_face_in_repr():
+    """obj_bytes formats every number at once; the text is the line-by-line one: ``v`` with each
+    coordinate's repr (-0.0 written 0.0), ``f`` with 1-based indices, a name line when named."""
+    V = np.array([[-0.0, 1e-05, 123456789.125], [0.1, -2.5e-300, 3.0], [1 / 3, 0.0, -7.0]])
+    mesh = trimesh.Trimesh(V, [[0, 1, 2], [2, 1, 0]], process=False)
+    lines = ["# robotkit OBJ", "o part"] + [f"v {x!r} {y!r} {z!r}" for x, y, z in (V + 0.0).tolist()]
+    assert obj_bytes(mesh, "part") == ("\n".join(lines + ["f 1 2 3", "f 3 2 1"]) + "\n").encode()
+    assert obj_bytes(mesh).startswith(b"# robotkit OBJ\nv 0.0 1e-05 123456789.125\n")
+    assert obj_bytes(trimesh.Trimesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=int), process=False)) == b"# robotkit OBJ\n"
 
 
 def test_canonical_order_ignores_the_input_order():

@@ -206,3 +206,15 @@ def test_every_registered_format_renders_below_the_robot_folder(name, finalized,
     assert path.is_relative_to(root) and ".." not in path.relative_to(root).parts
     for template in fmt.templates:
         assert any((Path(d) / template).is_file() for d in template_dirs()), template
+
+
+def test_dump_json_writes_float_rows_as_json_does():
+    """dump_json formats a record's rows of floats (hull points) itself: the text json.dumps gives,
+    for rows with -0.0, tiny and huge numbers, and for what it leaves to json (ints, bools, NaN,
+    rows of unequal length, empty lists, a list at the top)."""
+    hull = [[0.1 * i, -0.0, 1e-300 * i, 1e22 + i] for i in range(50)]
+    cases = [{"version": 4, "hull": hull, "inertia": [[1.0, 0.0, 0.0]] * 3, "source": "a \"b\" é", "faces": 12},
+             {"a": [[1.0, 2]], "b": [[1.0], [2.0, 3.0]], "c": [[float("nan")]], "d": [[True]], "e": [], "f": [[]]},
+             [[1.0, 2.0]], {}]
+    for data in cases:
+        assert actions.dump_json(data) == json.dumps(data, indent=1, sort_keys=True) + "\n"
