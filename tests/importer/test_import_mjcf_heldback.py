@@ -388,3 +388,30 @@ def test_mimic_of_a_mimic_is_kept_and_stated_for_urdf_and_sdf(tmp_path):
         "telescope.xml:17: equality joint #0: urdf, sdf: joint 'j1' mimics 'j2', itself a mimic of 'j3': Drake and "
         "Gazebo do not follow a chain of mimic joints"]
     assert result.verdict.ok, result.verdict.lines()
+
+
+UNSTABLE = """<mujoco model="twitchy">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="finger">
+      <joint name="j" axis="0 1 0" range="-1 1"/>
+      <geom type="capsule" fromto="0 0 0 0.05 0 0" size="0.005" mass="0.001"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <position name="j" joint="j" kp="1" kv="10" ctrlrange="-1 1"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_rollout_stops_where_the_original_turns_unstable(tmp_path):
+    """Boston Dynamics Spot's arm, driven by the rollout's random controls in free fall, makes the
+    original itself unstable (MuJoCo resets it, and what follows compared a restart with a rebuild
+    that had not: 'disagreed' by 6 cm): the rollout compares until then and the verdict says so.
+    Here a servo's damping far beyond what Euler integrates (kv dt / I = 2e4) on a gram's finger."""
+    (tmp_path / "twitchy.xml").write_text(UNSTABLE)
+    result = import_mjcf(tmp_path / "twitchy.xml", tmp_path / "out" / "twitchy.yaml", build=build_mjcf)
+    assert result.verdict.ok, result.verdict.lines()
+    assert result.verdict.notes == ["rollout from the zero configuration: the original turns unstable at 0.004 s under "
+                                    "this control sequence (MuJoCo resets it): compared until the hold before"]
