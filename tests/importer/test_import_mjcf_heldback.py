@@ -415,3 +415,29 @@ def test_rollout_stops_where_the_original_turns_unstable(tmp_path):
     assert result.verdict.ok, result.verdict.lines()
     assert result.verdict.notes == ["rollout from the zero configuration: the original turns unstable at 0.004 s under "
                                     "this control sequence (MuJoCo resets it): compared until the hold before"]
+
+
+BEYOND = """<mujoco model="arm">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="upper">
+      <joint name="shoulder" axis="0 1 0" range="-1.5 1.5"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02" mass="1"/>
+    </body>
+  </worldbody>
+  <keyframe>
+    <key name="home" qpos="1.5708"/>
+  </keyframe>
+</mujoco>
+"""
+
+
+def test_keyframe_beyond_its_joint_range_is_written_at_the_limit(tmp_path):
+    """MuJoCo takes a keyframe outside a joint's range (a Menagerie 'home' a rounding past its
+    limit); a recipe's pose lies within the limits: the nearest limit, on the ledger (it was a
+    refusal: 'poses.home.shoulder: 1.5708 is outside the limits')."""
+    (tmp_path / "arm.xml").write_text(BEYOND)
+    result = import_mjcf(tmp_path / "arm.xml", tmp_path / "out" / "arm.yaml")
+    assert yaml.safe_load(result.recipe_path.read_text())["poses"] == {"home": {"shoulder": 1.5}}
+    assert result.ledger[1:] == ["arm.xml:10: keyframe 'home': all: joint 'shoulder' at 1.5708, outside its range "
+                                 "[-1.5, 1.5]: written as 1.5"]
