@@ -4,13 +4,16 @@ with its known answer (ledger lines word for word)."""
 
 from __future__ import annotations
 
+import pytest
 import yaml
 
 from robotkit.commands.import_ import build_mjcf
+from robotkit.errors import RobotkitError
 from robotkit.importer import import_mjcf
 from robotkit.importer.mjcf import convert
 
 INCLUDED_MAIN = """<mujoco model="two">
+  <compiler angle="radian"/>
   <worldbody>
     <body name="a">
       <geom size="0.1"/>
@@ -41,9 +44,8 @@ def test_ledger_names_the_included_file_and_line(tmp_path):
     (tmp_path / "parts" / "acts.xml").write_text(INCLUDED_ACTS)
     recipe, ledger, src, _ = convert(tmp_path / "main.xml", tmp_path / "out" / "two.yaml")
     assert ledger.lines()[1:] == [
-        "parts/acts.xml:3: actuator 'grip': all: ctrlrange [-0.5, 0.5] written as the joint's range "
-        "[-0.0174533, 0.0174533]",
-        "main.xml:6: site 'grip': mjcf: a frame link (in the rebuilt MJCF a body without mass holding a site of its "
+        "parts/acts.xml:3: actuator 'grip': all: ctrlrange [-0.5, 0.5] written as the joint's range [-1, 1]",
+        "main.xml:7: site 'grip': mjcf: a frame link (in the rebuilt MJCF a body without mass holding a site of its "
         "name): its sphere of size 0.005 is not drawn",
         "parts/acts.xml:6: keyframe 'home': all: ctrl dropped (the MJCF keyframe's ctrl is the pose's position "
         "targets)",
@@ -441,3 +443,23 @@ def test_keyframe_beyond_its_joint_range_is_written_at_the_limit(tmp_path):
     assert yaml.safe_load(result.recipe_path.read_text())["poses"] == {"home": {"shoulder": 1.5}}
     assert result.ledger[1:] == ["arm.xml:10: keyframe 'home': all: joint 'shoulder' at 1.5708, outside its range "
                                  "[-1.5, 1.5]: written as 1.5"]
+
+
+def test_include_outside_the_project_is_refused_at_its_line(tmp_path, monkeypatch):
+    """The read rules of the URDF import (its xacro includes'): an ``<include>`` outside the
+    input's project and the roots widened on purpose is one line at the include, exit 2, that
+    file not read and nothing written (MuJoCo read it); ROBOTKIT_ROOT widens them."""
+    monkeypatch.delenv("ROBOTKIT_ROOT", raising=False)  # conftest widens the read rules
+    (tmp_path / "project").mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "project" / "main.xml").write_text(INCLUDED_MAIN.replace("parts/acts.xml", "../elsewhere/acts.xml"))
+    (tmp_path / "elsewhere" / "acts.xml").write_text(INCLUDED_ACTS)
+    with pytest.raises(RobotkitError) as exc:
+        import_mjcf(tmp_path / "project" / "main.xml", tmp_path / "project" / "out" / "two.yaml")
+    assert [str(p) for p in exc.value.problems] == [
+        f"{tmp_path}/project/main.xml:10: {tmp_path}/elsewhere/acts.xml is outside the project {tmp_path}/project/: "
+        "robotkit reads only the project and declared package paths (widen on purpose with --root DIR or "
+        "ROBOTKIT_ROOT)"]
+    assert not (tmp_path / "project" / "out").exists()
+    monkeypatch.setenv("ROBOTKIT_ROOT", str(tmp_path / "elsewhere"))
+    assert import_mjcf(tmp_path / "project" / "main.xml", tmp_path / "project" / "out" / "two.yaml").ledger
