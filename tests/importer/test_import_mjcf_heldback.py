@@ -4,13 +4,16 @@ with its known answer (ledger lines word for word)."""
 
 from __future__ import annotations
 
+import pytest
 import yaml
 
 from robotkit.commands.import_ import build_mjcf
+from robotkit.errors import RobotkitError
 from robotkit.importer import import_mjcf
 from robotkit.importer.mjcf import convert
 
 INCLUDED_MAIN = """<mujoco model="two">
+  <compiler angle="radian"/>
   <worldbody>
     <body name="a">
       <geom size="0.1"/>
@@ -41,9 +44,8 @@ def test_ledger_names_the_included_file_and_line(tmp_path):
     (tmp_path / "parts" / "acts.xml").write_text(INCLUDED_ACTS)
     recipe, ledger, src, _ = convert(tmp_path / "main.xml", tmp_path / "out" / "two.yaml")
     assert ledger.lines()[1:] == [
-        "parts/acts.xml:3: actuator 'grip': all: ctrlrange [-0.5, 0.5] written as the joint's range "
-        "[-0.0174533, 0.0174533]",
-        "main.xml:6: site 'grip': mjcf: a frame link (in the rebuilt MJCF a body without mass holding a site of its "
+        "parts/acts.xml:3: actuator 'grip': all: ctrlrange [-0.5, 0.5] written as the joint's range [-1, 1]",
+        "main.xml:7: site 'grip': mjcf: a frame link (in the rebuilt MJCF a body without mass holding a site of its "
         "name): its sphere of size 0.005 is not drawn",
         "parts/acts.xml:6: keyframe 'home': all: ctrl dropped (the MJCF keyframe's ctrl is the pose's position "
         "targets)",
@@ -388,3 +390,76 @@ def test_mimic_of_a_mimic_is_kept_and_stated_for_urdf_and_sdf(tmp_path):
         "telescope.xml:17: equality joint #0: urdf, sdf: joint 'j1' mimics 'j2', itself a mimic of 'j3': Drake and "
         "Gazebo do not follow a chain of mimic joints"]
     assert result.verdict.ok, result.verdict.lines()
+
+
+UNSTABLE = """<mujoco model="twitchy">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="finger">
+      <joint name="j" axis="0 1 0" range="-1 1"/>
+      <geom type="capsule" fromto="0 0 0 0.05 0 0" size="0.005" mass="0.001"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <position name="j" joint="j" kp="1" kv="10" ctrlrange="-1 1"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def test_rollout_stops_where_the_original_turns_unstable(tmp_path):
+    """Boston Dynamics Spot's arm, driven by the rollout's random controls in free fall, makes the
+    original itself unstable (MuJoCo resets it, and what follows compared a restart with a rebuild
+    that had not: 'disagreed' by 6 cm): the rollout compares until then and the verdict says so.
+    Here a servo's damping far beyond what Euler integrates (kv dt / I = 2e4) on a gram's finger."""
+    (tmp_path / "twitchy.xml").write_text(UNSTABLE)
+    result = import_mjcf(tmp_path / "twitchy.xml", tmp_path / "out" / "twitchy.yaml", build=build_mjcf)
+    assert result.verdict.ok, result.verdict.lines()
+    assert result.verdict.notes == ["rollout from the zero configuration: the original turns unstable at 0.004 s under "
+                                    "this control sequence (MuJoCo resets it): compared until the hold before"]
+
+
+BEYOND = """<mujoco model="arm">
+  <compiler angle="radian"/>
+  <worldbody>
+    <body name="upper">
+      <joint name="shoulder" axis="0 1 0" range="-1.5 1.5"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02" mass="1"/>
+    </body>
+  </worldbody>
+  <keyframe>
+    <key name="home" qpos="1.5708"/>
+  </keyframe>
+</mujoco>
+"""
+
+
+def test_keyframe_beyond_its_joint_range_is_written_at_the_limit(tmp_path):
+    """MuJoCo takes a keyframe outside a joint's range (a Menagerie 'home' a rounding past its
+    limit); a recipe's pose lies within the limits: the nearest limit, on the ledger (it was a
+    refusal: 'poses.home.shoulder: 1.5708 is outside the limits')."""
+    (tmp_path / "arm.xml").write_text(BEYOND)
+    result = import_mjcf(tmp_path / "arm.xml", tmp_path / "out" / "arm.yaml")
+    assert yaml.safe_load(result.recipe_path.read_text())["poses"] == {"home": {"shoulder": 1.5}}
+    assert result.ledger[1:] == ["arm.xml:10: keyframe 'home': all: joint 'shoulder' at 1.5708, outside its range "
+                                 "[-1.5, 1.5]: written as 1.5"]
+
+
+def test_include_outside_the_project_is_refused_at_its_line(tmp_path, monkeypatch):
+    """The read rules of the URDF import (its xacro includes'): an ``<include>`` outside the
+    input's project and the roots widened on purpose is one line at the include, exit 2, that
+    file not read and nothing written (MuJoCo read it); ROBOTKIT_ROOT widens them."""
+    monkeypatch.delenv("ROBOTKIT_ROOT", raising=False)  # conftest widens the read rules
+    (tmp_path / "project").mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "project" / "main.xml").write_text(INCLUDED_MAIN.replace("parts/acts.xml", "../elsewhere/acts.xml"))
+    (tmp_path / "elsewhere" / "acts.xml").write_text(INCLUDED_ACTS)
+    with pytest.raises(RobotkitError) as exc:
+        import_mjcf(tmp_path / "project" / "main.xml", tmp_path / "project" / "out" / "two.yaml")
+    assert [str(p) for p in exc.value.problems] == [
+        f"{tmp_path}/project/main.xml:10: {tmp_path}/elsewhere/acts.xml is outside the project {tmp_path}/project/: "
+        "robotkit reads only the project and declared package paths (widen on purpose with --root DIR or "
+        "ROBOTKIT_ROOT)"]
+    assert not (tmp_path / "project" / "out").exists()
+    monkeypatch.setenv("ROBOTKIT_ROOT", str(tmp_path / "elsewhere"))
+    assert import_mjcf(tmp_path / "project" / "main.xml", tmp_path / "project" / "out" / "two.yaml").ledger

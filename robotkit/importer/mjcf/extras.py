@@ -44,6 +44,7 @@ def add_poses(src, tree, recipe: dict, ledger) -> None:
         where = src.where(keys[k]) if k < len(keys) else src.where()
         values = joint_values(m, tree, m.key_qpos[k])
         _mimics_followed(tree, values, where, name, ledger)
+        _within_limits(tree, values, where, name, ledger)
         poses[name] = {j: v for j, v in values.items() if v != 0}
         if any(int(m.jnt_type[j]) == FREE for j in range(m.njnt)):
             ledger.add(where, f"keyframe '{name}'", "all", "the free joint's position and orientation dropped "
@@ -68,6 +69,20 @@ def _mimics_followed(tree, values: dict, where: str, pose: str, ledger) -> None:
         if abs(given - follows) > 1e-9:
             ledger.add(where, f"keyframe '{pose}'", "all", f"joint '{name}' at {given:g}, written as its mimic's "
                        f"{follows:g}")
+
+
+def _within_limits(tree, values: dict, where: str, pose: str, ledger) -> None:
+    """A value outside its joint's range (MuJoCo takes a keyframe there; a recipe's pose lies
+    within the limits): the nearest limit, on the ledger."""
+    for name, value in values.items():
+        limit = tree.joints[name].get("limit") if name in tree.joints else None
+        if not limit or "lower" not in limit or "upper" not in limit:
+            continue
+        inside = min(max(value, float(limit["lower"])), float(limit["upper"]))
+        if inside != value:
+            values[name] = inside
+            ledger.add(where, f"keyframe '{pose}'", "all", f"joint '{name}' at {value:g}, outside its range "
+                       f"[{float(limit['lower']):g}, {float(limit['upper']):g}]: written as {inside:g}")
 
 
 def _ctrl_is_targets(m, tree, recipe: dict, k: int) -> bool:

@@ -34,7 +34,7 @@ FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 
 
 def rollouts(mujoco, om, rm, tree, kept: dict[int, int], equalities: set[int]):
-    """(label, largest frame difference over the rollout, where) for each start."""
+    """(label, largest frame difference over the rollout, where, a note or '') for each start."""
     om, rm = _neutralised(mujoco, om, rm, tree, kept, equalities)
     starts = [(f"keyframe '{om.key(k).name or k}'", np.array(om.key_qpos[k]), np.array(om.key_qvel[k]))
               for k in range(om.nkey)] or [("the zero configuration", np.array(om.qpos0), np.zeros(om.nv))]
@@ -101,7 +101,9 @@ def _controls(om, rm, kept: dict[int, int], rng) -> list[tuple[np.ndarray, np.nd
     return out
 
 
-def _run(mujoco, om, rm, tree, q, v, controls) -> tuple[float, str]:
+def _run(mujoco, om, rm, tree, q, v, controls) -> tuple[float, str, str]:
+    """(largest frame difference, where, a note): compared until the original turns unstable, if
+    it does (MuJoCo resets it: what follows compares a restart; the note says when)."""
     od, rd = mujoco.MjData(om), mujoco.MjData(rm)
     od.qpos[:], od.qvel[:] = q, v
     rd.qpos[:] = mapped(om, rm, tree, q)
@@ -110,15 +112,20 @@ def _run(mujoco, om, rm, tree, q, v, controls) -> tuple[float, str]:
     mujoco.mj_forward(rm, rd)
     bodies = [(b, rm.body(tree.link_of[b]).id, tree.offset[b]) for b in range(1, om.nbody)]
     steps = max(1, int(round(HOLD / om.opt.timestep)))
+    unstable = int(mujoco.mjtWarning.mjWARN_BADQACC)
     worst, where = 0.0, ""
     for k, (uo, ur) in enumerate(controls):
         od.ctrl[:], rd.ctrl[:] = uo, ur
-        for _ in range(steps):
+        for i in range(steps):
             mujoco.mj_step(om, od)
+            if od.warning[unstable].number:
+                t = (k * steps + i) * om.opt.timestep  # as MuJoCo reports it
+                return worst, where, (f"the original turns unstable at {t:.3f} s under this control sequence "
+                                      "(MuJoCo resets it): compared until the hold before")
             mujoco.mj_step(rm, rd)
         for b, r, offset in bodies:
             frame = od.xpos[b] + od.xmat[b].reshape(3, 3) @ offset
             err = max(np.abs(frame - rd.xpos[r]).max(), np.abs(od.xmat[b] - rd.xmat[r]).max())
             if err > worst:
                 worst, where = float(err), f"body '{tree.link_of[b]}' at {(k + 1) * steps * om.opt.timestep:.2f} s"
-    return worst, where
+    return worst, where, ""

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from robotkit import mj, urdfxml
 from robotkit.errors import Problem, RobotkitError
+from robotkit.paths import ReadPolicy
 
 _LINE = re.compile(r"line (\d+)")
 _TINYXML_LINE = re.compile(r"Line number=(\d+)")
@@ -66,23 +67,8 @@ class Source:
         return [self.path.parent / label for label, _ in self._texts()[1:]]
 
     def _texts(self) -> list:
-        """(label, parsed root) of the main file, then of each file it includes (a label relative
-        to the main file's folder, where MuJoCo looks for it), each once; an unreadable one skipped."""
-        texts: list = []
-        pending, seen = [self.path.resolve()], set()
-        while pending:
-            path = pending.pop(0)
-            if path in seen:
-                continue
-            seen.add(path)
-            try:
-                root = urdfxml.parse_text(path.read_text(encoding="utf-8")).getroot()
-            except (OSError, UnicodeDecodeError, urdfxml.MalformedXML):
-                continue
-            texts.append((self.path.name if path == self.path.resolve() else
-                          Path(os.path.relpath(path, self.path.parent)).as_posix(), root))
-            pending += [(self.path.parent / e.get("file")).resolve() for e in root.iter("include") if e.get("file")]
-        return texts
+        """(label, parsed root) of the main file, then of each file it includes (:func:`included`)."""
+        return included(self.path)[0]
 
     def where(self, element=None) -> str:
         """``file:line`` of an element (the file alone when its line is unknown)."""
@@ -129,6 +115,37 @@ class Source:
         return np.array(mesh.refpos, float), quat_matrix(mesh.refquat)
 
 
+def included(path: Path, policy=None) -> tuple[list, list[Problem]]:
+    """(label, parsed root) of the file ``path``, then of each file it ``<include>``s (and those
+    they include: a label relative to its folder, where MuJoCo looks for each), each once, an
+    unreadable one skipped; and with a read ``policy`` (robotkit.paths.ReadPolicy), a problem for
+    each include outside it, at its line, that file not read."""
+    texts: list = []
+    problems: list[Problem] = []
+    main = path.resolve()
+    pending, seen = [main], set()
+    while pending:
+        target = pending.pop(0)
+        if target in seen:
+            continue
+        seen.add(target)
+        try:
+            root = urdfxml.parse_text(target.read_text(encoding="utf-8")).getroot()
+        except (OSError, UnicodeDecodeError, urdfxml.MalformedXML):
+            continue
+        texts.append((path.name if target == main else Path(os.path.relpath(target, main.parent)).as_posix(), root))
+        for e in root.iter("include"):
+            if not e.get("file"):
+                continue
+            file = (main.parent / e.get("file")).resolve()
+            problem = policy.problem(file, file=str(target), line=e.sourceline) if policy is not None else None
+            if problem is not None:
+                problems.append(problem)
+            else:
+                pending.append(file)
+    return texts, problems
+
+
 def refused(path: Path, message: str) -> RobotkitError:
     """MuJoCo's refusal as one line: its first line (with tinyxml2's detail when that line is only a
     heading), at the line it names."""
@@ -147,6 +164,9 @@ def read(path: str | os.PathLike) -> Source:
     source = Path(path).absolute()
     if not source.is_file():
         raise RobotkitError(Problem("file not found", file=str(source)))
+    outside = included(source, ReadPolicy.for_file(source))[1]
+    if outside:  # the read rules of the URDF import's (its xacro includes'): nothing read there
+        raise RobotkitError(outside)
     mujoco = mj.load()
     try:
         spec = mujoco.MjSpec.from_file(str(source))

@@ -97,8 +97,10 @@ def verify(src, tree, rebuilt_path) -> Verdict:
         verdict.notes.append(f"no rollout: ball joint '{balls[0]}' is three revolute joints through chain links "
                              "in the rebuild (approximated, on the ledger), whose motion parts from the ball's")
         return verdict
-    for label, err, where in rollouts(mujoco, om, rm, tree, kept, equalities):
+    for label, err, where, note in rollouts(mujoco, om, rm, tree, kept, equalities):
         _check(verdict, "rollout", err, f"{label}: {where}" if where else label)
+        if note:  # the original's own instability (Spot's arm under random controls, in free fall)
+            verdict.notes.append(f"{label}: {note}")
     verdict.rollouts = max(om.nkey, 1)
     return verdict
 
