@@ -146,6 +146,9 @@ def from_mujoco(model, source: str) -> KModel:
     links: dict[str, KLink] = {}
     joints: dict[str, KJoint] = {}
     names = {b: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(model.nbody)}
+    # the first body is the root, at the origin; where several bodies are welded to the world
+    # (two arms on one table: ALOHA), each sits where it is in the world
+    welded = [b for b in range(1, model.nbody) if model.body_parentid[b] == 0 and not model.body_jntnum[b]]
     for b in range(1, model.nbody):
         name = names[b]
         R = _quat_R(model.body_iquat[b])
@@ -155,7 +158,7 @@ def from_mujoco(model, source: str) -> KModel:
         T_pb = _T(model.body_pos[b], _quat_R(model.body_quat[b]))
         jids = [j for j in range(model.njnt) if model.jnt_bodyid[j] == b]
         if not jids:
-            if parent != WORLD or b != 1:
+            if parent != WORLD or b != 1 or len(welded) > 1:
                 joints[f"(fixed {name})"] = KJoint(f"(fixed {name})", "fixed", parent, name, T_pb, np.eye(4),
                                                    np.array([1.0, 0, 0]))
             continue
@@ -269,12 +272,20 @@ def read_sdf_text(text: str, source: str, leave_out: tuple[set[str], set[str]] =
         joint = _sdf_frame_joint(f, world)
         if joint is not None:
             joints[joint.name] = joint
+    welded = []  # fixed joints to the world: the model's placement, unless there are several
     for name, j in joint_els.items():
         if name in leave_out[1]:
             continue
         joint = _sdf_joint(name, j, world)
         if joint is not None:
             joints[name] = joint
+        elif j.find("child").text.strip() in links:
+            welded.append(name)
+    if len(welded) > 1:  # two arms on one table (ALOHA): each where it stands in the world
+        for name in welded:
+            X_j, child = world(name), joint_els[name].find("child").text.strip()
+            joints[name] = KJoint(name, "fixed", WORLD, child, X_j, np.linalg.inv(X_j) @ world(child),
+                                  np.array([1.0, 0, 0]))
     return KModel(source, links, joints)
 
 
@@ -391,17 +402,23 @@ def read_urdf_via_libsdformat(path) -> KModel:
     return read_sdf_text(proc.stdout, f"URDF {path} (libsdformat)", extension_parts(path))
 
 
-def lump(model: KModel, kept: frozenset[str] = frozenset()) -> KModel:
+def lump(model: KModel, kept: frozenset[str] = frozenset(), world: bool = False) -> KModel:
     """``model`` as libsdformat's URDF conversion (Gazebo's spawn path) sees it: every link
     joined to its parent by a fixed joint merged into that parent (masses added, centres of
     mass combined, inertias moved by the parallel-axis theorem), the joints below re-attached;
-    but the fixed joints ``kept`` (the URDF's ``<preserveFixedJoint>``: ``model.kept``)."""
+    but the fixed joints ``kept`` (the URDF's ``<preserveFixedJoint>``: ``model.kept``).  With
+    ``world`` (Pinocchio), the links welded to the world are one body too, named after the first."""
     parent_of = model.parent_of()
+    to_world = [n for n in model.links if n in parent_of and parent_of[n].type == "fixed"
+                and parent_of[n].parent == WORLD and parent_of[n].name not in kept] if world else []
+    X = {n: parent_of[n].T_pj @ parent_of[n].T_jc for n in to_world}
 
     def carrier(name: str) -> tuple[str, np.ndarray]:
         T = np.eye(4)
         while True:
             j = parent_of.get(name)
+            if name in X and name != to_world[0]:  # welded to the world: into the first welded link
+                return to_world[0], np.linalg.inv(X[to_world[0]]) @ X[name] @ T
             if j is None or j.type != "fixed" or j.parent == WORLD or j.parent not in model.links or \
                     j.name in kept:
                 return name, T
@@ -427,6 +444,8 @@ def lump(model: KModel, kept: frozenset[str] = frozenset()) -> KModel:
     joints = {}
     for name, j in model.joints.items():
         if j.type == "fixed" and j.parent != WORLD and j.parent in model.links and name not in kept:
+            continue
+        if j.child in X and j.child != to_world[0]:  # merged into the first welded link
             continue
         top, T = carrier(j.parent) if j.parent in model.links else (j.parent, np.eye(4))
         joints[name] = KJoint(**{**j.__dict__, "parent": top, "T_pj": T @ j.T_pj})

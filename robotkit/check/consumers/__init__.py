@@ -69,6 +69,7 @@ class View:
     masses: dict[str, float]  # link (as the program splits the robot) -> kg
     poses: Callable[[dict[str, float]], dict[str, np.ndarray]] | None = None  # joint values -> link frames
     lumped: bool = False  # the program merges links joined by fixed joints
+    lumps_world: bool = False  # ... and the links welded to the world into one body (Pinocchio's universe)
     kept: frozenset[str] = frozenset()  # but these fixed joints (the URDF's <preserveFixedJoint>)
     pose_tol: float = REL_TOL  # relative: what the program's arithmetic can hold
     notes: list[str] = field(default_factory=list)
@@ -152,7 +153,7 @@ def configurations(reference, count: int, seed: int = 0) -> list[dict[str, float
 
 def compare(reference, view: View, configs: list[dict[str, float]], tol: float = REL_TOL) -> list[str]:
     """Differences between the description (``reference``, a KModel) and a program's view."""
-    ref = lump(reference, view.kept) if view.lumped else reference
+    ref = lump(reference, view.kept, view.lumps_world) if view.lumped else reference
     expected = {n: real_mass(link.mass) for n, link in ref.links.items() if n != "world"}
     total = sum(expected.values())
     scale = max(total, 1e-12)

@@ -58,4 +58,4 @@ def from_urdf(build) -> View:
         pin.framesForwardKinematics(model, data, qv)
         return {f.name: data.oMf[i].homogeneous.copy() for i, f in bodies}
 
-    return View(masses, poses, lumped=True)
+    return View(masses, poses, lumped=True, lumps_world=True)
