@@ -477,12 +477,33 @@ def turn(A: np.ndarray, B: np.ndarray) -> float:
     return math.acos(max(-1.0, min(1.0, float(cos))))
 
 
+def followed_mimics(model: KModel) -> KModel:
+    """``model`` with each mimic joint against the joint its chain starts from (a mimic of a
+    mimic composed: robotkit's URDF writes them so, an MJCF keeps the chain of equalities)."""
+    chained = [j for j in model.joints.values() if j.mimic and j.mimic[0] in model.joints
+               and model.joints[j.mimic[0]].mimic]
+    if not chained:
+        return model
+    model = copy.deepcopy(model)
+    for j in model.joints.values():
+        if not j.mimic:
+            continue
+        (leader, multiplier, offset), seen = j.mimic, {j.name}
+        while leader in model.joints and model.joints[leader].mimic and leader not in seen:
+            seen.add(leader)
+            up = model.joints[leader].mimic
+            leader, multiplier, offset = up[0], multiplier * up[1], multiplier * up[2] + offset
+        j.mimic = (leader, multiplier, offset)
+    return model
+
+
 def compare(a: KModel, b: KModel, tol: float = 1e-9, configs: int = 100, seed: int = 0,
             ignore: tuple[str, ...] = (), pose_tol: float | None = None) -> list[str]:
     """Every difference between two readings of a robot, as sentences; [] when equivalent.
 
     ``ignore`` names joint attributes one side cannot hold (e.g. "velocity" for MJCF);
     ``pose_tol`` is what the readers can hold of a link's pose (default ``tol``)."""
+    a, b = followed_mimics(a), followed_mimics(b)
     diffs: list[str] = []
     la = {n for n in a.links if n != WORLD}
     lb = {n for n in b.links if n != WORLD}

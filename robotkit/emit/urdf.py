@@ -10,7 +10,7 @@ from robotkit.emit.formats import Format
 from robotkit.emit.gazebo import kept_fixed_joints
 from robotkit.emit.meshfiles import collision_file
 from robotkit.emit.sensors import contexts
-from robotkit.model.robot import Geom, Robot, Shape
+from robotkit.model.robot import Geom, Mimic, Robot, Shape
 
 
 MASSLESS = 1e-300
@@ -113,7 +113,25 @@ def context(robot: Robot) -> dict:
         "materials": [materials[name] for name in used],
         "links": links,
         "joints": robot.joints,
+        "mimics": followed_mimics(robot),
     }
+
+
+def followed_mimics(robot: Robot) -> dict[str, Mimic]:
+    """Each mimic joint's line to the joint its chain starts from: a mimic of a mimic (a telescoping
+    arm's segments) composed, since URDF readers (Drake's, libsdformat's, Pinocchio's) follow one
+    mimic, not a chain.  The recipe and the MJCF keep the chain."""
+    by_name, out = {j.name: j for j in robot.joints}, {}
+    for j in robot.joints:
+        if j.mimic is None:
+            continue
+        leader, multiplier, offset, seen = j.mimic.joint, j.mimic.multiplier, j.mimic.offset, {j.name}
+        while by_name[leader].mimic is not None and leader not in seen:
+            seen.add(leader)
+            up = by_name[leader].mimic
+            leader, multiplier, offset = up.joint, multiplier * up.multiplier, multiplier * up.offset + offset
+        out[j.name] = Mimic(leader, multiplier, offset)
+    return out
 
 
 def actuator_contexts(robot: Robot) -> list[dict]:

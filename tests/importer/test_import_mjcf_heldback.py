@@ -4,6 +4,8 @@ with its known answer (ledger lines word for word)."""
 
 from __future__ import annotations
 
+import shutil
+
 import pytest
 import yaml
 
@@ -377,19 +379,31 @@ TELESCOPE = """<mujoco model="telescope">
 """
 
 
-def test_mimic_of_a_mimic_is_kept_and_stated_for_urdf_and_sdf(tmp_path):
+def test_mimic_of_a_mimic_is_kept_and_the_urdf_follows_the_chain(tmp_path):
     """Stretch's telescoping arm: each segment follows the next (joint equalities in a chain), so
-    a mimic joint's leader is itself a mimic; the MJCF keeps the chain (the rebuild agrees in
-    MuJoCo) and the ledger says Drake and Gazebo do not follow it (their URDF and SDF readers
-    left the segments behind in robotkit check's consumers, unsaid)."""
+    a mimic joint's leader is itself a mimic; the recipe and the MJCF keep the chain (the rebuild
+    agrees in MuJoCo), the URDF composes it (its readers, Drake's and libsdformat's, follow one
+    mimic, not a chain): every segment where the chain puts it in every program."""
+    from robotkit.check.consumers import Build, consumer_findings
+
     (tmp_path / "telescope.xml").write_text(TELESCOPE)
-    result = import_mjcf(tmp_path / "telescope.xml", tmp_path / "out" / "telescope.yaml", build=build_mjcf)
+    folder = tmp_path / "rebuilt"
+
+    def build(recipe, out):
+        built = build_mjcf(recipe, out)
+        shutil.copytree(built.parent.parent, folder)
+        return built
+
+    result = import_mjcf(tmp_path / "telescope.xml", tmp_path / "out" / "telescope.yaml", build=build)
     recipe = yaml.safe_load(result.recipe_path.read_text())
     assert (recipe["joints"]["j1"]["mimic"], recipe["joints"]["j2"]["mimic"]) == ({"joint": "j2"}, {"joint": "j3"})
-    assert result.ledger[1:] == [
-        "telescope.xml:17: equality joint #0: urdf, sdf: joint 'j1' mimics 'j2', itself a mimic of 'j3': Drake and "
-        "Gazebo do not follow a chain of mimic joints"]
+    assert result.ledger[1:] == []
     assert result.verdict.ok, result.verdict.lines()
+    urdf = (folder / "urdf" / "telescope.urdf").read_text()
+    assert urdf.count('<mimic joint="j3" multiplier="1" offset="0"/>') == 2
+    build_ = Build("telescope", folder, folder / "urdf" / "telescope.urdf", None, None)
+    errors = [f.message for f in consumer_findings(build_)[0] if f.severity == "error"]
+    assert not [e for e in errors if "Drake" in e or "Pinocchio" in e or "PyBullet" in e], errors
 
 
 UNSTABLE = """<mujoco model="twitchy">

@@ -24,7 +24,7 @@ import numpy as np
 
 from robotkit import urdfxml
 from robotkit.check.findings import Finding
-from robotkit.check.kinematics import lump, read_urdf, real_mass, turn
+from robotkit.check.kinematics import followed_mimics, lump, read_urdf, real_mass, turn
 from robotkit.check.lints import resolve_uri
 from robotkit.mesh.export import obj_bytes
 from robotkit.mesh.io import load_mesh
@@ -134,6 +134,7 @@ def read(consumer: str, build: Build) -> View:
 def configurations(reference, count: int, seed: int = 0) -> list[dict[str, float]]:
     """Joint values: the zero pose, then random ones within limits (mimic joints follow)."""
     rng = np.random.default_rng(seed)
+    reference = followed_mimics(reference)
     movable = {n: j for n, j in reference.joints.items() if j.type in ("revolute", "continuous", "prismatic")}
     out = []
     for k in range(count):
@@ -153,6 +154,7 @@ def configurations(reference, count: int, seed: int = 0) -> list[dict[str, float
 
 def compare(reference, view: View, configs: list[dict[str, float]], tol: float = REL_TOL) -> list[str]:
     """Differences between the description (``reference``, a KModel) and a program's view."""
+    reference = followed_mimics(reference)
     ref = lump(reference, view.kept, view.lumps_world) if view.lumped else reference
     expected = {n: real_mass(link.mass) for n, link in ref.links.items() if n != "world"}
     total = sum(expected.values())

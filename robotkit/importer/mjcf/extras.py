@@ -142,22 +142,6 @@ def add_equalities(src, tree, recipe: dict, ledger) -> None:
                                "dropped: the rebuilt MJCF has MuJoCo's defaults (the recipe has no constraint softness)")
                 continue
         # the others are kept verbatim if they can be (robotkit.importer.mjcf.verbatim), on the ledger
-    _chained(src, tree, ledger)
-
-
-def _chained(src, tree, ledger) -> None:
-    """A mimic of a mimic (Stretch's telescoping arm: l0 follows l1, which follows l2...): kept
-    (the MJCF's equalities are a chain, and the rebuild's dynamics with them), and stated for the
-    URDF and SDF: Drake and Gazebo do not follow a chain of mimic joints (robotkit check's consumers)."""
-    specs = list(src.spec.equalities)
-    for e, (child, leader) in tree.mimics.items():
-        up = tree.joints[leader].get("mimic")
-        if up:
-            name = src.model.eq(e).name
-            ledger.add(src.where(specs[e]) if e < len(specs) else src.where(),
-                       f"equality joint '{name}'" if name else f"equality joint #{e}", "urdf, sdf",
-                       f"joint '{child}' mimics '{leader}', itself a mimic of '{up['joint']}': Drake and Gazebo do not "
-                       "follow a chain of mimic joints")
 
 
 def _one_dof(m, a: int, b: int) -> bool:
